@@ -1,0 +1,4 @@
+// Everything detsim offers a game, in one include.
+#pragma once
+
+#include <detsim/fixed.hpp>
