@@ -64,10 +64,11 @@ class Fixed {
   /// rounding except values >= 2^31 - 0.5, which saturate to INT32_MAX.
   [[nodiscard]] constexpr std::int32_t to_int() const noexcept;
 
-  /// Display only: the nearest double. Never feed the result back into simulation state.
-  [[nodiscard]] double to_double() const noexcept {
-    return static_cast<double>(raw_) * (1.0 / 4294967296.0);
-  }
+  /// Display only: the nearest binary floating-point value. Never feed it back into simulation
+  /// state (docs/DETERMINISM.md, rule 1).
+  // clang-format off
+  [[nodiscard]] double to_double() const noexcept { return static_cast<double>(raw_) * 0x1p-32; }
+  // clang-format on
 
   [[nodiscard]] static constexpr Fixed max() noexcept {
     return from_raw(std::numeric_limits<raw_type>::max());

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Builds and runs every test: the README's test command, and what CI runs.
+#   1. gcc, Release, warnings as errors: the whole suite, plus the installed-package consumer test.
+#   2. clang with AddressSanitizer + UndefinedBehaviorSanitizer, warnings as errors: the whole suite.
+#   3. clang-format: every C++ file is formatted.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+
+jobs=$(nproc)
+step() { printf '\n== %s ==\n' "$*"; }
+
+step "gcc Release"
+cmake -S . -B build/gcc-release -G Ninja -DCMAKE_CXX_COMPILER=g++ -DCMAKE_BUILD_TYPE=Release \
+  -DDETSIM_WERROR=ON >/dev/null
+cmake --build build/gcc-release -j "$jobs"
+ctest --test-dir build/gcc-release --output-on-failure -j "$jobs"
+
+step "clang ASan+UBSan"
+san="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
+cmake -S . -B build/clang-sanitize -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS="$san" -DCMAKE_EXE_LINKER_FLAGS="$san" \
+  -DDETSIM_WERROR=ON >/dev/null
+cmake --build build/clang-sanitize -j "$jobs"
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir build/clang-sanitize --output-on-failure -j "$jobs" -E '^install_consumer$'
+
+step "clang-format"
+git ls-files '*.cpp' '*.hpp' '*.h' | xargs clang-format --dry-run --Werror
+echo "clang-format: all files formatted"

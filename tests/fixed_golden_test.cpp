@@ -1,0 +1,170 @@
+// golden/fixed.txt: for every operation and function of the fixed layer, the XXH3-64 of its outputs
+// (raw values, 8 bytes little-endian each) over a fixed, seeded set of inputs. Any change to any
+// result on any machine fails here, naming the function. Changing a result is a breaking change:
+// the file is rewritten only on purpose, with
+//   DETSIM_UPDATE_GOLDEN=1 <build>/tests/fixed_golden_test
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <xxhash.h>
+#include <detsim/fixed.hpp>
+
+namespace detsim {
+namespace {
+
+constexpr std::size_t kInputs = 131072;
+const char* const kGoldenPath = DETSIM_SOURCE_DIR "/golden/fixed.txt";
+
+// SplitMix64 (Steele, Lea, Flood 2014): the input generator is part of the golden definition, so it
+// is written out here rather than taken from <random>, whose distributions differ by library.
+struct SplitMix64 {
+  std::uint64_t state;
+  std::uint64_t next() {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15U);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9U;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBU;
+    return z ^ (z >> 31);
+  }
+};
+
+// A third of the inputs uniform over all raw values, a third with log-uniform magnitude, a third
+// uniform in [-32, 32) where most functions do their interesting work.
+std::vector<Fixed> inputs(std::uint64_t seed) {
+  SplitMix64 rng{seed};
+  std::vector<Fixed> v;
+  v.reserve(kInputs);
+  for (std::size_t i = 0; i < kInputs; ++i) {
+    const std::uint64_t bits = rng.next();
+    std::uint64_t raw = bits;
+    if (i % 3 == 1) {
+      const std::uint64_t magnitude = (bits >> 1) >> (rng.next() % 63);
+      raw = (bits & 1U) != 0 ? 0U - magnitude : magnitude;
+    }
+    if (i % 3 == 2) raw = static_cast<std::uint64_t>(static_cast<std::int64_t>(bits) >> 26);
+    v.push_back(Fixed::from_raw(static_cast<std::int64_t>(raw)));
+  }
+  return v;
+}
+
+void append_le(std::vector<unsigned char>& out, Fixed x) {
+  const auto bits = static_cast<std::uint64_t>(x.raw());
+  for (int i = 0; i < 8; ++i)
+    out.push_back(static_cast<unsigned char>(bits >> (8 * i)));
+}
+
+using Unary = std::function<Fixed(Fixed)>;
+using Binary = std::function<Fixed(Fixed, Fixed)>;
+
+std::map<std::string, std::uint64_t> compute_hashes() {
+  const std::vector<Fixed> x = inputs(1);
+  const std::vector<Fixed> y = inputs(2);
+  const std::vector<std::pair<const char*, Unary>> unary = {
+      {"sqrt", [](Fixed a) { return sqrt(a); }},
+      {"rsqrt", [](Fixed a) { return rsqrt(a); }},
+      {"sin", [](Fixed a) { return sin(a); }},
+      {"cos", [](Fixed a) { return cos(a); }},
+      {"tan", [](Fixed a) { return tan(a); }},
+      {"asin", [](Fixed a) { return asin(a >> 31); }},
+      {"acos", [](Fixed a) { return acos(a >> 31); }},
+      {"atan", [](Fixed a) { return atan(a); }},
+      {"exp", [](Fixed a) { return exp(a); }},
+      {"exp2", [](Fixed a) { return exp2(a); }},
+      {"log", [](Fixed a) { return log(a); }},
+      {"log2", [](Fixed a) { return log2(a); }},
+      {"floor", [](Fixed a) { return floor(a); }},
+      {"ceil", [](Fixed a) { return ceil(a); }},
+      {"round", [](Fixed a) { return round(a); }},
+      {"neg", [](Fixed a) { return -a; }},
+  };
+  const std::vector<std::pair<const char*, Binary>> binary = {
+      {"add", [](Fixed a, Fixed b) { return a + b; }},
+      {"sub", [](Fixed a, Fixed b) { return a - b; }},
+      {"mul", [](Fixed a, Fixed b) { return a * b; }},
+      {"div", [](Fixed a, Fixed b) { return a / b; }},
+      {"hypot", [](Fixed a, Fixed b) { return hypot(a, b); }},
+      {"atan2", [](Fixed a, Fixed b) { return atan2(a, b); }},
+      {"pow", [](Fixed a, Fixed b) { return pow(a, b >> 27); }},
+      {"lerp", [](Fixed a, Fixed b) { return lerp(a, b, b >> 30); }},
+  };
+  std::map<std::string, std::uint64_t> hashes;
+  std::vector<unsigned char> bytes;
+  for (const auto& [name, f] : unary) {
+    bytes.clear();
+    for (const Fixed a : x)
+      append_le(bytes, f(a));
+    hashes[name] = XXH3_64bits(bytes.data(), bytes.size());
+  }
+  for (const auto& [name, f] : binary) {
+    bytes.clear();
+    for (std::size_t i = 0; i < kInputs; ++i)
+      append_le(bytes, f(x[i], y[i]));
+    hashes[name] = XXH3_64bits(bytes.data(), bytes.size());
+  }
+  bytes.clear();
+  for (const Fixed a : x) {
+    const SinCos sc = sincos(a);
+    append_le(bytes, sc.sin);
+    append_le(bytes, sc.cos);
+  }
+  hashes["sincos"] = XXH3_64bits(bytes.data(), bytes.size());
+  return hashes;
+}
+
+std::string hex(std::uint64_t h) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+TEST(FixedGolden, EveryFunctionReproducesItsGoldenHash) {
+  const auto actual = compute_hashes();
+  const char* update = std::getenv("DETSIM_UPDATE_GOLDEN");
+  if (update != nullptr && std::string(update) == "1") {
+    std::ofstream out(kGoldenPath);
+    out << "# XXH3-64 of the little-endian raw outputs of each fixed-layer function over "
+        << kInputs
+        << " seeded inputs\n# (tests/fixed_golden_test.cpp). Every machine must reproduce these. "
+           "A change is a breaking\n# change: regenerate only on purpose with "
+           "DETSIM_UPDATE_GOLDEN=1 <build>/tests/fixed_golden_test\n";
+    for (const auto& [name, h] : actual)
+      out << name << ' ' << hex(h) << '\n';
+    ASSERT_TRUE(out.good()) << "could not write " << kGoldenPath;
+    GTEST_SKIP() << "rewrote " << kGoldenPath;
+  }
+  std::ifstream in(kGoldenPath);
+  ASSERT_TRUE(in) << "missing " << kGoldenPath;
+  std::map<std::string, std::string> expected;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::string name;
+    std::string value;
+    fields >> name >> value;
+    expected[name] = value;
+  }
+  for (const auto& [name, h] : actual) {
+    const auto it = expected.find(name);
+    if (it == expected.end()) {
+      ADD_FAILURE() << name << ": no golden hash (actual " << hex(h) << ")";
+    } else {
+      EXPECT_EQ(it->second, hex(h))
+          << name << ": results changed (expected " << it->second << ", actual " << hex(h) << ")";
+    }
+  }
+  for (const auto& [name, value] : expected) {
+    EXPECT_TRUE(actual.count(name) != 0) << "golden/fixed.txt names unknown function " << name;
+  }
+}
+
+}  // namespace
+}  // namespace detsim
