@@ -7,7 +7,8 @@
 //   nearest, ties to even. There is no other rounding rule.
 // - Overflow: results outside [min(), max()] saturate to the nearer extreme. -min() == max().
 // - Division by zero never traps: x / 0 is max() for x > 0, min() for x < 0, and 0 for 0 / 0.
-// - Shifts: x << n == x * 2^n (saturating), x >> n == x / 2^n (rounded); n < 0 shifts the other way.
+// - Shifts: x << n == x * 2^n (saturating), x >> n == x / 2^n (rounded); n < 0 shifts the other
+// way.
 #pragma once
 
 #include <compare>
@@ -22,17 +23,69 @@ namespace detsim {
 struct ParseResult;
 
 namespace detail {
+
+inline constexpr int fraction_bits = 32;
+inline constexpr std::int64_t raw_max = std::numeric_limits<std::int64_t>::max();
+inline constexpr std::int64_t raw_min = std::numeric_limits<std::int64_t>::min();
+
+/// |v| as an unsigned value (exact for INT64_MIN).
+constexpr std::uint64_t magnitude(std::int64_t v) noexcept {
+  return v < 0 ? 0U - static_cast<std::uint64_t>(v) : static_cast<std::uint64_t>(v);
+}
+
+/// Applies a sign to an unsigned magnitude and saturates to the int64 range.
+constexpr std::int64_t signed_saturate(bool negative, std::uint64_t mag) noexcept {
+  if (negative) {
+    return mag >= (std::uint64_t{1} << 63) ? raw_min : -static_cast<std::int64_t>(mag);
+  }
+  return mag > static_cast<std::uint64_t>(raw_max) ? raw_max : static_cast<std::int64_t>(mag);
+}
+
+/// Rounds a 128-bit magnitude right by `shift` bits (1..64), to nearest, ties to even. The result
+/// saturates to UINT64_MAX when it does not fit in 64 bits.
+constexpr std::uint64_t round_shift_right(wide::U128 v, unsigned shift) noexcept {
+  const wide::U128 q = wide::shr(v, shift);
+  if (q.hi != 0) return ~std::uint64_t{0};
+  const std::uint64_t rest = shift == 64 ? v.lo : v.lo & ((std::uint64_t{1} << shift) - 1);
+  const std::uint64_t half = std::uint64_t{1} << (shift - 1);
+  const bool up = rest > half || (rest == half && (q.lo & 1U) != 0);
+  if (up && q.lo == ~std::uint64_t{0}) return q.lo;  // saturated anyway
+  return q.lo + (up ? 1U : 0U);
+}
+
 template <class Ops>
-constexpr std::int64_t fixed_mul(std::int64_t a, std::int64_t b) noexcept;
+constexpr std::int64_t fixed_mul(std::int64_t a, std::int64_t b) noexcept {
+  // Sign-magnitude: round the magnitude, then apply the sign. Ties to even is symmetric, so this
+  // equals rounding the signed product.
+  const bool negative = (a < 0) != (b < 0);
+  const wide::U128 product = Ops::mul(magnitude(a), magnitude(b));
+  return signed_saturate(negative, round_shift_right(product, fraction_bits));
+}
+
 template <class Ops>
-constexpr std::int64_t fixed_div(std::int64_t a, std::int64_t b) noexcept;
+constexpr std::int64_t fixed_div(std::int64_t a, std::int64_t b) noexcept {
+  if (b == 0) return a > 0 ? raw_max : (a < 0 ? raw_min : 0);
+  const bool negative = (a < 0) != (b < 0);
+  const std::uint64_t n = magnitude(a);
+  const std::uint64_t d = magnitude(b);
+  const wide::U128 numerator{n >> 32, n << 32};                // |a| * 2^32
+  if (numerator.hi >= d) return negative ? raw_min : raw_max;  // quotient >= 2^64
+  const wide::DivResult qr = Ops::div(numerator, d);
+  // Ties to even: compare twice the remainder with the divisor (2 * rem < 2^64 since rem < d).
+  const std::uint64_t twice = qr.remainder << 1;
+  const bool over_half = (qr.remainder >> 63) != 0 || twice > d;
+  const bool up = over_half || (twice == d && (qr.quotient & 1U) != 0);
+  if (up && qr.quotient == ~std::uint64_t{0}) return negative ? raw_min : raw_max;
+  return signed_saturate(negative, qr.quotient + (up ? 1U : 0U));
+}
+
 }  // namespace detail
 
 /// Q32.32 fixed-point number: 32 integer bits (including sign) and 32 fraction bits.
 class Fixed {
  public:
   using raw_type = std::int64_t;
-  static constexpr int fraction_bits = 32;
+  static constexpr int fraction_bits = detail::fraction_bits;
   static constexpr raw_type one_raw = raw_type{1} << fraction_bits;
 
   /// Zero.
@@ -106,8 +159,8 @@ class Fixed {
 
   /// Saturating addition.
   friend constexpr Fixed operator+(Fixed a, Fixed b) noexcept {
-    const auto sum =
-        static_cast<raw_type>(static_cast<std::uint64_t>(a.raw_) + static_cast<std::uint64_t>(b.raw_));
+    const auto sum = static_cast<raw_type>(static_cast<std::uint64_t>(a.raw_) +
+                                           static_cast<std::uint64_t>(b.raw_));
     // Overflow iff both operands have the same sign and the sum's sign differs.
     if (((a.raw_ ^ sum) & (b.raw_ ^ sum)) < 0) return a.raw_ < 0 ? min() : max();
     return from_raw(sum);
@@ -115,8 +168,8 @@ class Fixed {
 
   /// Saturating subtraction.
   friend constexpr Fixed operator-(Fixed a, Fixed b) noexcept {
-    const auto diff =
-        static_cast<raw_type>(static_cast<std::uint64_t>(a.raw_) - static_cast<std::uint64_t>(b.raw_));
+    const auto diff = static_cast<raw_type>(static_cast<std::uint64_t>(a.raw_) -
+                                            static_cast<std::uint64_t>(b.raw_));
     // Overflow iff the operands have different signs and the result's sign differs from a's.
     if (((a.raw_ ^ b.raw_) & (a.raw_ ^ diff)) < 0) return a.raw_ < 0 ? min() : max();
     return from_raw(diff);
@@ -127,7 +180,8 @@ class Fixed {
     return from_raw(detail::fixed_mul<wide::Default>(a.raw_, b.raw_));
   }
 
-  /// Quotient rounded to nearest (ties to even), saturated; x / 0 saturates with x's sign, 0 / 0 = 0.
+  /// Quotient rounded to nearest (ties to even), saturated; x / 0 saturates with x's sign, 0 / 0 =
+  /// 0.
   friend constexpr Fixed operator/(Fixed a, Fixed b) noexcept {
     return from_raw(detail::fixed_div<wide::Default>(a.raw_, b.raw_));
   }
@@ -150,69 +204,12 @@ class Fixed {
 
 static_assert(sizeof(Fixed) == 8, "Fixed is exactly its 64-bit raw value");
 
-namespace detail {
-
-inline constexpr std::int64_t raw_max = std::numeric_limits<std::int64_t>::max();
-inline constexpr std::int64_t raw_min = std::numeric_limits<std::int64_t>::min();
-
-/// |v| as an unsigned value (exact for INT64_MIN).
-constexpr std::uint64_t magnitude(std::int64_t v) noexcept {
-  return v < 0 ? 0U - static_cast<std::uint64_t>(v) : static_cast<std::uint64_t>(v);
-}
-
-/// Applies a sign to an unsigned magnitude and saturates to the int64 range.
-constexpr std::int64_t signed_saturate(bool negative, std::uint64_t mag) noexcept {
-  if (negative) {
-    return mag >= (std::uint64_t{1} << 63) ? raw_min : -static_cast<std::int64_t>(mag);
-  }
-  return mag > static_cast<std::uint64_t>(raw_max) ? raw_max : static_cast<std::int64_t>(mag);
-}
-
-/// Rounds a 128-bit magnitude right by `shift` bits (1..64), to nearest, ties to even. The result
-/// saturates to UINT64_MAX when it does not fit in 64 bits.
-constexpr std::uint64_t round_shift_right(wide::U128 v, unsigned shift) noexcept {
-  const wide::U128 q = wide::shr(v, shift);
-  if (q.hi != 0) return ~std::uint64_t{0};
-  const std::uint64_t rest = shift == 64 ? v.lo : v.lo & ((std::uint64_t{1} << shift) - 1);
-  const std::uint64_t half = std::uint64_t{1} << (shift - 1);
-  const bool up = rest > half || (rest == half && (q.lo & 1U) != 0);
-  if (up && q.lo == ~std::uint64_t{0}) return q.lo;  // saturated anyway
-  return q.lo + (up ? 1U : 0U);
-}
-
-template <class Ops>
-constexpr std::int64_t fixed_mul(std::int64_t a, std::int64_t b) noexcept {
-  // Sign-magnitude: round the magnitude, then apply the sign. Ties to even is symmetric, so this
-  // equals rounding the signed product.
-  const bool negative = (a < 0) != (b < 0);
-  const wide::U128 product = Ops::mul(magnitude(a), magnitude(b));
-  return signed_saturate(negative, round_shift_right(product, Fixed::fraction_bits));
-}
-
-template <class Ops>
-constexpr std::int64_t fixed_div(std::int64_t a, std::int64_t b) noexcept {
-  if (b == 0) return a > 0 ? raw_max : (a < 0 ? raw_min : 0);
-  const bool negative = (a < 0) != (b < 0);
-  const std::uint64_t n = magnitude(a);
-  const std::uint64_t d = magnitude(b);
-  const wide::U128 numerator{n >> 32, n << 32};  // |a| * 2^32
-  if (numerator.hi >= d) return negative ? raw_min : raw_max;  // quotient >= 2^64
-  const wide::DivResult qr = Ops::div(numerator, d);
-  // Ties to even: compare twice the remainder with the divisor (2 * rem < 2^64 since rem < d).
-  const std::uint64_t twice = qr.remainder << 1;
-  const bool over_half = (qr.remainder >> 63) != 0 || twice > d;
-  const bool up = over_half || (twice == d && (qr.quotient & 1U) != 0);
-  if (up && qr.quotient == ~std::uint64_t{0}) return negative ? raw_min : raw_max;
-  return signed_saturate(negative, qr.quotient + (up ? 1U : 0U));
-}
-
-}  // namespace detail
-
 constexpr std::int32_t Fixed::to_int() const noexcept {
   const std::uint64_t mag = detail::magnitude(raw_);
   const std::uint64_t rounded = detail::round_shift_right(wide::U128{0, mag}, fraction_bits);
-  if (raw_ < 0) return rounded >= (std::uint64_t{1} << 31) ? std::numeric_limits<std::int32_t>::min()
-                                                            : -static_cast<std::int32_t>(rounded);
+  if (raw_ < 0)
+    return rounded >= (std::uint64_t{1} << 31) ? std::numeric_limits<std::int32_t>::min()
+                                               : -static_cast<std::int32_t>(rounded);
   return rounded > 0x7FFFFFFFU ? std::numeric_limits<std::int32_t>::max()
                                : static_cast<std::int32_t>(rounded);
 }
@@ -237,8 +234,12 @@ constexpr Fixed operator>>(Fixed a, int n) noexcept {
 }
 
 /// Products of Fixed and int32 are exact before saturation; these spare the reader a from_int.
-constexpr Fixed operator*(Fixed a, std::int32_t b) noexcept { return a * Fixed::from_int(b); }
-constexpr Fixed operator*(std::int32_t a, Fixed b) noexcept { return Fixed::from_int(a) * b; }
+constexpr Fixed operator*(Fixed a, std::int32_t b) noexcept {
+  return a * Fixed::from_int(b);
+}
+constexpr Fixed operator*(std::int32_t a, Fixed b) noexcept {
+  return Fixed::from_int(a) * b;
+}
 
 }  // namespace detsim
 
