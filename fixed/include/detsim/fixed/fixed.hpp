@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <limits>
 #include <string_view>
+#include <type_traits>
 
 #include <detsim/fixed/wide.hpp>
 
@@ -55,8 +56,25 @@ constexpr std::uint64_t round_shift_right(wide::U128 v, unsigned shift) noexcept
 
 template <class Ops>
 constexpr std::int64_t fixed_mul(std::int64_t a, std::int64_t b) noexcept {
-  // Sign-magnitude: round the magnitude, then apply the sign. Ties to even is symmetric, so this
-  // equals rounding the signed product.
+#if DETSIM_HAS_INT128
+  if constexpr (std::is_same_v<Ops, wide::Native>) {
+    // Signed form for 64-bit targets: one widening multiply, then 64-bit work on bits 32..95 (the
+    // candidate result q) and 96..127 (which must be q's sign extension, else the result does not
+    // fit). Ties to even: add 1 iff the dropped 32 bits plus q's lowest bit exceed 2^31 - 1.
+    __extension__ using int128 = __int128;
+    const int128 p = static_cast<int128>(a) * b;
+    const auto lo = static_cast<std::uint64_t>(p);
+    const auto hi = static_cast<std::uint64_t>(p >> 64);
+    const std::uint64_t q = (lo >> fraction_bits) | (hi << fraction_bits);
+    const auto top = static_cast<std::int64_t>(hi) >> fraction_bits;
+    if (top != (static_cast<std::int64_t>(q) >> 63)) return top < 0 ? raw_min : raw_max;
+    const std::uint64_t up = ((lo & 0xFFFFFFFFU) + (q & 1U) + 0x7FFFFFFFU) >> fraction_bits;
+    const auto rounded = static_cast<std::int64_t>(q + up);
+    return rounded < static_cast<std::int64_t>(q) ? raw_max : rounded;  // q == max rounded up
+  }
+#endif
+  // Portable: sign-magnitude. Round the magnitude, then apply the sign; ties to even is symmetric,
+  // so this equals rounding the signed product. Tests compare the two forms bit for bit.
   const bool negative = (a < 0) != (b < 0);
   const wide::U128 product = Ops::mul(magnitude(a), magnitude(b));
   return signed_saturate(negative, round_shift_right(product, fraction_bits));
