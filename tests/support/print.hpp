@@ -10,10 +10,9 @@
 namespace detsim {
 
 inline void PrintTo(Fixed x, std::ostream* os) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.12g (raw 0x%016" PRIx64 ")", x.to_double(),
-                static_cast<std::uint64_t>(x.raw()));
-  *os << buf;
+  char buf[40];
+  std::snprintf(buf, sizeof buf, " (raw 0x%016" PRIx64 ")", static_cast<std::uint64_t>(x.raw()));
+  *os << to_string(x) << buf;
 }
 
 }  // namespace detsim

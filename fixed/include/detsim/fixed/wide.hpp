@@ -60,7 +60,9 @@ constexpr U128 shr(U128 a, unsigned n) noexcept {
 }
 
 /// Two's-complement negation.
-constexpr U128 negate(U128 a) noexcept { return sub(U128{0, 0}, a); }
+constexpr U128 negate(U128 a) noexcept {
+  return sub(U128{0, 0}, a);
+}
 
 /// Plain 64-bit C++: schoolbook multiplication on 32-bit limbs and Knuth's algorithm D with two
 /// 32-bit quotient digits (Hacker's Delight, "divlu"). Valid on every target.

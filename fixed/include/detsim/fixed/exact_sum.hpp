@@ -1,0 +1,164 @@
+// Exact sums of Q32.32 products, rounded once.
+//
+// A dot product of Q32.32 vectors is a sum of 128-bit products (each a Q64.64 value). Rounding
+// every product to Q32.32 before adding would round up to four times and would saturate whenever a
+// partial sum leaves the Fixed range even though the total does not. ExactSum instead keeps the
+// whole sum as a two's-complement integer of 64 * Limbs bits and rounds once at the end, to nearest
+// with ties to even, saturating to the Fixed range. Three limbs hold any sum of up to 2^64 products
+// of two raws; four limbs hold sums of products of three raws (determinants, R I R^T).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include <detsim/fixed/fixed.hpp>
+#include <detsim/fixed/wide.hpp>
+
+namespace detsim::detail {
+
+template <std::size_t Limbs>
+class ExactSum {
+  static_assert(Limbs >= 2, "an exact sum needs at least 128 bits");
+
+ public:
+  /// Little-endian 64-bit limbs.
+  using Words = std::array<std::uint64_t, Limbs>;
+
+  /// Adds m (or subtracts it when `negative`); m is an unsigned magnitude of M <= Limbs limbs. The
+  /// caller keeps the true sum inside the signed range, which the limb counts above guarantee.
+  template <std::size_t M>
+  constexpr void add(bool negative, const std::array<std::uint64_t, M>& m) noexcept {
+    static_assert(M <= Limbs);
+    // Branch-free (the sign of a product is unpredictable): adding -m is adding ~m + 1 over all
+    // limbs, with the limbs above m's all ones.
+    const std::uint64_t flip = negative ? ~std::uint64_t{0} : 0;
+    std::uint64_t carry = negative ? 1U : 0U;
+    for (std::size_t i = 0; i < Limbs; ++i) {
+      const std::uint64_t mi = (i < M ? m[i] : 0) ^ flip;
+      const std::uint64_t s = limb_[i] + mi;
+      const std::uint64_t s2 = s + carry;
+      carry = (s < mi ? 1U : 0U) | (s2 < carry ? 1U : 0U);
+      limb_[i] = s2;
+    }
+  }
+
+  constexpr void add(bool negative, wide::U128 m) noexcept {
+    add(negative, std::array<std::uint64_t, 2>{m.lo, m.hi});
+  }
+
+  /// Adds a * b (raw times raw: a Q64.64 term).
+  constexpr void add_product(std::int64_t a, std::int64_t b) noexcept {
+    add((a < 0) != (b < 0), wide::Default::mul(magnitude(a), magnitude(b)));
+  }
+
+  /// Subtracts a * b.
+  constexpr void sub_product(std::int64_t a, std::int64_t b) noexcept {
+    add((a < 0) == (b < 0), wide::Default::mul(magnitude(a), magnitude(b)));
+  }
+
+  /// Adds (negative ? -m : m) * c for a 128-bit magnitude m: up to 192 bits.
+  constexpr void add_product(bool negative, wide::U128 m, std::int64_t c) noexcept {
+    const std::uint64_t cm = magnitude(c);
+    const wide::U128 lo = wide::Default::mul(m.lo, cm);
+    const wide::U128 hi = wide::Default::mul(m.hi, cm);
+    const std::uint64_t mid = lo.hi + hi.lo;
+    // m * c < 2^192, so the top limb cannot overflow.
+    add(negative != (c < 0),
+        std::array<std::uint64_t, 3>{lo.lo, mid, hi.hi + (mid < lo.hi ? 1U : 0U)});
+  }
+
+  /// Adds a * b * c (a Q96.96 term).
+  constexpr void add_product(std::int64_t a, std::int64_t b, std::int64_t c) noexcept {
+    add_product((a < 0) != (b < 0), wide::Default::mul(magnitude(a), magnitude(b)), c);
+  }
+
+  /// Subtracts a * b * c.
+  constexpr void sub_product(std::int64_t a, std::int64_t b, std::int64_t c) noexcept {
+    add_product((a < 0) == (b < 0), wide::Default::mul(magnitude(a), magnitude(b)), c);
+  }
+
+  /// Adds a * 2^shift, shift < 64.
+  constexpr void add_scaled(std::int64_t a, unsigned shift) noexcept {
+    add(a < 0, wide::shl(wide::U128{0, magnitude(a)}, shift));
+  }
+
+  [[nodiscard]] constexpr bool negative() const noexcept { return (limb_[Limbs - 1] >> 63) != 0; }
+
+  [[nodiscard]] constexpr bool is_zero() const noexcept {
+    for (const std::uint64_t w : limb_)
+      if (w != 0) return false;
+    return true;
+  }
+
+  /// |sum| as little-endian limbs.
+  [[nodiscard]] constexpr Words magnitude_words() const noexcept {
+    if (!negative()) return limb_;
+    Words m{};
+    std::uint64_t carry = 1;
+    for (std::size_t i = 0; i < Limbs; ++i) {
+      m[i] = ~limb_[i] + carry;
+      carry = (carry != 0 && m[i] == 0) ? 1U : 0U;
+    }
+    return m;
+  }
+
+  /// |sum| when it fits in 128 bits (check with fits_128 first).
+  [[nodiscard]] constexpr wide::U128 magnitude_128() const noexcept {
+    const Words m = magnitude_words();
+    return {m[1], m[0]};
+  }
+
+  [[nodiscard]] constexpr bool fits_128() const noexcept {
+    const Words m = magnitude_words();
+    for (std::size_t i = 2; i < Limbs; ++i)
+      if (m[i] != 0) return false;
+    return true;
+  }
+
+  /// sum / 2^shift rounded to nearest, ties to even, saturated to the int64 range. 1 <= shift and
+  /// shift + 64 <= 64 * Limbs. Rounding the magnitude and then applying the sign equals rounding
+  /// the signed value, because ties to even is symmetric.
+  [[nodiscard]] constexpr std::int64_t round_to_raw(unsigned shift) const noexcept {
+    const bool neg = negative();
+    const Words m = magnitude_words();
+    const std::size_t word = shift / 64;
+    const unsigned bit = shift % 64;
+    std::uint64_t q = m[word] >> bit;
+    bool overflow = false;
+    if (bit != 0 && word + 1 < Limbs) {
+      q |= m[word + 1] << (64 - bit);
+      overflow = (m[word + 1] >> bit) != 0;
+    } else if (bit == 0 && word + 1 < Limbs) {
+      overflow = m[word + 1] != 0;
+    }
+    for (std::size_t i = word + 2; i < Limbs; ++i)
+      overflow = overflow || m[i] != 0;
+    if (overflow) return neg ? raw_min : raw_max;
+
+    const std::size_t half_word = (shift - 1) / 64;
+    const unsigned half_bit = (shift - 1) % 64;
+    const bool half = ((m[half_word] >> half_bit) & 1U) != 0;
+    bool sticky = (m[half_word] & ((std::uint64_t{1} << half_bit) - 1)) != 0;
+    for (std::size_t i = 0; i < half_word; ++i)
+      sticky = sticky || m[i] != 0;
+    const bool up = half && (sticky || (q & 1U) != 0);
+    if (up && q == ~std::uint64_t{0}) return neg ? raw_min : raw_max;
+    return signed_saturate(neg, q + (up ? 1U : 0U));
+  }
+
+  /// The sum of Q64.64 terms rounded to Fixed.
+  [[nodiscard]] constexpr Fixed to_fixed() const noexcept {
+    return Fixed::from_raw(round_to_raw(Fixed::fraction_bits));
+  }
+
+ private:
+  Words limb_{};
+};
+
+/// The sum of products used by dot and cross products: exact for any number of terms that matters.
+using ProductSum = ExactSum<3>;
+/// The sum of products of three raws (determinants, tensor rotation).
+using TripleProductSum = ExactSum<4>;
+
+}  // namespace detsim::detail
