@@ -18,6 +18,10 @@
 #include <xxhash.h>
 #include <detsim/fixed.hpp>
 
+#if defined(DETSIM_NO_INT128)
+static_assert(DETSIM_HAS_INT128 == 0, "the portable golden build must not use __int128");
+#endif
+
 namespace detsim {
 namespace {
 
@@ -116,6 +120,71 @@ std::map<std::string, std::uint64_t> compute_hashes() {
     append_le(bytes, sc.cos);
   }
   hashes["sincos"] = XXH3_64bits(bytes.data(), bytes.size());
+
+  // The vector layer, which the simulation's results pass through: vectors from three consecutive
+  // inputs scaled into +-2^20 (the documented no-overflow range), angles and steps from y.
+  const auto vec_shifted = [&x](std::size_t i, int shift) {
+    return Vec3{x[i % kInputs] >> shift, x[(i + 1) % kInputs] >> shift,
+                x[(i + 2) % kInputs] >> shift};
+  };
+  const auto vec = [&vec_shifted](std::size_t i) { return vec_shifted(i, 11); };
+  const auto quat = [&y](std::size_t i) {
+    return Quat{y[i % kInputs] >> 28, y[(i + 1) % kInputs] >> 28, y[(i + 2) % kInputs] >> 28,
+                y[(i + 3) % kInputs] >> 28};
+  };
+  const auto hash_vectors = [&bytes](const char* name, auto&& f, auto& out) {
+    bytes.clear();
+    for (std::size_t i = 0; i < kInputs; ++i) {
+      for (const Fixed c : f(i))
+        append_le(bytes, c);
+    }
+    out[name] = XXH3_64bits(bytes.data(), bytes.size());
+  };
+  const auto v3 = [](Vec3 v) { return std::array<Fixed, 3>{v.x, v.y, v.z}; };
+  const auto q4 = [](Quat q) { return std::array<Fixed, 4>{q.w, q.x, q.y, q.z}; };
+  const auto m9 = [](const Mat3& m) {
+    std::array<Fixed, 9> a;
+    for (std::size_t r = 0; r < 3; ++r) {
+      a[3 * r] = m.rows[r].x;
+      a[3 * r + 1] = m.rows[r].y;
+      a[3 * r + 2] = m.rows[r].z;
+    }
+    return a;
+  };
+  const auto mat = [&vec_shifted](std::size_t i) {
+    return Mat3{{vec_shifted(i, 27), vec_shifted(i + 3, 27), vec_shifted(i + 6, 27)}};
+  };
+  hash_vectors(
+      "vec3_cross", [&](std::size_t i) { return v3(cross(vec(i), vec(i + 5))); }, hashes);
+  hash_vectors(
+      "vec3_length", [&](std::size_t i) { return std::array<Fixed, 1>{length(vec(i))}; }, hashes);
+  hash_vectors(
+      "vec3_normalize", [&](std::size_t i) { return v3(normalize(vec(i))); }, hashes);
+  hash_vectors(
+      "quat_normalize", [&](std::size_t i) { return q4(normalize(quat(i))); }, hashes);
+  hash_vectors(
+      "quat_product",
+      [&](std::size_t i) { return q4(normalize(quat(i)) * normalize(quat(i + 7))); }, hashes);
+  hash_vectors(
+      "quat_rotate",
+      [&](std::size_t i) { return v3(rotate(normalize(quat(i)), vec_shifted(i, 19))); }, hashes);
+  hash_vectors(
+      "quat_from_axis_angle",
+      [&](std::size_t i) { return q4(from_axis_angle(vec(i), y[i] >> 24)); }, hashes);
+  hash_vectors(
+      "quat_integrate",
+      [&](std::size_t i) {
+        return q4(integrate(normalize(quat(i)), vec_shifted(i, 23), Fixed::from_raw(71582788)));
+      },
+      hashes);
+  hash_vectors(
+      "quat_to_mat3", [&](std::size_t i) { return m9(to_mat3(normalize(quat(i)))); }, hashes);
+  hash_vectors(
+      "mat3_inverse", [&](std::size_t i) { return m9(inverse(mat(i))); }, hashes);
+  hash_vectors(
+      "mat3_rotate_inertia",
+      [&](std::size_t i) { return m9(rotate_inertia(to_mat3(normalize(quat(i))), mat(i))); },
+      hashes);
   return hashes;
 }
 
