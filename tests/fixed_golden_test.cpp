@@ -5,18 +5,16 @@
 //   DETSIM_UPDATE_GOLDEN=1 <build>/tests/fixed_golden_test
 #include <array>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
-#include <fstream>
 #include <functional>
 #include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <xxhash.h>
 #include <detsim/fixed.hpp>
+
+#include "support/golden.hpp"
 
 #if defined(DETSIM_NO_INT128)
 static_assert(DETSIM_HAS_INT128 == 0, "the portable golden build must not use __int128");
@@ -188,51 +186,15 @@ std::map<std::string, std::uint64_t> compute_hashes() {
   return hashes;
 }
 
-std::string hex(std::uint64_t h) {
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
-
 TEST(FixedGolden, EveryFunctionReproducesItsGoldenHash) {
-  const auto actual = compute_hashes();
-  const char* update = std::getenv("DETSIM_UPDATE_GOLDEN");
-  if (update != nullptr && std::string(update) == "1") {
-    std::ofstream out(kGoldenPath);
-    out << "# XXH3-64 of the little-endian raw outputs of each fixed-layer function over "
-        << kInputs
-        << " seeded inputs\n# (tests/fixed_golden_test.cpp). Every machine must reproduce these. "
-           "A change is a breaking\n# change: regenerate only on purpose with "
-           "DETSIM_UPDATE_GOLDEN=1 <build>/tests/fixed_golden_test\n";
-    for (const auto& [name, h] : actual)
-      out << name << ' ' << hex(h) << '\n';
-    ASSERT_TRUE(out.good()) << "could not write " << kGoldenPath;
-    GTEST_SKIP() << "rewrote " << kGoldenPath;
-  }
-  std::ifstream in(kGoldenPath);
-  ASSERT_TRUE(in) << "missing " << kGoldenPath;
-  std::map<std::string, std::string> expected;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream fields(line);
-    std::string name;
-    std::string value;
-    fields >> name >> value;
-    expected[name] = value;
-  }
-  for (const auto& [name, h] : actual) {
-    const auto it = expected.find(name);
-    if (it == expected.end()) {
-      ADD_FAILURE() << name << ": no golden hash (actual " << hex(h) << ")";
-    } else {
-      EXPECT_EQ(it->second, hex(h))
-          << name << ": results changed (expected " << it->second << ", actual " << hex(h) << ")";
-    }
-  }
-  for (const auto& [name, value] : expected) {
-    EXPECT_TRUE(actual.count(name) != 0) << "golden/fixed.txt names unknown function " << name;
-  }
+  test::check_golden(
+      kGoldenPath,
+      "# XXH3-64 of the little-endian raw outputs of each fixed-layer function over " +
+          std::to_string(kInputs) +
+          " seeded inputs\n# (tests/fixed_golden_test.cpp). Every machine must reproduce these. "
+          "A change is a breaking\n# change: regenerate only on purpose with "
+          "DETSIM_UPDATE_GOLDEN=1 <build>/tests/fixed_golden_test\n",
+      compute_hashes());
 }
 
 }  // namespace

@@ -2,3 +2,4 @@
 #pragma once
 
 #include <detsim/fixed.hpp>
+#include <detsim/sim.hpp>

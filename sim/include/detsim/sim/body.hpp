@@ -1,0 +1,57 @@
+// Bodies: IDs, types and the definition a body is created from.
+#pragma once
+
+#include <compare>
+#include <cstdint>
+
+#include <detsim/fixed/decimal.hpp>
+#include <detsim/fixed/fixed.hpp>
+#include <detsim/fixed/quat.hpp>
+#include <detsim/fixed/vec3.hpp>
+#include <detsim/sim/shape.hpp>
+
+namespace detsim {
+
+/// A body's identity: a value, never reused within a world, assigned in creation order (1, 2,
+/// 3, ...). Zero is the null ID. Everything the simulation iterates goes in ascending ID order.
+struct BodyId {
+  std::uint32_t value = 0;
+
+  [[nodiscard]] constexpr bool is_null() const noexcept { return value == 0; }
+  friend constexpr auto operator<=>(BodyId, BodyId) noexcept = default;
+};
+
+/// The numeric values are part of the canonical state encoding.
+enum class BodyType : std::uint8_t {
+  static_body = 0,  ///< never moves; infinite mass
+  kinematic = 1,    ///< moved by its velocity only; pushes dynamic bodies, is not pushed
+  dynamic = 2,      ///< moved by forces, gravity and contacts
+};
+
+/// Everything needed to create a body. Plain data with defaults; recordable.
+struct BodyDef {
+  BodyType type = BodyType::dynamic;
+  Shape shape = Shape::sphere(Fixed::half());
+  Vec3 position{};
+  /// Must be a unit quaternion: | |q|^2 - 1 | <= 2^-20. Use normalize() or from_axis_angle().
+  Quat orientation{};
+  Vec3 linear_velocity{};   ///< m/s
+  Vec3 angular_velocity{};  ///< rad/s, world space
+  /// kg. When zero, the mass is density * volume. Dynamic bodies must end up with a positive mass.
+  Fixed mass{};
+  Fixed density = Fixed::from_int(1000);  ///< kg/m^3 (water), used when mass is zero
+  Fixed friction = Fixed::from_raw(Fixed::one_raw * 6 / 10);  ///< Coulomb coefficient, >= 0
+  Fixed restitution{};                                        ///< 0 (no bounce) .. 1 (elastic)
+  Fixed linear_damping{};   ///< 1/s, >= 0: velocity *= 1 / (1 + dt * damping) per step
+  Fixed angular_damping{};  ///< 1/s, >= 0
+  /// Collision filtering: a and b collide when (a.layer & b.mask) and (b.layer & a.mask).
+  std::uint32_t layer = 1;
+  std::uint32_t mask = 0xFFFFFFFFU;
+  bool sensor = false;  ///< reports overlaps as events, makes no contact response
+  bool ccd = false;     ///< continuous collision against everything, whatever its speed
+  std::uint64_t user_data = 0;
+
+  friend constexpr bool operator==(const BodyDef&, const BodyDef&) noexcept = default;
+};
+
+}  // namespace detsim

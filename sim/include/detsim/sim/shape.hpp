@@ -1,0 +1,51 @@
+// detsim::Shape: the collision shapes of a body, in the body's local frame.
+//
+// One plain tagged struct rather than a class hierarchy: it is copied into the world, recorded into
+// snapshots field by field and compared bitwise, and the narrowphase dispatches on `type`.
+#pragma once
+
+#include <cstdint>
+
+#include <detsim/fixed/fixed.hpp>
+#include <detsim/fixed/vec3.hpp>
+
+namespace detsim {
+
+/// The kinds of shape. The numeric values are part of the canonical state encoding: never
+/// renumber, only append.
+enum class ShapeType : std::uint8_t {
+  sphere = 1,   ///< centred on the body's origin
+  box = 2,      ///< oriented box centred on the body's origin
+  capsule = 3,  ///< segment along the body's local y axis, swept by a sphere
+  plane = 4,    ///< half-space below the body's local y = 0 plane; static bodies only
+};
+
+/// A shape in the body's local frame (lengths in metres).
+/// - sphere: `radius` > 0.
+/// - box: every component of `half_extents` > 0.
+/// - capsule: `radius` > 0, `half_height` >= 0: the core segment runs from (0, -half_height, 0) to
+///   (0, +half_height, 0).
+/// - plane: no parameters. Solid below the plane through the body's position whose outward normal
+///   is the body's local +y axis, rotated by its orientation. Only a static body can have one.
+/// Fields that a type does not use are zero. Build shapes with the named constructors.
+struct Shape {
+  ShapeType type = ShapeType::sphere;
+  Fixed radius{};
+  Fixed half_height{};
+  Vec3 half_extents{};
+
+  [[nodiscard]] static constexpr Shape sphere(Fixed radius) noexcept {
+    return {ShapeType::sphere, radius, {}, {}};
+  }
+  [[nodiscard]] static constexpr Shape box(Vec3 half_extents) noexcept {
+    return {ShapeType::box, {}, {}, half_extents};
+  }
+  [[nodiscard]] static constexpr Shape capsule(Fixed radius, Fixed half_height) noexcept {
+    return {ShapeType::capsule, radius, half_height, {}};
+  }
+  [[nodiscard]] static constexpr Shape plane() noexcept { return {ShapeType::plane, {}, {}, {}}; }
+
+  friend constexpr bool operator==(const Shape&, const Shape&) noexcept = default;
+};
+
+}  // namespace detsim

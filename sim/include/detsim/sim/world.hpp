@@ -1,0 +1,141 @@
+// detsim::World: the deterministic rigid-body simulation.
+//
+// Single-threaded; everything iterates in ascending body ID order; only Fixed arithmetic. The same
+// WorldDef, the same calls in the same order and the same inputs give the same bits on every
+// machine. See docs/SIM.md for the step's stages and docs/DETERMINISM.md for the rules.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include <detsim/sim/body.hpp>
+#include <detsim/sim/rng.hpp>
+#include <detsim/sim/status.hpp>
+#include <detsim/sim/world_def.hpp>
+
+namespace detsim {
+
+namespace sim_detail {
+struct WorldState;
+}
+
+/// A body's complete state as the world holds it (a copy: it does not follow later changes).
+struct BodyState {
+  BodyId id{};
+  BodyType type = BodyType::dynamic;
+  Shape shape{};
+  Vec3 position{};
+  Quat orientation{};
+  Vec3 linear_velocity{};
+  Vec3 angular_velocity{};  ///< world space
+  Fixed mass{};    ///< kg: what the body weighs while dynamic (kept while kinematic or static)
+  Vec3 inertia{};  ///< principal moments in the body frame, kg m^2, like mass
+  Fixed friction{};
+  Fixed restitution{};
+  Fixed linear_damping{};
+  Fixed angular_damping{};
+  std::uint32_t layer = 1;
+  std::uint32_t mask = 0xFFFFFFFFU;
+  bool sensor = false;
+  bool ccd = false;
+  std::uint64_t user_data = 0;
+  bool awake = true;
+  Fixed sleep_time{};  ///< seconds the body has been slow enough to sleep
+  Vec3 force{};        ///< accumulated for the next step, then cleared
+  Vec3 torque{};
+
+  friend constexpr bool operator==(const BodyState&, const BodyState&) noexcept = default;
+};
+
+/// Hashes of the state after a step (XXH3-64 of the canonical bytes of each part).
+struct StateHashes {
+  std::uint64_t total = 0;     ///< the frame's state hash: covers everything below
+  std::uint64_t globals = 0;   ///< frame, ID counter, definition
+  std::uint64_t rng = 0;       ///< the RNG state
+  std::uint64_t bodies = 0;    ///< every body
+  std::uint64_t contacts = 0;  ///< the contact cache (manifolds and warm-start impulses)
+
+  friend constexpr bool operator==(const StateHashes&, const StateHashes&) noexcept = default;
+};
+
+class World {
+ public:
+  /// A world with the default WorldDef.
+  World();
+  /// A world from `def`, or an error naming the first invalid field.
+  static Expected<World> create(const WorldDef& def);
+
+  World(const World& other);
+  World& operator=(const World& other);
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+  ~World();
+
+  [[nodiscard]] const WorldDef& def() const noexcept;
+  /// Steps taken since creation (restored by restore()).
+  [[nodiscard]] std::uint64_t frame() const noexcept;
+
+  // ---- Bodies ----
+
+  /// Creates a body; its ID is the next in sequence. An invalid definition (non-positive size or
+  /// mass, an orientation that is not a unit quaternion, a non-static plane, ...) is refused with a
+  /// message naming the field, and the world is unchanged.
+  Expected<BodyId> create_body(const BodyDef& def);
+  /// Removes a body and its contacts; wakes the bodies it touched. Unknown IDs are an error.
+  Status destroy_body(BodyId id);
+  [[nodiscard]] bool contains(BodyId id) const noexcept;
+  [[nodiscard]] std::size_t body_count() const noexcept;
+  /// Every body's ID, ascending.
+  [[nodiscard]] std::vector<BodyId> body_ids() const;
+  /// A copy of a body's state, or an error for an unknown ID.
+  [[nodiscard]] Expected<BodyState> body(BodyId id) const;
+
+  /// Switches between kinematic and dynamic (either way, keeping the velocity) or to/from static
+  /// (velocity zeroed). A dynamic body gets its mass back from its shape and definition.
+  Status set_type(BodyId id, BodyType type);
+  /// Teleports a body (orientation must be a unit quaternion). Wakes it.
+  Status set_transform(BodyId id, Vec3 position, Quat orientation);
+  Status set_linear_velocity(BodyId id, Vec3 velocity);
+  Status set_angular_velocity(BodyId id, Vec3 velocity);
+
+  // ---- Game inputs: accumulated until the next step. Each wakes the body. ----
+
+  Status apply_force(BodyId id, Vec3 force);                       ///< N, at the centre
+  Status apply_torque(BodyId id, Vec3 torque);                     ///< N m, world space
+  Status apply_force_at_point(BodyId id, Vec3 force, Vec3 point);  ///< point in world space
+  Status apply_linear_impulse(BodyId id, Vec3 impulse);            ///< N s, immediate
+  Status apply_impulse_at_point(BodyId id, Vec3 impulse, Vec3 point);
+  Status apply_angular_impulse(BodyId id, Vec3 impulse);  ///< N m s, immediate
+  Status wake(BodyId id);
+
+  // ---- Stepping ----
+
+  /// Advances the world by def().dt.
+  void step();
+
+  /// The world's random number generator: the only randomness the simulation (and a game built
+  /// on it) should draw. Part of the saved and hashed state.
+  [[nodiscard]] Rng& rng() noexcept;
+  [[nodiscard]] const Rng& rng() const noexcept;
+
+  // ---- State ----
+
+  /// The complete state in the canonical encoding (docs/STATE.md): versioned, little-endian,
+  /// identical on every host.
+  [[nodiscard]] std::vector<std::uint8_t> save() const;
+  /// Replaces the whole state with `bytes`. Everything is validated first; on any error the world
+  /// is untouched and the message names the byte offset and the field.
+  Status restore(std::span<const std::uint8_t> bytes);
+  /// The hashes of the current state (the per-frame state hash is `hashes().total`).
+  [[nodiscard]] StateHashes hashes() const;
+  /// XXH3-64 of one body's canonical bytes, or an error for an unknown ID.
+  [[nodiscard]] Expected<std::uint64_t> body_hash(BodyId id) const;
+
+ private:
+  explicit World(std::unique_ptr<sim_detail::WorldState> state) noexcept;
+  std::unique_ptr<sim_detail::WorldState> s_;
+};
+
+}  // namespace detsim

@@ -1,0 +1,11 @@
+#include <detsim/sim/bytes.hpp>
+
+namespace detsim {
+
+std::string ByteReader::error() const {
+  if (ok_) return {};
+  return "byte " + std::to_string(error_offset_) + ": " + error_what_ + ": expected " +
+         error_expected_;
+}
+
+}  // namespace detsim

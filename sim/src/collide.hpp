@@ -1,0 +1,51 @@
+// Narrowphase: contact manifolds between two posed shapes. Internal to detsim::sim.
+//
+// Conventions shared by every pair function and the solver:
+// - A pair is (a, b) with a the body of lower ID. `normal` is a unit vector pointing from a into b:
+//   moving b along +normal separates them.
+// - Each point lies midway between the two surfaces; `separation` is the signed distance between
+//   the surfaces along the normal at that point (negative when they overlap).
+// - Points are reported while separation <= `margin` (speculative contacts), at most four per pair.
+// - `feature` identifies the pair of features (vertex/edge/face indices of each shape) that made the
+//   point, so that the solver can match a point with the same point of the previous step and warm
+//   start it. It is stable while the same features touch, and depends only on the shapes' features,
+//   never on the order in which points were found.
+// - Everything is Fixed arithmetic and deterministic: no data-dependent iteration order, ties broken
+//   by index.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include <detsim/fixed/mat3.hpp>
+#include <detsim/fixed/vec3.hpp>
+#include <detsim/sim/shape.hpp>
+
+namespace detsim::sim_detail {
+
+/// A body's placement for the narrowphase: position and the rotation matrix of its orientation
+/// (to_mat3 of the unit quaternion), computed once per step.
+struct Pose {
+  Vec3 position;
+  Mat3 rotation = Mat3::identity();
+};
+
+struct ContactPoint {
+  Vec3 point;        ///< world space, midway between the surfaces
+  Fixed separation;  ///< signed distance along the normal; < 0 when overlapping
+  std::uint32_t feature = 0;
+};
+
+struct Manifold {
+  Vec3 normal;  ///< unit, from a into b
+  std::uint8_t count = 0;
+  std::array<ContactPoint, 4> points{};
+};
+
+/// The contact manifold of shape `a` at `pose_a` against shape `b` at `pose_b`, with every point
+/// whose separation is at most `margin` (>= 0). `count` is 0 when the shapes are farther apart than
+/// `margin`, and always 0 for a plane against a plane.
+[[nodiscard]] Manifold collide(const Shape& a, const Pose& pose_a, const Shape& b,
+                               const Pose& pose_b, Fixed margin) noexcept;
+
+}  // namespace detsim::sim_detail

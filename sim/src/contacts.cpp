@@ -1,0 +1,198 @@
+// Narrowphase driving, warm-start matching, islands and sleep.
+//
+// Islands are not stored: they are recomputed when needed with a union-find over the touching
+// contacts between dynamic bodies, rooted at the lowest body index (so at the lowest ID), which
+// makes them a pure function of the saved state.
+#include <algorithm>
+#include <numeric>
+#include <vector>
+
+#include <detsim/fixed/math.hpp>
+
+#include "world_state.hpp"
+
+namespace detsim::sim_detail {
+
+namespace {
+
+std::size_t index_of(const WorldState& s, std::uint32_t id) {
+  return static_cast<std::size_t>(s.find(id));
+}
+
+bool moving(const BodyState& b) {
+  if (b.type == BodyType::static_body || !b.awake) return false;
+  if (b.type == BodyType::dynamic) return true;
+  return b.linear_velocity != Vec3{} || b.angular_velocity != Vec3{};  // a kinematic body
+}
+
+// A radius that bounds the shape about the body's origin (0 for a plane, which does not turn).
+Fixed bounding_radius(const Shape& shape) {
+  switch (shape.type) {
+    case ShapeType::sphere:
+      return shape.radius;
+    case ShapeType::box:
+      return length(shape.half_extents);
+    case ShapeType::capsule:
+      return shape.radius + shape.half_height;
+    case ShapeType::plane:
+      break;
+  }
+  return Fixed::zero();
+}
+
+// How far apart two bodies may be and still touch within this step: the speculative distance
+// plus the distance their relative motion can close in dt (linear, and the rim speed of each
+// body's rotation). Speculative contacts over this margin let the solver stop a fast body exactly
+// at the surface instead of resolving a deep overlap a step later, which keeps bounces elastic and
+// thin walls solid; the margin is capped so that a runaway speed cannot make every pair collide.
+Fixed contact_margin(const WorldState& s, const BodyState& a, const BodyState& b) {
+  const Fixed closing = length(a.linear_velocity - b.linear_velocity) +
+                        length(a.angular_velocity) * bounding_radius(a.shape) +
+                        length(b.angular_velocity) * bounding_radius(b.shape);
+  const Fixed cap = Fixed::from_int(20);
+  return s.def.speculative_distance + min(closing * s.def.dt, cap);
+}
+
+// Recomputes the manifold of `c` and carries the impulses of points whose features persist.
+void collide_one(WorldState& s, Contact& c, std::size_t ia, std::size_t ib) {
+  const BodyState& a = s.bodies[ia];
+  const BodyState& b = s.bodies[ib];
+  c.manifold =
+      collide(a.shape, s.derived[ia].pose, b.shape, s.derived[ib].pose, contact_margin(s, a, b));
+  std::array<CachedPoint, 4> next{};
+  for (std::size_t k = 0; k < c.manifold.count; ++k) {
+    next[k].feature = c.manifold.points[k].feature;
+    for (std::size_t j = 0; j < c.point_count; ++j) {
+      if (c.cached[j].feature == next[k].feature) {
+        next[k] = c.cached[j];
+        break;
+      }
+    }
+  }
+  c.cached = next;
+  c.point_count = c.manifold.count;
+  c.touching = c.point_count > 0;
+}
+
+struct UnionFind {
+  std::vector<std::uint32_t> parent;
+  explicit UnionFind(std::size_t n) : parent(n) {
+    std::iota(parent.begin(), parent.end(), std::uint32_t{0});
+  }
+  std::uint32_t root(std::uint32_t i) {
+    while (parent[i] != i) {
+      parent[i] = parent[parent[i]];  // path halving
+      i = parent[i];
+    }
+    return i;
+  }
+  void join(std::uint32_t i, std::uint32_t j) {
+    const std::uint32_t ri = root(i);
+    const std::uint32_t rj = root(j);
+    if (ri < rj) parent[rj] = ri;  // the lower index becomes the root: order-independent result
+    if (rj < ri) parent[ri] = rj;
+  }
+};
+
+// Islands of dynamic bodies joined by touching, non-sensor contacts.
+UnionFind islands(const WorldState& s) {
+  UnionFind uf(s.bodies.size());
+  for (const Contact& c : s.contacts) {
+    if (!c.touching) continue;
+    const std::size_t ia = index_of(s, c.a);
+    const std::size_t ib = index_of(s, c.b);
+    const BodyState& a = s.bodies[ia];
+    const BodyState& b = s.bodies[ib];
+    if (a.type == BodyType::dynamic && b.type == BodyType::dynamic && !a.sensor && !b.sensor)
+      uf.join(static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
+  }
+  return uf;
+}
+
+}  // namespace
+
+void collide_contacts(WorldState& s) {
+  for (Contact& c : s.contacts) {
+    const std::size_t ia = index_of(s, c.a);
+    const std::size_t ib = index_of(s, c.b);
+    // A pair where nothing moves keeps its manifold and impulses as they were.
+    if (!moving(s.bodies[ia]) && !moving(s.bodies[ib])) continue;
+    collide_one(s, c, ia, ib);
+  }
+}
+
+void wake_touched_islands(WorldState& s) {
+  UnionFind uf = islands(s);
+  std::vector<bool> wake(s.bodies.size(), false);
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    if (moving(s.bodies[i])) wake[uf.root(static_cast<std::uint32_t>(i))] = true;
+  }
+  // A moving kinematic body is in no island but wakes what it touches.
+  for (const Contact& c : s.contacts) {
+    if (!c.touching) continue;
+    const std::size_t ia = index_of(s, c.a);
+    const std::size_t ib = index_of(s, c.b);
+    if (moving(s.bodies[ia]) && s.bodies[ib].type == BodyType::dynamic)
+      wake[uf.root(static_cast<std::uint32_t>(ib))] = true;
+    if (moving(s.bodies[ib]) && s.bodies[ia].type == BodyType::dynamic)
+      wake[uf.root(static_cast<std::uint32_t>(ia))] = true;
+  }
+  bool woke_any = false;
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    BodyState& b = s.bodies[i];
+    if (b.type == BodyType::dynamic && !b.awake && wake[uf.root(static_cast<std::uint32_t>(i))]) {
+      b.awake = true;
+      b.sleep_time = Fixed::zero();
+      woke_any = true;
+    }
+  }
+  if (!woke_any) return;
+  // The pairs of bodies that just woke were skipped by collide_contacts: collide them now, and
+  // refresh the derived data the solver will use for them.
+  prepare_bodies(s);
+  for (Contact& c : s.contacts) {
+    const std::size_t ia = index_of(s, c.a);
+    const std::size_t ib = index_of(s, c.b);
+    collide_one(s, c, ia, ib);
+  }
+}
+
+void update_sleep(WorldState& s) {
+  const Fixed lin2 = s.def.sleep_linear_speed * s.def.sleep_linear_speed;
+  const Fixed ang2 = s.def.sleep_angular_speed * s.def.sleep_angular_speed;
+  for (BodyState& b : s.bodies) {
+    if (b.type != BodyType::dynamic || !b.awake) continue;
+    const bool slow =
+        length_squared(b.linear_velocity) <= lin2 && length_squared(b.angular_velocity) <= ang2;
+    b.sleep_time = slow ? min(b.sleep_time + s.def.dt, Fixed::from_int(1000)) : Fixed::zero();
+  }
+  if (!s.def.enable_sleep) return;
+  UnionFind uf = islands(s);
+  // An island sleeps when every body in it has been slow long enough and nothing moving that is
+  // outside the island (a kinematic body) touches it.
+  std::vector<bool> keep_awake(s.bodies.size(), false);
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    const BodyState& b = s.bodies[i];
+    if (b.type == BodyType::dynamic && b.awake && b.sleep_time < s.def.time_to_sleep)
+      keep_awake[uf.root(static_cast<std::uint32_t>(i))] = true;
+  }
+  for (const Contact& c : s.contacts) {
+    if (!c.touching) continue;
+    const std::size_t ia = index_of(s, c.a);
+    const std::size_t ib = index_of(s, c.b);
+    if (s.bodies[ia].type == BodyType::kinematic && moving(s.bodies[ia]))
+      keep_awake[uf.root(static_cast<std::uint32_t>(ib))] = true;
+    if (s.bodies[ib].type == BodyType::kinematic && moving(s.bodies[ib]))
+      keep_awake[uf.root(static_cast<std::uint32_t>(ia))] = true;
+  }
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    BodyState& b = s.bodies[i];
+    if (b.type != BodyType::dynamic || !b.awake) continue;
+    if (keep_awake[uf.root(static_cast<std::uint32_t>(i))]) continue;
+    b.awake = false;
+    b.linear_velocity = {};
+    b.angular_velocity = {};
+  }
+}
+
+}  // namespace detsim::sim_detail

@@ -1,0 +1,85 @@
+// World::step: a short orchestrator of named stages (docs/SIM.md describes each).
+#include <detsim/fixed/math.hpp>
+
+#include "world_state.hpp"
+
+namespace detsim {
+
+void World::step() {
+  sim_detail::WorldState& s = *s_;
+  sim_detail::prepare_bodies(s);        // 1. derived data: poses, inverse mass and inertia, AABBs
+  sim_detail::update_contacts(s);       // 2. broadphase: overlapping pairs, ascending by ID pair
+  sim_detail::collide_contacts(s);      // 3. narrowphase: manifolds, warm-start impulses matched
+  sim_detail::wake_touched_islands(s);  // 4. islands touched by moving bodies wake up
+  sim_detail::solve(s);                 // 5. inputs, velocities, contacts, positions (sub-stepped)
+  sim_detail::update_sleep(s);          // 6. islands at rest fall asleep
+  for (BodyState& b : s.bodies) {       // 7. game inputs are consumed by the step
+    b.force = {};
+    b.torque = {};
+  }
+  ++s.frame;
+}
+
+namespace sim_detail {
+
+namespace {
+
+// Half extents of the world-space bounding box of `shape` under `rotation`.
+Vec3 aabb_extent(const Shape& shape, const Mat3& r) {
+  switch (shape.type) {
+    case ShapeType::sphere:
+      return {shape.radius, shape.radius, shape.radius};
+    case ShapeType::box: {
+      const Vec3 h = shape.half_extents;
+      const auto row = [&h](Vec3 m) { return abs(m.x) * h.x + abs(m.y) * h.y + abs(m.z) * h.z; };
+      return {row(r.rows[0]), row(r.rows[1]), row(r.rows[2])};
+    }
+    case ShapeType::capsule: {
+      const Vec3 axis = r.column(1);  // the core segment's direction
+      const Fixed h = shape.half_height;
+      return {abs(axis.x) * h + shape.radius, abs(axis.y) * h + shape.radius,
+              abs(axis.z) * h + shape.radius};
+    }
+    case ShapeType::plane:
+      break;
+  }
+  return {};
+}
+
+}  // namespace
+
+void prepare_bodies(WorldState& s) {
+  s.derived.resize(s.bodies.size());
+  const Vec3 margin{s.def.speculative_distance, s.def.speculative_distance,
+                    s.def.speculative_distance};
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    const BodyState& b = s.bodies[i];
+    Derived& d = s.derived[i];
+    d.pose = {b.position, to_mat3(b.orientation)};
+    const bool moving = b.type == BodyType::dynamic && b.awake;
+    d.inverse_mass = moving ? inverse_or_zero(b.mass) : Fixed::zero();
+    d.inverse_inertia_world =
+        moving ? rotate_inertia(d.pose.rotation, Mat3::diagonal(inverse_or_zero(b.inertia.x),
+                                                                inverse_or_zero(b.inertia.y),
+                                                                inverse_or_zero(b.inertia.z)))
+               : Mat3::zero();
+    d.infinite = b.shape.type == ShapeType::plane;
+    const Vec3 e = aabb_extent(b.shape, d.pose.rotation) + margin;
+    d.aabb_min = b.position - e;
+    d.aabb_max = b.position + e;
+    // A moving body's box also covers where its velocity takes it this step, so that speculative
+    // contacts exist before fast bodies meet.
+    if (b.type != BodyType::static_body && b.awake) {
+      const Vec3 travel = b.linear_velocity * s.def.dt;
+      d.aabb_min += Vec3{min(travel.x, Fixed::zero()), min(travel.y, Fixed::zero()),
+                         min(travel.z, Fixed::zero())};
+      d.aabb_max += Vec3{max(travel.x, Fixed::zero()), max(travel.y, Fixed::zero()),
+                         max(travel.z, Fixed::zero())};
+    }
+    d.delta_position = {};
+    d.delta_angle = {};
+  }
+}
+
+}  // namespace sim_detail
+}  // namespace detsim

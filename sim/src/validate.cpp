@@ -1,0 +1,133 @@
+// Validation of definitions: every refusal names the field and the value it got, so a user can
+// fix the call without reading the source.
+#include <detsim/fixed/decimal.hpp>
+#include <detsim/fixed/math.hpp>
+
+#include "world_state.hpp"
+
+namespace detsim::sim_detail {
+
+namespace {
+
+std::string str(Fixed x) {
+  return to_string(x);
+}
+
+// The largest size the simulation accepts: bounding boxes and products of lengths stay far from
+// the Fixed range (2^31).
+constexpr Fixed kMaxSize = Fixed::from_int(10000);
+// A unit quaternion must be this close: | |q|^2 - 1 | <= 2^-20.
+constexpr Fixed kUnitTolerance = Fixed::from_raw(Fixed::one_raw >> 20);
+
+std::string positive(const char* what, Fixed x) {
+  if (x <= Fixed::zero()) return std::string(what) + " must be > 0, got " + str(x);
+  if (x > kMaxSize) return std::string(what) + " must be <= 10000, got " + str(x);
+  return {};
+}
+
+std::string non_negative(const char* what, Fixed x) {
+  if (x < Fixed::zero()) return std::string(what) + " must be >= 0, got " + str(x);
+  return {};
+}
+
+}  // namespace
+
+std::string check_orientation(Quat q) {
+  const Fixed l2 = length_squared(q);
+  if (abs(l2 - Fixed::one()) > kUnitTolerance)
+    return "orientation must be a unit quaternion (|q|^2 within 2^-20 of 1), got |q|^2 = " +
+           str(l2);
+  return {};
+}
+
+std::string check_shape(const Shape& shape, BodyType type) {
+  switch (shape.type) {
+    case ShapeType::sphere:
+      return positive("sphere radius", shape.radius);
+    case ShapeType::box: {
+      if (auto e = positive("box half extent x", shape.half_extents.x); !e.empty()) return e;
+      if (auto e = positive("box half extent y", shape.half_extents.y); !e.empty()) return e;
+      return positive("box half extent z", shape.half_extents.z);
+    }
+    case ShapeType::capsule: {
+      if (auto e = positive("capsule radius", shape.radius); !e.empty()) return e;
+      if (auto e = non_negative("capsule half height", shape.half_height); !e.empty()) return e;
+      if (shape.half_height > kMaxSize) return "capsule half height must be <= 10000";
+      return {};
+    }
+    case ShapeType::plane:
+      if (type != BodyType::static_body) return "a plane shape needs a static body";
+      return {};
+  }
+  return "unknown shape type " + std::to_string(static_cast<unsigned>(shape.type));
+}
+
+std::string check_body_def(const BodyDef& def) {
+  if (def.type != BodyType::static_body && def.type != BodyType::kinematic &&
+      def.type != BodyType::dynamic)
+    return "unknown body type " + std::to_string(static_cast<unsigned>(def.type));
+  if (auto e = check_shape(def.shape, def.type); !e.empty()) return e;
+  if (auto e = check_orientation(def.orientation); !e.empty()) return e;
+  if (auto e = non_negative("mass", def.mass); !e.empty()) return e;
+  if (auto e = non_negative("density", def.density); !e.empty()) return e;
+  if (auto e = non_negative("friction", def.friction); !e.empty()) return e;
+  if (auto e = non_negative("restitution", def.restitution); !e.empty()) return e;
+  if (def.restitution > Fixed::one())
+    return "restitution must be <= 1, got " + str(def.restitution);
+  if (auto e = non_negative("linear damping", def.linear_damping); !e.empty()) return e;
+  if (auto e = non_negative("angular damping", def.angular_damping); !e.empty()) return e;
+  if (def.type == BodyType::dynamic) {
+    const MassProperties m = body_mass(def);
+    if (m.mass <= Fixed::zero())
+      return "a dynamic body needs a positive mass: mass is 0 and density * volume rounds to " +
+             str(m.mass);
+    if (m.inertia.x <= Fixed::zero() || m.inertia.y <= Fixed::zero() ||
+        m.inertia.z <= Fixed::zero())
+      return "the body's moments of inertia round to zero (shape too small for its mass); give "
+             "it a larger mass or shape";
+  }
+  return {};
+}
+
+std::string check_world_def(const WorldDef& def) {
+  if (def.dt <= Fixed::zero() || def.dt > Fixed::one())
+    return "dt must be in (0, 1] seconds, got " + str(def.dt);
+  if (def.substeps < 1 || def.substeps > 64)
+    return "substeps must be in 1..64, got " + std::to_string(def.substeps);
+  if (def.iterations < 1 || def.iterations > 64)
+    return "iterations must be in 1..64, got " + std::to_string(def.iterations);
+  const Fixed g_limit = Fixed::from_int(100000);
+  if (abs(def.gravity.x) > g_limit || abs(def.gravity.y) > g_limit || abs(def.gravity.z) > g_limit)
+    return "gravity components must be within +-100000 m/s^2";
+  if (def.max_linear_speed <= Fixed::zero() || def.max_linear_speed > Fixed::from_int(100000))
+    return "max linear speed must be in (0, 100000] m/s, got " + str(def.max_linear_speed);
+  if (def.max_angular_speed <= Fixed::zero() || def.max_angular_speed > Fixed::from_int(10000))
+    return "max angular speed must be in (0, 10000] rad/s, got " + str(def.max_angular_speed);
+  if (def.contact_hertz <= Fixed::zero() || def.contact_hertz > Fixed::from_int(1000))
+    return "contact hertz must be in (0, 1000], got " + str(def.contact_hertz);
+  if (auto e = non_negative("contact damping ratio", def.contact_damping_ratio); !e.empty())
+    return e;
+  if (def.contact_push_max <= Fixed::zero())
+    return "contact push max must be > 0, got " + str(def.contact_push_max);
+  if (auto e = non_negative("restitution threshold", def.restitution_threshold); !e.empty())
+    return e;
+  if (auto e = non_negative("linear slop", def.linear_slop); !e.empty()) return e;
+  if (auto e = non_negative("speculative distance", def.speculative_distance); !e.empty()) return e;
+  if (def.speculative_distance > Fixed::one())
+    return "speculative distance must be <= 1 m, got " + str(def.speculative_distance);
+  if (auto e = non_negative("sleep linear speed", def.sleep_linear_speed); !e.empty()) return e;
+  if (auto e = non_negative("sleep angular speed", def.sleep_angular_speed); !e.empty()) return e;
+  if (auto e = non_negative("time to sleep", def.time_to_sleep); !e.empty()) return e;
+  return {};
+}
+
+MassProperties body_mass(const BodyDef& def) noexcept {
+  const Fixed mass = def.mass > Fixed::zero() ? def.mass : def.density * volume(def.shape);
+  return mass_properties(def.shape, mass);
+}
+
+Fixed inverse_or_zero(Fixed x) noexcept {
+  return x > Fixed::zero() ? Fixed::one() / x : Fixed::zero();
+}
+
+}  // namespace detsim::sim_detail

@@ -1,0 +1,98 @@
+// The World's state, internal to detsim::sim.
+//
+// Saved state (everything that affects the future, docs/DETERMINISM.md rule 5): the definition,
+// the frame counter, the ID counter, the RNG, the bodies (sorted by ID) and the contact cache
+// (sorted by ID pair) with its warm-start impulses. Derived data (poses, world-space inverse
+// inertia, bounding boxes, solver scratch) is rebuilt from it at the start of every step, so a
+// restored world steps exactly like the one that was saved.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <detsim/fixed/mat3.hpp>
+#include <detsim/sim/bytes.hpp>
+#include <detsim/sim/mass.hpp>
+#include <detsim/sim/world.hpp>
+
+#include "collide.hpp"
+
+namespace detsim::sim_detail {
+
+/// What a contact point keeps from one step to the next: the feature pair it was made by (to match
+/// it with the next step's point) and the accumulated impulses (to warm start with).
+struct CachedPoint {
+  std::uint32_t feature = 0;
+  Fixed normal_impulse;
+  Fixed tangent_impulse_1;
+  Fixed tangent_impulse_2;
+
+  friend constexpr bool operator==(const CachedPoint&, const CachedPoint&) noexcept = default;
+};
+
+/// A pair of bodies whose bounding boxes overlap, a < b. `manifold` is the current geometry
+/// (recomputed every step while either body is awake; not saved — a sleeping pair's manifold is
+/// recomputed on waking before it is used); `cached` is saved.
+struct Contact {
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
+  std::uint8_t point_count = 0;  ///< points in `cached` (and in `manifold` after collide)
+  bool touching = false;         ///< had at least one point at the last collide
+  std::array<CachedPoint, 4> cached{};
+  Manifold manifold;
+};
+
+/// Per-body data rebuilt at the start of each step (parallel to WorldState::bodies).
+struct Derived {
+  Pose pose;
+  Fixed inverse_mass;
+  Mat3 inverse_inertia_world;  ///< R I^-1 R^T; zero unless dynamic
+  Vec3 aabb_min;
+  Vec3 aabb_max;
+  bool infinite = false;  ///< a plane: bounded by nothing
+  // Solver scratch for the current step.
+  Vec3 delta_position;  ///< since the start of the step
+  Vec3 delta_angle;     ///< small-angle sum of angular velocity * h since the start of the step
+};
+
+struct WorldState {
+  WorldDef def;
+  std::uint64_t frame = 0;
+  std::uint32_t next_id = 1;
+  Rng rng;
+  std::vector<BodyState> bodies;  ///< ascending ID
+  std::vector<Contact> contacts;  ///< ascending (a, b)
+  std::vector<Derived> derived;   ///< rebuilt each step
+
+  /// Index of body `id` in `bodies`, or -1.
+  [[nodiscard]] std::ptrdiff_t find(std::uint32_t id) const noexcept;
+};
+
+/// Definition checks shared by World::create, create_body and restore. Empty string: valid.
+[[nodiscard]] std::string check_world_def(const WorldDef& def);
+[[nodiscard]] std::string check_shape(const Shape& shape, BodyType type);
+[[nodiscard]] std::string check_orientation(Quat q);
+[[nodiscard]] std::string check_body_def(const BodyDef& def);
+
+/// Mass and inertia of a body of this definition (what it has whenever it is dynamic).
+[[nodiscard]] MassProperties body_mass(const BodyDef& def) noexcept;
+/// 1 / x for x > 0, else 0.
+[[nodiscard]] Fixed inverse_or_zero(Fixed x) noexcept;
+
+// The step's stages (step.cpp orchestrates them, in this order).
+void prepare_bodies(WorldState& s);        // poses, inverse masses, world inertia, bounding boxes
+void update_contacts(WorldState& s);       // broadphase: contact list = overlapping pairs, by ID
+void collide_contacts(WorldState& s);      // narrowphase: manifolds, warm start matched by feature
+void wake_touched_islands(WorldState& s);  // sleeping bodies touched by awake ones wake
+void solve(WorldState& s);                 // sub-stepped soft contact solver and integration
+void update_sleep(WorldState& s);          // sleep timers; islands at rest fall asleep
+
+/// Canonical bytes (state_io.cpp).
+void write_globals(const WorldState& s, ByteWriter& w);
+void write_body(const BodyState& b, ByteWriter& w);
+void write_contact(const Contact& c, ByteWriter& w);
+
+}  // namespace detsim::sim_detail
