@@ -17,6 +17,7 @@
 #include <detsim/fixed/fixed.hpp>
 
 #include "support/print.hpp"
+#include "support/scale.hpp"
 
 namespace detsim {
 namespace {
@@ -553,7 +554,7 @@ TEST(DecimalToString, RoundTripsEveryRawNearZero) {
 }
 
 TEST(DecimalToString, RoundTripsTenMillionRandomRaws) {
-  for (const std::int64_t r : random_raws(10000000, 2024))
+  for (const std::int64_t r : random_raws(test::scaled(10000000), 2024))
     ASSERT_TRUE(round_trips(r));
 }
 
@@ -604,7 +605,7 @@ TEST(DecimalToString, IsTheShortestAndTheNearest) {
     EXPECT_TRUE(shortest_and_nearest(r));
   for (std::int64_t r = -5000; r <= 5000; ++r)
     ASSERT_TRUE(shortest_and_nearest(r));
-  for (const std::int64_t r : random_raws(1000000, 99))
+  for (const std::int64_t r : random_raws(test::scaled(1000000), 99))
     ASSERT_TRUE(shortest_and_nearest(r));
 }
 

@@ -20,6 +20,7 @@
 #include <detsim/fixed/fixed.hpp>
 
 #include "support/print.hpp"
+#include "support/scale.hpp"
 
 namespace detsim {
 namespace {
@@ -197,7 +198,7 @@ TEST(DecimalMpfr, ParseMatchesMpfrOnRandomDecimals) {
   std::size_t out_of_range = 0;
   std::size_t nonzero = 0;
   std::size_t needed_more_precision = 0;
-  const std::size_t count = 1200000;
+  const std::size_t count = test::scaled(1200000);
   for (std::size_t i = 0; i < count; ++i) {
     const std::string text = i % 6 == 5 ? random_midpoint(rng) : random_decimal(rng);
     const Reference ref = mpfr_reference(text);
@@ -270,7 +271,7 @@ std::string mpfr_shortest(std::int64_t raw) {
 
 TEST(DecimalMpfr, ToStringIsTheShortestNearestDecimal) {
   std::mt19937_64 rng(77);
-  const std::size_t count = 300000;
+  const std::size_t count = test::scaled(300000);
   std::size_t max_places = 0;
   for (std::size_t i = 0; i < count; ++i) {
     std::uint64_t bits = rng();
