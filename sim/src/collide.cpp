@@ -427,7 +427,7 @@ Manifold capsule_into_box(const Segment& core, Vec3 h, Fixed radius, Fixed margi
     }
   }
   if (max(sep_face, sep_edge) > margin) return {};
-  if (edge < 0 || !clearly_greater(sep_edge, sep_face, hysteresis_scale(h))) {
+  if (edge < 0 || !clearly_greater(sep_edge, sep_face, axis_bias_scale(h))) {
     return capsule_on_face(core, h, radius, face, component(core.center, face) >= Fixed::zero(),
                            margin);
   }

@@ -434,7 +434,7 @@ Manifold box_box(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb,
   }
 
   // Prefer a's faces, then b's, then edges, each only when clearly better (see clearly_greater).
-  const Fixed scale = max(hysteresis_scale(ha), hysteresis_scale(hb));
+  const Fixed scale = max(axis_bias_scale(ha), axis_bias_scale(hb));
   const bool ref_is_b = clearly_greater(sep_b, sep_a, scale);
   const Fixed sep_face = ref_is_b ? sep_b : sep_a;
   if (!have_edge || !clearly_greater(sep_e, sep_face, scale)) {

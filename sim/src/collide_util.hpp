@@ -1,5 +1,5 @@
 // Narrowphase internals shared by collide.cpp and collide_box.cpp: feature IDs, tolerances, small
-// vector helpers, closest points of segments and the pair functions' declarations.
+// vector and box helpers, closest points of segments and the pair functions' declarations.
 //
 // Every pair function takes its shapes in the canonical order of ShapeType (sphere < box < capsule
 // < plane); collide() swaps its arguments into that order and mirrors the result.
@@ -94,16 +94,17 @@ inline constexpr Fixed parallel_sin2 = Fixed::from_raw(Fixed::one_raw >> 20);
 /// Below this sin^2 (angle < ~0.9 degree) two segments lying along each other get two contacts
 /// (the ends of their overlap) instead of one, so that a capsule resting on another does not rock.
 inline constexpr Fixed flat_sin2 = Fixed::from_raw(Fixed::one_raw >> 12);
-/// A capsule-box normal within ~0.6 degree of a box face normal (|n_k| >= 1 - 2^-16) is snapped to
+/// A capsule-box normal within ~0.3 degree of a box face normal (|n_k| >= 1 - 2^-16) is snapped to
 /// it and the core is clipped against that face: two points for a capsule lying on a box.
 inline constexpr Fixed face_cos = Fixed::from_raw(Fixed::one_raw - (Fixed::one_raw >> 16));
 /// Closest points closer than this (~1.5e-5 m) do not define a direction well (a unit vector from
 /// a difference of a few ulps); such deep contacts use separating axes instead.
 inline constexpr Fixed core_epsilon = Fixed::from_raw(Fixed::one_raw >> 16);
 
-/// Hysteresis of separating-axis choices: `challenger` replaces `incumbent` only when it is larger
-/// by a relative 1/32 plus an absolute 2^-20 of `scale` (about a micrometre for metre-sized
-/// shapes), so that rounding noise and tiny motions never flip the axis between frames.
+/// The bias of separating-axis choices (there is no state between frames, so no true hysteresis):
+/// `challenger` replaces `incumbent` only when it is larger by a relative 1/32 plus an absolute
+/// 2^-20 of `scale` (about a micrometre for metre-sized shapes), so that rounding noise and tiny
+/// motions do not flip a near tie between frames.
 [[nodiscard]] constexpr bool clearly_greater(Fixed challenger, Fixed incumbent,
                                              Fixed scale) noexcept {
   const Fixed tolerance = (abs(incumbent) >> 5) + (scale >> 20) + Fixed::epsilon();
@@ -178,8 +179,8 @@ inline Manifold to_world(Manifold m, const Pose& pose) noexcept {
   return m;
 }
 
-/// The largest half extent plus one metre: the scale of the axis-choice hysteresis.
-inline Fixed hysteresis_scale(Vec3 h) noexcept {
+/// The largest half extent plus one metre: the scale of the axis-choice bias.
+inline Fixed axis_bias_scale(Vec3 h) noexcept {
   return Fixed::one() + max(h.x, max(h.y, h.z));
 }
 
