@@ -203,13 +203,14 @@ World settled() {
 // Quat = w x y z. A body: id u32, type u8, shape (type u8, then radius | half extents | radius and
 // half height | nothing), position, orientation, linear and angular velocity, mass, inertia,
 // friction, restitution, linear and angular damping, layer u32, mask u32, sensor, ccd, user data
-// u64, awake, sleep time, force, torque. A contact: a u32, b u32, touching, point count u8, then
-// per point: feature u32, normal impulse, two tangent impulses.
+// u64, awake, sleep time, force, torque. A contact: a u32, b u32, flags u8 (bit 0 touching, bit 1
+// reported by events, no other bit), point count u8, then per point: feature u32, normal impulse, two tangent impulses.
 
 struct DecodedContact {
   std::uint32_t a = 0;
   std::uint32_t b = 0;
   bool touching = false;
+  bool reported = false;
   std::uint8_t point_count = 0;
   std::size_t at = 0;  // offset of the record
   std::size_t first_impulse_at = 0;
@@ -317,7 +318,10 @@ Decoded decode(std::span<const std::uint8_t> bytes) {
     c.at = r.offset();
     c.a = r.u32("a");
     c.b = r.u32("b");
-    c.touching = r.boolean("touching");
+    const std::uint8_t flags = r.u8("flags");
+    if (flags > 3) r.fail("flags", "bits 0 and 1 only");
+    c.touching = (flags & 1U) != 0;
+    c.reported = (flags & 2U) != 0;
     c.point_count = r.u8("point count");
     if (c.point_count > 4) r.fail("point count", "<= 4");
     c.first_impulse_at = r.offset() + 4;
@@ -453,6 +457,7 @@ TEST(StateFormat, DecodesToExactlyWhatTheWorldReports) {
   // bodies, and a kinematic body in motion.
   ASSERT_FALSE(d.contacts.empty());
   std::size_t touching = 0;
+  std::size_t reported = 0;
   for (std::size_t i = 0; i < d.contacts.size(); ++i) {
     const DecodedContact& c = d.contacts[i];
     EXPECT_LT(c.a, c.b);
@@ -462,9 +467,12 @@ TEST(StateFormat, DecodesToExactlyWhatTheWorldReports) {
       EXPECT_TRUE(p.a < c.a || (p.a == c.a && p.b < c.b)) << "contacts not in ascending order";
     }
     touching += c.touching ? 1 : 0;
+    reported += c.reported ? 1 : 0;
     EXPECT_EQ(c.touching, c.point_count > 0);
+    EXPECT_TRUE(c.touching || !c.reported);
   }
   EXPECT_GE(touching, 5U);
+  EXPECT_GE(reported, 5U);
   const auto asleep = std::count_if(d.bodies.begin(), d.bodies.end(), [](const BodyState& b) {
     return b.type == BodyType::dynamic && !b.awake;
   });
@@ -910,6 +918,42 @@ TEST_F(RejectedRestore, ContactsMustNameExistingBodiesInOrder) {
   // More than four points.
   bad = state_;
   bad[last.at + 9] = 5;
+  expect_rejected(target_, bad);
+}
+
+TEST_F(RejectedRestore, ContactFlagsMustBeConsistent) {
+  const auto with_points =
+      std::find_if(decoded_.contacts.begin(), decoded_.contacts.end(),
+                   [](const DecodedContact& c) { return c.point_count > 0; });
+  ASSERT_NE(with_points, decoded_.contacts.end());
+  for (const int flags : {4, 0x81, 0xFF}) {  // bits that mean nothing
+    Bytes bad = state_;
+    bad[with_points->at + 8] = static_cast<std::uint8_t>(flags);
+    const std::string message = expect_rejected(target_, bad);
+    EXPECT_TRUE(contains(message, "contact flags")) << message;
+  }
+  // The same contact without its points (the record is then consistent with flags 0): reported
+  // as touching (bit 1) without points, and touching (bit 0) without points, are refused.
+  Bytes no_points = state_;
+  const auto points_at = static_cast<std::ptrdiff_t>(with_points->at + 10);
+  no_points.erase(no_points.begin() + points_at,
+                  no_points.begin() + points_at + 28 * with_points->point_count);
+  no_points[with_points->at + 9] = 0;
+  no_points[with_points->at + 8] = 0;
+  {
+    World w;
+    EXPECT_TRUE(w.restore(no_points).ok()) << "the edited record itself should be valid";
+  }
+  for (const int flags : {2, 3}) {
+    Bytes bad = no_points;
+    bad[with_points->at + 8] = static_cast<std::uint8_t>(flags);
+    const std::string message = expect_rejected(target_, bad);
+    EXPECT_TRUE(contains(message, "without contact points") || contains(message, "point count"))
+        << message;
+  }
+  // Points but not touching.
+  Bytes bad = state_;
+  bad[with_points->at + 8] = 0;
   expect_rejected(target_, bad);
 }
 

@@ -100,9 +100,9 @@ void update_contacts(WorldState& s) {
     const std::uint32_t b = s.bodies[pair & 0xFFFFFFFFU].id.value;
     while (old < s.contacts.size() &&
            (s.contacts[old].a < a || (s.contacts[old].a == a && s.contacts[old].b < b)))
-      ++old;
+      report_end(s, s.contacts[old++]);  // a pair whose boxes parted
     if (old < s.contacts.size() && s.contacts[old].a == a && s.contacts[old].b == b) {
-      merged.push_back(s.contacts[old]);
+      merged.push_back(s.contacts[old++]);
     } else {
       Contact c;
       c.a = a;
@@ -110,6 +110,7 @@ void update_contacts(WorldState& s) {
       merged.push_back(c);
     }
   }
+  for (; old < s.contacts.size(); ++old) report_end(s, s.contacts[old]);
   s.contacts = std::move(merged);
 }
 

@@ -72,6 +72,8 @@ void collide_one(WorldState& s, Contact& c, std::size_t ia, std::size_t ib) {
   c.cached = next;
   c.point_count = c.manifold.count;
   c.touching = c.point_count > 0;
+  c.collided = true;
+  c.pushed = false;  // set by the solver if a point pushes
 }
 
 struct UnionFind {
@@ -155,6 +157,44 @@ void wake_touched_islands(WorldState& s) {
     const std::size_t ib = index_of(s, c.b);
     collide_one(s, c, ia, ib);
   }
+}
+
+void report_end(WorldState& s, const Contact& c) {
+  if (!c.reported) return;
+  const BodyState& a = s.bodies[index_of(s, c.a)];
+  const BodyState& b = s.bodies[index_of(s, c.b)];
+  s.events.push_back({ContactEvent::Kind::end, BodyId{c.a}, BodyId{c.b}, a.sensor || b.sensor});
+}
+
+void report_contacts(WorldState& s) {
+  for (Contact& c : s.contacts) {
+    if (!c.collided) continue;  // neither body moved: the pair is as it was
+    c.collided = false;
+    const BodyState& a = s.bodies[index_of(s, c.a)];
+    const BodyState& b = s.bodies[index_of(s, c.b)];
+    // A solid pair is in touch when a point began the step within the speculative distance, or
+    // when the solver pushed on it (a fast body that met the surface and bounced within the step
+    // never shows a small gap at a step's boundary). The contact margin also holds points that a
+    // body would reach only in later steps: those alone are not a touch. A sensor pair is in touch
+    // while the shapes overlap.
+    const bool sensor = a.sensor || b.sensor;
+    const Fixed reach = sensor ? Fixed::zero() : s.def.speculative_distance;
+    bool touch = !sensor && c.pushed;
+    for (std::size_t k = 0; k < c.manifold.count; ++k)
+      touch = touch || c.manifold.points[k].separation <= reach;
+    if (touch == c.reported) continue;
+    c.reported = touch;
+    s.events.push_back(
+        {touch ? ContactEvent::Kind::begin : ContactEvent::Kind::end, BodyId{c.a}, BodyId{c.b},
+         sensor});
+  }
+  // Ends of vanished pairs were found first, by the broadphase; the order reported is by pair. A
+  // pair changes at most once per step, so the order is total.
+  std::sort(s.events.begin(), s.events.end(), [](const ContactEvent& x, const ContactEvent& y) {
+    if (x.a != y.a) return x.a < y.a;
+    if (x.b != y.b) return x.b < y.b;
+    return x.kind < y.kind;
+  });
 }
 
 void update_sleep(WorldState& s) {

@@ -366,6 +366,7 @@ class Solver {
   void store_impulses() {
     for (const Constraint& k : constraints_) {
       Contact& c = s_.contacts[k.contact];
+      c.pushed = k.pushed;
       for (std::size_t p = 0; p < k.count; ++p) {
         c.cached[p].normal_impulse = k.points[p].normal_impulse;
         c.cached[p].tangent_impulse_1 = k.points[p].tangent_impulse_1;

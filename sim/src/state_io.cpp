@@ -139,7 +139,11 @@ Contact read_contact(ByteReader& r) {
   Contact c;
   c.a = r.u32("contact body a");
   c.b = r.u32("contact body b");
-  c.touching = r.boolean("contact touching flag");
+  const std::size_t flags_at = r.offset();
+  const std::uint8_t flags = r.u8("contact flags");
+  if (flags > 3) r.fail_at(flags_at, "contact flags", "only bits 0 (touching) and 1 (reported)");
+  c.touching = (flags & 1U) != 0;
+  c.reported = (flags & 2U) != 0;
   c.point_count = r.u8("contact point count");
   if (c.point_count > 4) {
     r.fail("contact point count", "at most 4");
@@ -206,7 +210,7 @@ void write_body(const BodyState& b, ByteWriter& w) {
 void write_contact(const Contact& c, ByteWriter& w) {
   w.u32(c.a);
   w.u32(c.b);
-  w.boolean(c.touching);
+  w.u8(static_cast<std::uint8_t>((c.touching ? 1U : 0U) | (c.reported ? 2U : 0U)));
   w.u8(c.point_count);
   for (std::size_t p = 0; p < c.point_count; ++p) {
     w.u32(c.cached[p].feature);
@@ -309,6 +313,8 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
       return failed_at(at, where + "pairs must be unique and ascending");
     if (c.touching != (c.point_count > 0))
       return failed_at(at, where + "touching flag disagrees with the point count");
+    if (c.reported && !c.touching)
+      return failed_at(at, where + "reported as touching without contact points");
     s.contacts.push_back(c);
   }
   if (!r.ok()) return failed(r.error());

@@ -7,13 +7,16 @@ namespace detsim {
 
 void World::step() {
   sim_detail::WorldState& s = *s_;
+  s.events.clear();
   sim_detail::prepare_bodies(s);        // 1. derived data: poses, inverse mass and inertia, AABBs
   sim_detail::update_contacts(s);       // 2. broadphase: overlapping pairs, ascending by ID pair
   sim_detail::collide_contacts(s);      // 3. narrowphase: manifolds, warm-start impulses matched
   sim_detail::wake_touched_islands(s);  // 4. islands touched by moving bodies wake up
   sim_detail::solve(s);                 // 5. inputs, velocities, contacts, positions (sub-stepped)
-  sim_detail::update_sleep(s);          // 6. islands at rest fall asleep
-  for (BodyState& b : s.bodies) {       // 7. game inputs are consumed by the step
+  sim_detail::continuous(s);            // 6. fast and CCD bodies stop at their first touch
+  sim_detail::update_sleep(s);          // 7. islands at rest fall asleep
+  sim_detail::report_contacts(s);       // 8. contact and sensor events, by pair
+  for (BodyState& b : s.bodies) {       // 9. game inputs are consumed by the step
     b.force = {};
     b.torque = {};
   }
@@ -76,6 +79,8 @@ void prepare_bodies(WorldState& s) {
       d.aabb_max += Vec3{max(travel.x, Fixed::zero()), max(travel.y, Fixed::zero()),
                          max(travel.z, Fixed::zero())};
     }
+    d.start_position = b.position;
+    d.start_orientation = b.orientation;
     d.delta_position = {};
     d.delta_angle = {};
   }

@@ -113,10 +113,17 @@ Status World::destroy_body(BodyId id) {
       }
     }
   }
+  for (const sim_detail::Contact& c : s_->contacts) {
+    if (c.a == id.value || c.b == id.value) sim_detail::report_end(*s_, c);
+  }
   std::erase_if(s_->contacts,
                 [id](const sim_detail::Contact& c) { return c.a == id.value || c.b == id.value; });
   s_->bodies.erase(s_->bodies.begin() + i);
   return Status::success();
+}
+
+std::span<const ContactEvent> World::contact_events() const noexcept {
+  return s_->events;
 }
 
 bool World::contains(BodyId id) const noexcept {

@@ -41,6 +41,12 @@ struct Contact {
   std::uint32_t b = 0;
   std::uint8_t point_count = 0;  ///< points in `cached` (and in `manifold` after collide)
   bool touching = false;         ///< had at least one point at the last collide
+  /// In touch as contact events report it (docs/SIM.md): some point within the speculative
+  /// distance, or for a sensor pair, overlapping. A change of it is an event.
+  bool reported = false;
+  // Step scratch, not saved: the narrowphase ran on the pair this step; the solver pushed on it.
+  bool collided = false;
+  bool pushed = false;
   std::array<CachedPoint, 4> cached{};
   Manifold manifold;
 };
@@ -53,6 +59,8 @@ struct Derived {
   Vec3 aabb_min;
   Vec3 aabb_max;
   bool infinite = false;  ///< a plane: bounded by nothing
+  Vec3 start_position;  ///< the pose at the start of the step (for the continuous pass)
+  Quat start_orientation;
   // Solver scratch for the current step.
   Vec3 delta_position;  ///< since the start of the step
   Vec3 delta_angle;     ///< small-angle sum of angular velocity * h since the start of the step
@@ -66,6 +74,8 @@ struct WorldState {
   std::vector<BodyState> bodies;  ///< ascending ID
   std::vector<Contact> contacts;  ///< ascending (a, b)
   std::vector<Derived> derived;   ///< rebuilt each step
+  /// Output of the last step (and of destroy_body since); not saved, cleared by restore.
+  std::vector<ContactEvent> events;
 
   /// Index of body `id` in `bodies`, or -1.
   [[nodiscard]] std::ptrdiff_t find(std::uint32_t id) const noexcept;
@@ -88,7 +98,12 @@ void update_contacts(WorldState& s);       // broadphase: contact list = overlap
 void collide_contacts(WorldState& s);      // narrowphase: manifolds, warm start matched by feature
 void wake_touched_islands(WorldState& s);  // sleeping bodies touched by awake ones wake
 void solve(WorldState& s);                 // sub-stepped soft contact solver and integration
+void continuous(WorldState& s);            // fast and CCD bodies moved back to their first touch
 void update_sleep(WorldState& s);          // sleep timers; islands at rest fall asleep
+void report_contacts(WorldState& s);       // contact and sensor events, in pair order
+
+/// Appends the end event of a contact that is reported as touching (a pair that stops existing).
+void report_end(WorldState& s, const Contact& c);
 
 /// Canonical bytes (state_io.cpp).
 void write_globals(const WorldState& s, ByteWriter& w);

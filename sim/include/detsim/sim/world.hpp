@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -58,6 +59,37 @@ struct StateHashes {
   std::uint64_t contacts = 0;  ///< the contact cache (manifolds and warm-start impulses)
 
   friend constexpr bool operator==(const StateHashes&, const StateHashes&) noexcept = default;
+};
+
+/// What a query considers: bodies with (layer & filter.mask) != 0 and (filter.layer & mask) != 0,
+/// like a body with this layer and mask would. Sensors only when asked for.
+struct QueryFilter {
+  std::uint32_t layer = 0xFFFFFFFFU;
+  std::uint32_t mask = 0xFFFFFFFFU;
+  bool include_sensors = false;
+};
+
+/// Where a ray met a body.
+struct RayHit {
+  BodyId body{};
+  Vec3 point{};     ///< world space
+  Vec3 normal{};    ///< unit surface normal at `point`, against the ray (zero if it starts inside)
+  Fixed fraction{};  ///< of the ray's translation, 0 .. 1
+
+  friend constexpr bool operator==(const RayHit&, const RayHit&) noexcept = default;
+};
+
+/// A change of touch between two bodies during a step. For a pair of solid bodies, "touching" means
+/// that their surfaces are within the world's speculative distance (the contact exists for the
+/// solver); for a pair with a sensor, that the shapes overlap.
+struct ContactEvent {
+  enum class Kind : std::uint8_t { begin = 0, end = 1 };
+  Kind kind = Kind::begin;
+  BodyId a{};  ///< the lower ID
+  BodyId b{};
+  bool sensor = false;  ///< a or b is a sensor: an overlap event, no contact response
+
+  friend constexpr bool operator==(const ContactEvent&, const ContactEvent&) noexcept = default;
 };
 
 class World {
@@ -119,6 +151,33 @@ class World {
   /// on it) should draw. Part of the saved and hashed state.
   [[nodiscard]] Rng& rng() noexcept;
   [[nodiscard]] const Rng& rng() const noexcept;
+
+  /// The contact and sensor events of the last step, ascending by (a, b), then the end events of
+  /// the pairs that destroy_body calls since have removed, in call order. A pair changes at most
+  /// once per step. The next step() starts a new list; restore() clears it (the events are output,
+  /// not state: whether each pair is in touch is state, so a restored world reports exactly what
+  /// the original did).
+  [[nodiscard]] std::span<const ContactEvent> contact_events() const noexcept;
+
+  // ---- Queries: on the current state, touch nothing, allocate only their result ----
+
+  /// The first body a ray from `origin` along `translation` meets (the lowest fraction; ties go to
+  /// the lower ID), or nothing. A ray that starts inside a shape hits it at fraction 0. Shapes are
+  /// closed: an origin on a surface is inside. A zero translation is a point: it hits exactly the
+  /// shapes that contain it. Long rays do not overflow (up to 10^9 m per component); the hit is
+  /// placed within about 2^-32 of the ray's length (~2.4e-4 m for 10^6 m), the resolution of
+  /// `fraction` itself.
+  [[nodiscard]] std::optional<RayHit> raycast_closest(Vec3 origin, Vec3 translation,
+                                                      const QueryFilter& filter = {}) const;
+  /// Every body the ray meets, one hit per body (its first), by ascending fraction then ID.
+  [[nodiscard]] std::vector<RayHit> raycast_all(Vec3 origin, Vec3 translation,
+                                                const QueryFilter& filter = {}) const;
+  /// The IDs, ascending, of the bodies whose shapes overlap `shape` placed at `position` with
+  /// `orientation` (a unit quaternion; touching surfaces count as overlapping). A shape that a
+  /// dynamic body could not have (a plane, a non-positive size, ...) or an orientation that
+  /// create_body would refuse overlaps nothing: the result is empty.
+  [[nodiscard]] std::vector<BodyId> overlap(const Shape& shape, Vec3 position, Quat orientation,
+                                            const QueryFilter& filter = {}) const;
 
   // ---- State ----
 

@@ -1,0 +1,178 @@
+// Continuous collision: the time-of-impact pass after the solver (docs/SIM.md, stage 6).
+//
+// Speculative contacts stop most fast bodies at the surface they approach, but they are made from
+// the closest features at the start of the step, so a body that is fast compared with its own
+// size can still pass something the start pose did not see (a thin wall beside its path, a box it
+// spins into). This pass sweeps each such body from its pose at the start of the step to its pose
+// now, and if the sweep meets another body, moves it back to the first touch. Its velocity is
+// kept: the next step's speculative contact then stops it as usual. Swept bodies: those with the
+// CCD flag, and any dynamic body whose travel in the step exceeds half its smallest dimension.
+// They are swept in ascending ID order against every other solid body the layers allow, static
+// ones and moving ones alike (those at their pose after the solver, possibly already moved back).
+//
+// The sweep is conservative advancement: with d the distance at time t of the step and b a bound
+// on how fast the distance can shrink per unit of t, no touch can happen before t + d / b. Every
+// advance is such a safe step, so the pass never skips through a surface; it stops within the
+// target gap, or gives up after a fixed number of iterations (a fixed bound: the same work and
+// result on every machine) and keeps the last safe time.
+#include <algorithm>
+
+#include <detsim/fixed/math.hpp>
+#include <detsim/fixed/quat.hpp>
+
+#include "world_state.hpp"
+
+namespace detsim::sim_detail {
+
+namespace {
+
+constexpr int max_iterations = 24;
+
+Fixed smallest_dimension(const Shape& shape) {
+  switch (shape.type) {
+    case ShapeType::sphere:
+    case ShapeType::capsule:
+      return shape.radius;
+    case ShapeType::box:
+      return min(shape.half_extents.x, min(shape.half_extents.y, shape.half_extents.z));
+    case ShapeType::plane:
+      break;
+  }
+  return Fixed::zero();
+}
+
+// The largest distance from the body's origin to a point of its shape.
+Fixed reach(const Shape& shape) {
+  switch (shape.type) {
+    case ShapeType::sphere:
+      return shape.radius;
+    case ShapeType::box:
+      return length(shape.half_extents);
+    case ShapeType::capsule:
+      return shape.radius + shape.half_height;
+    case ShapeType::plane:
+      break;
+  }
+  return Fixed::zero();
+}
+
+// An upper bound of the rotation angle (radians) between two unit quaternions, taken the shorter
+// way. With c = |q1 - q0| (sign of q1 matched, so c <= sqrt 2), the angle is 4 asin(c / 2), and
+// since asin(x) / x grows on [0, 1], 4 asin(c / 2) <= c * 4 asin(sqrt 2 / 2) / sqrt 2 = 2.2214 c.
+Fixed angle_bound(Quat q0, Quat q1) {
+  const Fixed d = q0.w * q1.w + q0.x * q1.x + q0.y * q1.y + q0.z * q1.z;
+  if (d < Fixed::zero()) q1 = {-q1.w, -q1.x, -q1.y, -q1.z};
+  const Vec3 dv{q1.x - q0.x, q1.y - q0.y, q1.z - q0.z};
+  const Fixed chord2 = length_squared(dv) + (q1.w - q0.w) * (q1.w - q0.w);
+  // 2.25 c, plus a few ulp for the rounding of c.
+  const Fixed chord = sqrt(chord2);
+  return min(chord * Fixed::from_raw(Fixed::one_raw * 9 / 4) + Fixed::from_raw(64), Fixed::pi());
+}
+
+// Normalised linear interpolation between unit quaternions along the shorter arc.
+Quat nlerp(Quat q0, Quat q1, Fixed t) {
+  const Fixed d = q0.w * q1.w + q0.x * q1.x + q0.y * q1.y + q0.z * q1.z;
+  if (d < Fixed::zero()) q1 = {-q1.w, -q1.x, -q1.y, -q1.z};
+  const Fixed u = Fixed::one() - t;
+  return normalize(
+      Quat{q0.w * u + q1.w * t, q0.x * u + q1.x * t, q0.y * u + q1.y * t, q0.z * u + q1.z * t});
+}
+
+struct Sweep {
+  Vec3 p0, p1;
+  Quat q0, q1;
+  bool turns = false;
+
+  [[nodiscard]] Pose at(Fixed t) const {
+    const Vec3 p = p0 + (p1 - p0) * t;
+    return {p, to_mat3(turns ? nlerp(q0, q1, t) : q1)};
+  }
+};
+
+// The signed distance between two posed shapes, as the narrowphase measures it (a lower bound of
+// the true distance when apart), or `beyond` when they are farther apart than that.
+Fixed distance(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Fixed beyond) {
+  const Manifold m = collide(a, pa, b, pb, beyond);
+  if (m.count == 0) return beyond;
+  Fixed d = m.points[0].separation;
+  for (std::size_t k = 1; k < m.count; ++k)
+    d = min(d, m.points[k].separation);
+  return d;
+}
+
+bool box_overlap(Vec3 amin, Vec3 amax, Vec3 bmin, Vec3 bmax) {
+  return amin.x <= bmax.x && bmin.x <= amax.x && amin.y <= bmax.y && bmin.y <= amax.y &&
+         amin.z <= bmax.z && bmin.z <= amax.z;
+}
+
+}  // namespace
+
+void continuous(WorldState& s) {
+  const Fixed target = s.def.linear_slop;  // stop this close to the surface
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    BodyState& body = s.bodies[i];
+    if (body.type != BodyType::dynamic || !body.awake || body.sensor) continue;
+    const Derived& d = s.derived[i];
+    const Vec3 travel = body.position - d.start_position;
+    const Fixed distance_moved = length(travel);
+    const bool fast = distance_moved > smallest_dimension(body.shape) / Fixed::from_int(2);
+    if (!body.ccd && !fast) continue;
+    const Sweep sweep{d.start_position, body.position, d.start_orientation, body.orientation,
+                      body.orientation != d.start_orientation};
+    // How fast the distance to anything can shrink per unit of t: the travel plus the rim speed.
+    // Normalised lerp turns at a varying rate, at most twice its mean for any angle up to pi, so
+    // the rim term is doubled.
+    const Fixed rim = sweep.turns
+                          ? angle_bound(sweep.q0, sweep.q1) * reach(body.shape) * Fixed::from_int(2)
+                          : Fixed::zero();
+    const Fixed bound = distance_moved + rim;
+    if (bound == Fixed::zero()) continue;
+    // The box the sweep covers.
+    const Fixed r = reach(body.shape);
+    const Vec3 rr{r, r, r};
+    const Vec3 lo{min(sweep.p0.x, sweep.p1.x), min(sweep.p0.y, sweep.p1.y),
+                  min(sweep.p0.z, sweep.p1.z)};
+    const Vec3 hi{max(sweep.p0.x, sweep.p1.x), max(sweep.p0.y, sweep.p1.y),
+                  max(sweep.p0.z, sweep.p1.z)};
+    const Vec3 sweep_min = lo - rr;
+    const Vec3 sweep_max = hi + rr;
+    const Fixed beyond = bound + target + r;
+
+    Fixed first_hit = Fixed::one();  // the earliest touch, as a fraction of the step
+    for (std::size_t j = 0; j < s.bodies.size(); ++j) {
+      if (j == i) continue;
+      const BodyState& other = s.bodies[j];
+      if (other.sensor) continue;
+      if ((body.layer & other.mask) == 0 || (other.layer & body.mask) == 0) continue;
+      const Pose other_pose{other.position, to_mat3(other.orientation)};
+      if (other.shape.type != ShapeType::plane) {
+        const Fixed o = reach(other.shape);
+        const Vec3 oo{o, o, o};
+        if (!box_overlap(sweep_min, sweep_max, other.position - oo, other.position + oo)) continue;
+      }
+      // Already touching at the start: the contact solver has it; a sweep would only stick.
+      if (distance(body.shape, sweep.at(Fixed::zero()), other.shape, other_pose, beyond) <= target)
+        continue;
+      Fixed t = Fixed::zero();
+      bool stop = true;  // a touch, or out of iterations: t is then the last safe time
+      for (int k = 0; k < max_iterations; ++k) {
+        const Fixed gap = distance(body.shape, sweep.at(t), other.shape, other_pose, beyond);
+        if (gap <= target) break;
+        // A safe advance that aims for half the target gap, so the loop ends near the surface.
+        t += (gap - target / Fixed::from_int(2)) / bound;
+        if (t >= first_hit) {
+          stop = false;  // no touch before what is already known
+          break;
+        }
+      }
+      if (stop && t < first_hit) first_hit = t;
+    }
+    if (first_hit < Fixed::one()) {
+      const Pose p = sweep.at(first_hit);
+      body.position = p.position;
+      if (sweep.turns) body.orientation = nlerp(sweep.q0, sweep.q1, first_hit);
+    }
+  }
+}
+
+}  // namespace detsim::sim_detail
