@@ -5,6 +5,7 @@
 #include <detsim/sim/bytes.hpp>
 #include <detsim/sim/mass.hpp>
 #include <detsim/sim/rng.hpp>
+#include <detsim/sim/scenario.hpp>
 #include <detsim/sim/shape.hpp>
 #include <detsim/sim/status.hpp>
 #include <detsim/sim/world.hpp>

@@ -1,0 +1,102 @@
+// Named scenarios: the scenes that tests, the `detsim` command, the golden files and the
+// benchmarks share (docs/SCENARIOS.md describes each).
+//
+// A scenario is a World built from a name and a few parameters, plus the per-frame game logic that
+// drives it (player inputs, scripted movers, RNG-driven events). That logic reads only the World
+// (its frame, bodies and RNG) and the frame's inputs, so the World's saved state is the scenario's
+// whole state: restoring a World restores the scenario.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <utility>
+
+#include <detsim/sim/status.hpp>
+#include <detsim/sim/world.hpp>
+
+namespace detsim {
+
+/// One player's input for one frame: a small plain struct with a fixed 3-byte canonical encoding
+/// (buttons, then the two axes as two's complement bytes).
+struct PlayerInput {
+  static constexpr std::uint8_t jump = 1U;  ///< buttons bit 0: an upward impulse when grounded
+  static constexpr std::uint8_t dash = 2U;  ///< buttons bit 1: a burst along the stick
+  static constexpr std::size_t encoded_size = 3;
+
+  std::uint8_t buttons = 0;
+  std::int8_t move_x = 0;  ///< stick, -127 .. 127 (-128 counts as -127)
+  std::int8_t move_z = 0;
+
+  friend constexpr bool operator==(const PlayerInput&, const PlayerInput&) noexcept = default;
+};
+
+/// What a scenario is and which parameters it takes.
+struct ScenarioInfo {
+  std::string_view name;
+  std::string_view summary;
+  std::uint32_t default_frames = 600;
+  std::uint32_t min_players = 0;  ///< 0 .. 0: takes no players
+  std::uint32_t max_players = 0;
+  std::uint32_t default_players = 0;
+  std::uint32_t default_count = 0;  ///< 0: no `count` parameter; else its default
+  std::uint32_t max_count = 0;
+  bool uses_seed = false;  ///< whether the seed changes anything but the RNG's unused state
+};
+
+/// Parameters of a scenario; zero means "the scenario's default".
+struct ScenarioParams {
+  std::uint64_t seed = 1;
+  std::uint32_t players = 0;
+  std::uint32_t count = 0;  ///< bodies, for the scenarios that take a count (the piles)
+
+  friend constexpr bool operator==(const ScenarioParams&, const ScenarioParams&) noexcept = default;
+};
+
+/// Every scenario, in a fixed order (by name).
+[[nodiscard]] std::span<const ScenarioInfo> scenario_list() noexcept;
+/// The scenario called `name`, or nullptr.
+[[nodiscard]] const ScenarioInfo* find_scenario(std::string_view name) noexcept;
+
+class Scenario {
+ public:
+  /// The scenario `name` with `params` (defaults filled in). Unknown names and out-of-range
+  /// parameters are errors naming what is wrong and what is allowed.
+  static Expected<Scenario> create(std::string_view name, const ScenarioParams& params = {});
+
+  [[nodiscard]] const ScenarioInfo& info() const noexcept { return *info_; }
+  /// The parameters with the defaults filled in.
+  [[nodiscard]] const ScenarioParams& params() const noexcept { return params_; }
+  [[nodiscard]] World& world() noexcept { return world_; }
+  [[nodiscard]] const World& world() const noexcept { return world_; }
+
+  /// Runs the frame's game logic with one input per player (missing inputs count as neutral,
+  /// extra ones are ignored), then steps the world.
+  void step(std::span<const PlayerInput> inputs = {});
+
+  /// The body a player controls (players 0 .. params().players - 1), or the null ID.
+  [[nodiscard]] BodyId player_body(std::uint32_t player) const;
+
+ private:
+  using Control = void (*)(World&, std::span<const PlayerInput>, const ScenarioParams&);
+  Scenario(const ScenarioInfo& info, const ScenarioParams& params, World world, Control control)
+      : info_(&info), params_(params), world_(std::move(world)), control_(control) {}
+
+  const ScenarioInfo* info_;
+  ScenarioParams params_;
+  World world_;
+  Control control_;
+};
+
+/// A deterministic stand-in for a human player, for headless runs, tests and golden files: the
+/// input of `player` at `frame` for a match seeded with `seed` (a pure function of the three).
+[[nodiscard]] PlayerInput scripted_input(std::uint64_t seed, std::uint64_t frame,
+                                         std::uint32_t player) noexcept;
+
+/// The 3-byte canonical encoding of an input, and back.
+void encode_input(const PlayerInput& input,
+                  std::span<std::uint8_t, PlayerInput::encoded_size> out) noexcept;
+[[nodiscard]] PlayerInput decode_input(
+    std::span<const std::uint8_t, PlayerInput::encoded_size> in) noexcept;
+
+}  // namespace detsim

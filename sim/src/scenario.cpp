@@ -1,0 +1,338 @@
+// The scenario registry, the Scenario driver, player inputs, and the scenes without game logic.
+#include <algorithm>
+#include <array>
+#include <string>
+
+#include <detsim/fixed/math.hpp>
+#include <detsim/fixed/quat.hpp>
+#include <detsim/sim/scenario.hpp>
+
+#include "scenario_scenes.hpp"
+
+namespace detsim {
+
+namespace {
+
+using namespace detsim::literals;
+
+struct Entry {
+  ScenarioInfo info;
+  void (*build)(World&, const ScenarioParams&);
+  void (*control)(World&, std::span<const PlayerInput>, const ScenarioParams&);
+};
+
+void build_pile_boxes(World& w, const ScenarioParams& p) {
+  sim_detail::build_pile(w, p, false);
+}
+void build_pile_spheres(World& w, const ScenarioParams& p) {
+  sim_detail::build_pile(w, p, true);
+}
+
+// Sorted by name: scenario_list() is documented to be.
+constexpr std::array entries{
+    Entry{{"arena",
+           "2-8 player-controlled spheres pushing crates in a walled arena; RNG-driven crate "
+           "spawns and kicks",
+           3600, 2, 8, 2, 0, 0, true},
+          sim_detail::build_arena,
+          sim_detail::control_arena},
+    Entry{{"bounce", "five spheres dropped from 5 m with restitution 0, 0.25, 0.5, 0.75 and 1", 600,
+           0, 0, 0, 0, 0, false},
+          sim_detail::build_bounce,
+          nullptr},
+    Entry{{"bullet_wall",
+           "a 0.1 m sphere (CCD) at 1000 m/s towards a 0.2 m thick static wall 10 m away", 120, 0,
+           0, 0, 0, 0, false},
+          sim_detail::build_bullet_wall,
+          nullptr},
+    Entry{{"dominoes", "30 dominoes in a row; the first is tipped over", 600, 0, 0, 0, 0, 0, false},
+          sim_detail::build_dominoes,
+          nullptr},
+    Entry{{"pile_boxes",
+           "N 1 m boxes (mass 1) on a cubic lattice, spacing 1.1 m, dropped on a plane "
+           "(the scene benchmarked against Bullet)",
+           600, 0, 0, 0, 1000, 100000, false},
+          build_pile_boxes,
+          nullptr},
+    Entry{{"pile_spheres",
+           "N spheres of radius 0.5 m (mass 1) on a cubic lattice, spacing 1.1 m, dropped on a "
+           "plane (the scene benchmarked against Bullet)",
+           600, 0, 0, 0, 1000, 100000, false},
+          build_pile_spheres,
+          nullptr},
+    Entry{{"pyramid", "a 20-row pyramid of 1 m boxes (210 boxes) on a plane", 1200, 0, 0, 0, 0, 0,
+           false},
+          sim_detail::build_pyramid,
+          nullptr},
+    Entry{
+        {"slope", "boxes of friction 0.2 to 1.0 on a 30-degree slope: those with tan 30 > mu slide",
+         600, 0, 0, 0, 0, 0, false},
+        sim_detail::build_slope,
+        nullptr},
+    Entry{{"spray",
+           "RNG-driven spawns of spheres, boxes and capsules onto a rotating paddle and a "
+           "moving platform (kinematic)",
+           1200, 0, 0, 0, 0, 0, true},
+          sim_detail::build_spray,
+          sim_detail::control_spray},
+    Entry{{"stack", "10 boxes of 1 m stacked on a plane", 1200, 0, 0, 0, 0, 0, false},
+          sim_detail::build_stack,
+          nullptr},
+};
+
+constexpr std::array<ScenarioInfo, entries.size()> infos = [] {
+  std::array<ScenarioInfo, entries.size()> out{};
+  for (std::size_t i = 0; i < entries.size(); ++i)
+    out[i] = entries[i].info;
+  return out;
+}();
+
+const Entry* find_entry(std::string_view name) {
+  for (const Entry& e : entries) {
+    if (e.info.name == name) return &e;
+  }
+  return nullptr;
+}
+
+std::string known_names() {
+  std::string s;
+  for (const Entry& e : entries) {
+    if (!s.empty()) s += ", ";
+    s += e.info.name;
+  }
+  return s;
+}
+
+// SplitMix64's finaliser: a strong 64-bit mix, for scripted inputs.
+constexpr std::uint64_t mix(std::uint64_t z) noexcept {
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9U;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBU;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+std::span<const ScenarioInfo> scenario_list() noexcept {
+  return infos;
+}
+
+const ScenarioInfo* find_scenario(std::string_view name) noexcept {
+  for (const ScenarioInfo& info : infos) {
+    if (info.name == name) return &info;
+  }
+  return nullptr;
+}
+
+Expected<Scenario> Scenario::create(std::string_view name, const ScenarioParams& params) {
+  const Entry* e = find_entry(name);
+  if (e == nullptr)
+    return Status::error("unknown scenario '" + std::string(name) + "' (known: " + known_names() +
+                         ")");
+  const ScenarioInfo& info = *find_scenario(name);
+  ScenarioParams p = params;
+  if (p.players == 0) p.players = info.default_players;
+  if (p.players < info.min_players || p.players > info.max_players) {
+    if (info.max_players == 0)
+      return Status::error("scenario '" + std::string(name) + "' takes no players, got " +
+                           std::to_string(p.players));
+    return Status::error(
+        "scenario '" + std::string(name) + "' takes " + std::to_string(info.min_players) + " to " +
+        std::to_string(info.max_players) + " players, got " + std::to_string(p.players));
+  }
+  if (p.count == 0) p.count = info.default_count;
+  if (p.count > info.max_count) {
+    if (info.max_count == 0)
+      return Status::error("scenario '" + std::string(name) + "' takes no body count, got " +
+                           std::to_string(p.count));
+    return Status::error("scenario '" + std::string(name) + "' takes 1 to " +
+                         std::to_string(info.max_count) + " bodies, got " +
+                         std::to_string(p.count));
+  }
+  WorldDef def;
+  def.seed = p.seed;
+  auto world = World::create(def);
+  if (!world) return world.status();
+  e->build(world.value(), p);
+  return Scenario(info, p, std::move(world.value()), e->control);
+}
+
+void Scenario::step(std::span<const PlayerInput> inputs) {
+  if (control_ != nullptr) {
+    std::array<PlayerInput, 8> frame{};  // missing inputs are neutral
+    const std::size_t n = std::min<std::size_t>({inputs.size(), params_.players, frame.size()});
+    std::copy_n(inputs.begin(), n, frame.begin());
+    control_(world_, std::span<const PlayerInput>(frame.data(), params_.players), params_);
+  }
+  world_.step();
+}
+
+BodyId Scenario::player_body(std::uint32_t player) const {
+  if (player >= params_.players) return {};
+  const std::uint64_t tag = sim_detail::player_tag + player;
+  for (const BodyId id : world_.body_ids()) {
+    if (world_.body(id)->user_data == tag) return id;
+  }
+  return {};
+}
+
+PlayerInput scripted_input(std::uint64_t seed, std::uint64_t frame, std::uint32_t player) noexcept {
+  // A player holds a decision for a quarter of a second (15 frames), like a person would, and
+  // each decision is a hash of (seed, player, decision number): a pure function, no state.
+  const std::uint64_t h =
+      mix(mix(seed ^ 0x243F6A8885A308D3U) ^ (std::uint64_t{player} << 48) ^ (frame / 15));
+  PlayerInput in;
+  in.move_x = static_cast<std::int8_t>(static_cast<int>(h & 0xFFU) - 128);
+  in.move_z = static_cast<std::int8_t>(static_cast<int>((h >> 8) & 0xFFU) - 128);
+  // Buttons are pressed on the first frame of a decision only, 1 in 4 and 1 in 8 of the time.
+  if (frame % 15 == 0) {
+    if (((h >> 16) & 3U) == 0) in.buttons |= PlayerInput::jump;
+    if (((h >> 18) & 7U) == 0) in.buttons |= PlayerInput::dash;
+  }
+  return in;
+}
+
+void encode_input(const PlayerInput& input,
+                  std::span<std::uint8_t, PlayerInput::encoded_size> out) noexcept {
+  out[0] = input.buttons;
+  out[1] = static_cast<std::uint8_t>(input.move_x);
+  out[2] = static_cast<std::uint8_t>(input.move_z);
+}
+
+PlayerInput decode_input(std::span<const std::uint8_t, PlayerInput::encoded_size> in) noexcept {
+  return {in[0], static_cast<std::int8_t>(in[1]), static_cast<std::int8_t>(in[2])};
+}
+
+namespace sim_detail {
+
+namespace {
+
+BodyId add(World& w, const BodyDef& def) {
+  // Scenario definitions are constants checked by the tests: a refusal is a bug here.
+  return w.create_body(def).value();
+}
+
+void add_ground(World& w, Fixed friction) {
+  add(w, {.type = BodyType::static_body, .shape = Shape::plane(), .friction = friction});
+}
+
+// The smallest s with s^3 >= n (n >= 1).
+std::uint32_t cube_side(std::uint32_t n) {
+  std::uint32_t s = 1;
+  while (std::uint64_t{s} * s * s < n)
+    ++s;
+  return s;
+}
+
+}  // namespace
+
+void build_pile(World& w, const ScenarioParams& p, bool spheres) {
+  add_ground(w, 0.5_fx);
+  const std::uint32_t side = cube_side(p.count);
+  const Fixed spacing = 1.1_fx;
+  const auto centred = [&](std::uint32_t k) {
+    return Fixed::from_int(static_cast<std::int32_t>(k) - static_cast<std::int32_t>(side / 2)) *
+           spacing;
+  };
+  for (std::uint32_t i = 0; i < p.count; ++i) {
+    const std::uint32_t x = i % side;
+    const std::uint32_t z = (i / side) % side;
+    const std::uint32_t y = i / (side * side);
+    add(w, {.shape = spheres ? Shape::sphere(0.5_fx) : Shape::box({0.5_fx, 0.5_fx, 0.5_fx}),
+            .position = {centred(x), 1_fx + Fixed::from_int(static_cast<std::int32_t>(y)) * spacing,
+                         centred(z)},
+            .mass = 1_fx,
+            .friction = 0.5_fx,
+            .restitution = 0_fx});
+  }
+}
+
+void build_stack(World& w, const ScenarioParams&) {
+  add_ground(w, 0.6_fx);
+  for (int i = 0; i < 10; ++i) {
+    add(w, {.shape = Shape::box({0.5_fx, 0.5_fx, 0.5_fx}),
+            .position = {0_fx, 0.5_fx + Fixed::from_int(i), 0_fx}});
+  }
+}
+
+void build_pyramid(World& w, const ScenarioParams&) {
+  add_ground(w, 0.6_fx);
+  constexpr int rows = 20;
+  for (int row = 0; row < rows; ++row) {
+    const int n = rows - row;
+    for (int i = 0; i < n; ++i) {
+      // Row r is centred on x = 0: boxes at i - (n - 1) / 2, half a box in from the row below.
+      const Fixed x = Fixed::from_int(2 * i - (n - 1)) / 2_fx;
+      add(w, {.shape = Shape::box({0.5_fx, 0.5_fx, 0.5_fx}),
+              .position = {x, 0.5_fx + Fixed::from_int(row), 0_fx}});
+    }
+  }
+}
+
+void build_dominoes(World& w, const ScenarioParams&) {
+  add_ground(w, 0.6_fx);
+  for (int i = 0; i < 30; ++i) {
+    BodyDef d{.shape = Shape::box({0.1_fx, 0.5_fx, 0.25_fx}),
+              .position = {Fixed::from_int(i) * 0.6_fx, 0.5_fx, 0_fx}};
+    if (i == 0) {
+      // The first one starts leaning 0.3 rad towards the others (turned about -z: its top moves
+      // towards +x), on its bottom edge at x = 0.1: the centre sits at that edge plus the rotated
+      // half diagonal (-0.1, 0.5) -> (-0.1 cos a + 0.5 sin a, 0.1 sin a + 0.5 cos a), lifted by
+      // 1 mm so that it starts just clear of the ground.
+      const Fixed angle = 0.3_fx;
+      const Fixed c = cos(angle);
+      const Fixed s = sin(angle);
+      d.orientation = from_axis_angle({0_fx, 0_fx, -1_fx}, angle);
+      d.position = {0.1_fx - 0.1_fx * c + 0.5_fx * s, 0.1_fx * s + 0.5_fx * c + 0.001_fx, 0_fx};
+    }
+    add(w, d);
+  }
+}
+
+void build_bullet_wall(World& w, const ScenarioParams&) {
+  add_ground(w, 0.6_fx);
+  add(w, {.type = BodyType::static_body,
+          .shape = Shape::box({0.1_fx, 1_fx, 1_fx}),
+          .position = {10_fx, 1_fx, 0_fx}});
+  add(w, {.shape = Shape::sphere(0.05_fx),
+          .position = {0_fx, 1_fx, 0_fx},
+          .linear_velocity = {1000_fx, 0_fx, 0_fx},
+          .density = 7800_fx,  // steel
+          .ccd = true});
+}
+
+void build_bounce(World& w, const ScenarioParams&) {
+  add_ground(w, 0.6_fx);
+  for (int i = 0; i < 5; ++i) {
+    add(w, {.shape = Shape::sphere(0.25_fx),
+            .position = {Fixed::from_int(i), 5_fx, 0_fx},
+            .restitution = Fixed::from_int(i) / 4_fx});
+  }
+}
+
+void build_slope(World& w, const ScenarioParams&) {
+  add_ground(w, 0.6_fx);
+  // A slab tilted 30 degrees about z; its surface normal is n = (-sin 30, cos 30, 0). Contact
+  // friction is the geometric mean of the two bodies': the slab has friction 1 and each box mu^2,
+  // so that the pairs have mu = 0.2, 0.4, 0.6, 0.8 and 1.0 against tan 30 = 0.577.
+  const Quat tilt = from_axis_angle({0_fx, 0_fx, 1_fx}, Fixed::pi() / 6_fx);
+  const Vec3 normal = rotate(tilt, Vec3{0_fx, 1_fx, 0_fx});
+  const Vec3 along = rotate(tilt, Vec3{1_fx, 0_fx, 0_fx});
+  const Vec3 centre{0_fx, 5_fx, 0_fx};
+  add(w, {.type = BodyType::static_body,
+          .shape = Shape::box({8_fx, 0.25_fx, 4_fx}),
+          .position = centre,
+          .orientation = tilt,
+          .friction = 1_fx});
+  for (int i = 0; i < 5; ++i) {
+    const Fixed mu = Fixed::from_int(i + 1) / 5_fx;  // 0.2, 0.4, 0.6, 0.8, 1.0 (pair: sqrt)
+    const Vec3 at = centre + normal * 0.501_fx + along * 3_fx +
+                    Vec3{0_fx, 0_fx, Fixed::from_int(2 * i - 4) * 0.75_fx};
+    add(w, {.shape = Shape::box({0.25_fx, 0.25_fx, 0.25_fx}),
+            .position = at,
+            .orientation = tilt,
+            .friction = mu * mu});
+  }
+}
+
+}  // namespace sim_detail
+}  // namespace detsim
