@@ -123,10 +123,12 @@ class Solver {
       warm_start();
       for (std::uint32_t i = 0; i < s_.def.iterations; ++i)
         solve_contacts(true);
+      clamp_speeds();  // contact impulses (a crushed light body) can exceed what gravity could
       integrate_positions();
       for (std::uint32_t i = 0; i < s_.def.iterations; ++i)
         solve_contacts(false);
       apply_restitution();
+      clamp_speeds();
     }
     store_impulses();
     for (std::size_t i = 0; i < s_.bodies.size(); ++i) {
@@ -220,6 +222,17 @@ class Solver {
     const Fixed l = length(v);
     if (l <= limit) return v;
     return v * (limit / l);
+  }
+
+  // The speed limits hold for every velocity a body moves with and keeps, not only after forces.
+  void clamp_speeds() {
+    for (std::size_t i = 0; i < s_.bodies.size(); ++i) {
+      const BodyState& b = s_.bodies[i];
+      if (b.type != BodyType::dynamic || !b.awake) continue;
+      Velocity& v = velocities_[i];
+      v.linear = clamp_speed(v.linear, s_.def.max_linear_speed);
+      v.angular = clamp_speed(v.angular, s_.def.max_angular_speed);
+    }
   }
 
   void integrate_velocities() {
