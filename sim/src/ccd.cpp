@@ -41,21 +41,6 @@ Fixed smallest_dimension(const Shape& shape) {
   return Fixed::zero();
 }
 
-// The largest distance from the body's origin to a point of its shape.
-Fixed reach(const Shape& shape) {
-  switch (shape.type) {
-    case ShapeType::sphere:
-      return shape.radius;
-    case ShapeType::box:
-      return length(shape.half_extents);
-    case ShapeType::capsule:
-      return shape.radius + shape.half_height;
-    case ShapeType::plane:
-      break;
-  }
-  return Fixed::zero();
-}
-
 // An upper bound of the rotation angle (radians) between two unit quaternions, taken the shorter
 // way. With c = |q1 - q0| (sign of q1 matched, so c <= sqrt 2), the angle is 4 asin(c / 2), and
 // since asin(x) / x grows on [0, 1], 4 asin(c / 2) <= c * 4 asin(sqrt 2 / 2) / sqrt 2 = 2.2214 c.
@@ -122,13 +107,13 @@ void continuous(WorldState& s) {
     // How fast the distance to anything can shrink per unit of t: the travel plus the rim speed.
     // Normalised lerp turns at a varying rate, at most twice its mean for any angle up to pi, so
     // the rim term is doubled.
-    const Fixed rim = sweep.turns
-                          ? angle_bound(sweep.q0, sweep.q1) * reach(body.shape) * Fixed::from_int(2)
-                          : Fixed::zero();
+    const Fixed rim = sweep.turns ? angle_bound(sweep.q0, sweep.q1) * bounding_radius(body.shape) *
+                                        Fixed::from_int(2)
+                                  : Fixed::zero();
     const Fixed bound = distance_moved + rim;
     if (bound == Fixed::zero()) continue;
     // The box the sweep covers.
-    const Fixed r = reach(body.shape);
+    const Fixed r = bounding_radius(body.shape);
     const Vec3 rr{r, r, r};
     const Vec3 lo{min(sweep.p0.x, sweep.p1.x), min(sweep.p0.y, sweep.p1.y),
                   min(sweep.p0.z, sweep.p1.z)};
@@ -146,7 +131,7 @@ void continuous(WorldState& s) {
       if ((body.layer & other.mask) == 0 || (other.layer & body.mask) == 0) continue;
       const Pose other_pose{other.position, to_mat3(other.orientation)};
       if (other.shape.type != ShapeType::plane) {
-        const Fixed o = reach(other.shape);
+        const Fixed o = bounding_radius(other.shape);
         const Vec3 oo{o, o, o};
         if (!box_overlap(sweep_min, sweep_max, other.position - oo, other.position + oo)) continue;
       }

@@ -25,21 +25,6 @@ bool moving(const BodyState& b) {
   return b.linear_velocity != Vec3{} || b.angular_velocity != Vec3{};  // a kinematic body
 }
 
-// A radius that bounds the shape about the body's origin (0 for a plane, which does not turn).
-Fixed bounding_radius(const Shape& shape) {
-  switch (shape.type) {
-    case ShapeType::sphere:
-      return shape.radius;
-    case ShapeType::box:
-      return length(shape.half_extents);
-    case ShapeType::capsule:
-      return shape.radius + shape.half_height;
-    case ShapeType::plane:
-      break;
-  }
-  return Fixed::zero();
-}
-
 // How far apart two bodies may be and still touch within this step: the speculative distance
 // plus the distance their relative motion can close in dt (linear, and the rim speed of each
 // body's rotation). Speculative contacts over this margin let the solver stop a fast body exactly
@@ -113,6 +98,20 @@ UnionFind islands(const WorldState& s) {
 
 }  // namespace
 
+Fixed bounding_radius(const Shape& shape) noexcept {
+  switch (shape.type) {
+    case ShapeType::sphere:
+      return shape.radius;
+    case ShapeType::box:
+      return length(shape.half_extents);
+    case ShapeType::capsule:
+      return shape.radius + shape.half_height;
+    case ShapeType::plane:
+      break;
+  }
+  return Fixed::zero();
+}
+
 void collide_contacts(WorldState& s) {
   for (Contact& c : s.contacts) {
     const std::size_t ia = index_of(s, c.a);
@@ -184,9 +183,8 @@ void report_contacts(WorldState& s) {
       touch = touch || c.manifold.points[k].separation <= reach;
     if (touch == c.reported) continue;
     c.reported = touch;
-    s.events.push_back(
-        {touch ? ContactEvent::Kind::begin : ContactEvent::Kind::end, BodyId{c.a}, BodyId{c.b},
-         sensor});
+    s.events.push_back({touch ? ContactEvent::Kind::begin : ContactEvent::Kind::end, BodyId{c.a},
+                        BodyId{c.b}, sensor});
   }
   // Ends of vanished pairs were found first, by the broadphase; the order reported is by pair. A
   // pair changes at most once per step, so the order is total.
