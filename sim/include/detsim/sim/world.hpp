@@ -72,8 +72,8 @@ struct QueryFilter {
 /// Where a ray met a body.
 struct RayHit {
   BodyId body{};
-  Vec3 point{};     ///< world space
-  Vec3 normal{};    ///< unit surface normal at `point`, against the ray (zero if it starts inside)
+  Vec3 point{};      ///< world space
+  Vec3 normal{};     ///< unit surface normal at `point`, against the ray (zero if it starts inside)
   Fixed fraction{};  ///< of the ray's translation, 0 .. 1
 
   friend constexpr bool operator==(const RayHit&, const RayHit&) noexcept = default;
