@@ -247,7 +247,8 @@ TEST(ArenaScenario, PlayersFollowTheirSticks) {
 TEST(ArenaScenario, JumpWorksFromTheFloorOnly) {
   Scenario s = make("arena");
   const BodyId p0 = s.player_body(0);
-  for (int f = 0; f < 30; ++f) s.step();  // settle on the floor
+  for (int f = 0; f < 30; ++f)
+    s.step();  // settle on the floor
   const std::vector<PlayerInput> jump{{PlayerInput::jump, 0, 0}};
   s.step(jump);
   // 400 N s on 80 kg: +5 m/s, less a step of gravity.

@@ -204,7 +204,8 @@ World settled() {
 // half height | nothing), position, orientation, linear and angular velocity, mass, inertia,
 // friction, restitution, linear and angular damping, layer u32, mask u32, sensor, ccd, user data
 // u64, awake, sleep time, force, torque. A contact: a u32, b u32, flags u8 (bit 0 touching, bit 1
-// reported by events, no other bit), point count u8, then per point: feature u32, normal impulse, two tangent impulses.
+// reported by events, no other bit), point count u8, then per point: feature u32, normal impulse,
+// two tangent impulses.
 
 struct DecodedContact {
   std::uint32_t a = 0;
@@ -922,9 +923,8 @@ TEST_F(RejectedRestore, ContactsMustNameExistingBodiesInOrder) {
 }
 
 TEST_F(RejectedRestore, ContactFlagsMustBeConsistent) {
-  const auto with_points =
-      std::find_if(decoded_.contacts.begin(), decoded_.contacts.end(),
-                   [](const DecodedContact& c) { return c.point_count > 0; });
+  const auto with_points = std::find_if(decoded_.contacts.begin(), decoded_.contacts.end(),
+                                        [](const DecodedContact& c) { return c.point_count > 0; });
   ASSERT_NE(with_points, decoded_.contacts.end());
   for (const int flags : {4, 0x81, 0xFF}) {  // bits that mean nothing
     Bytes bad = state_;

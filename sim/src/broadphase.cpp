@@ -110,7 +110,8 @@ void update_contacts(WorldState& s) {
       merged.push_back(c);
     }
   }
-  for (; old < s.contacts.size(); ++old) report_end(s, s.contacts[old]);
+  for (; old < s.contacts.size(); ++old)
+    report_end(s, s.contacts[old]);
   s.contacts = std::move(merged);
 }
 

@@ -59,7 +59,7 @@ struct Derived {
   Vec3 aabb_min;
   Vec3 aabb_max;
   bool infinite = false;  ///< a plane: bounded by nothing
-  Vec3 start_position;  ///< the pose at the start of the step (for the continuous pass)
+  Vec3 start_position;    ///< the pose at the start of the step (for the continuous pass)
   Quat start_orientation;
   // Solver scratch for the current step.
   Vec3 delta_position;  ///< since the start of the step
