@@ -6,6 +6,10 @@
 // whole sum as a two's-complement integer of 64 * Limbs bits and rounds once at the end, to nearest
 // with ties to even, saturating to the Fixed range. Three limbs hold any sum of up to 2^64 products
 // of two raws; four limbs hold sums of products of three raws (determinants, R I R^T).
+//
+// ExactSum is the portable definition. On targets with __int128, ProductSum is NativeProductSum
+// instead: the same exact value held as an __int128 plus a wrap count, which is several times
+// faster and gives bit-identical results (the slow limb path remains its fallback and reference).
 #pragma once
 
 #include <array>
@@ -156,8 +160,119 @@ class ExactSum {
   Words limb_{};
 };
 
+#if DETSIM_HAS_INT128
+/// An exact sum of Q64.64 terms for 64-bit targets: the same value, and so the same rounded result,
+/// as ExactSum<3>, in the form the hardware adds fastest (a widening multiply and an add with carry
+/// per term, small enough for dot and cross to inline). Every term a * b of two raws fits in a
+/// signed 128-bit integer (|a b| <= 2^126), so the sum is kept as `acc_ + wraps_ * 2^128`: an
+/// __int128 that wraps modulo 2^128 plus a count of its wraps. A wrap needs partial sums of 2^127
+/// or more, i.e. several terms near 2^126 (raws near +-2^63); with wraps_ == 0 the value is acc_
+/// and rounds with a few 64-bit operations. Any other state, and any shift above 63, goes to the
+/// out-of-line ExactSum<3> path. Determinism does not depend on which path runs: the result is
+/// defined as the exactly rounded value, both paths compute exactly that, and a differential test
+/// (tests/fixed_wide_test.cpp) compares them on boundary operands.
+class NativeProductSum {
+ public:
+  using int128 = wide::int128_t;
+
+  /// Adds m (or subtracts it when `negative`) for an unsigned 128-bit magnitude m.
+  constexpr void add(bool negative, wide::U128 m) noexcept {
+    // As a signed value the bits of m are m, or m - 2^128 when m >= 2^127: count that 2^128 too.
+    const auto term = static_cast<int128>((static_cast<wide::uint128_t>(m.hi) << 64) | m.lo);
+    if (negative) {
+      sub_term(term);
+      if (term < 0) --wraps_;
+    } else {
+      add_term(term);
+      if (term < 0) ++wraps_;
+    }
+  }
+
+  /// Adds a * b (raw times raw: a Q64.64 term).
+  constexpr void add_product(std::int64_t a, std::int64_t b) noexcept {
+    add_term(static_cast<int128>(a) * b);
+  }
+
+  /// Subtracts a * b.
+  constexpr void sub_product(std::int64_t a, std::int64_t b) noexcept {
+    sub_term(static_cast<int128>(a) * b);
+  }
+
+  /// Adds a * 2^shift, shift < 64.
+  constexpr void add_scaled(std::int64_t a, unsigned shift) noexcept {
+    add_term(static_cast<int128>(a) * static_cast<int128>(std::uint64_t{1} << shift));
+  }
+
+  [[nodiscard]] constexpr bool negative() const noexcept {
+    return wraps_ < 0 || (wraps_ == 0 && acc_ < 0);
+  }
+
+  [[nodiscard]] constexpr bool is_zero() const noexcept { return wraps_ == 0 && acc_ == 0; }
+
+  /// |sum| < 2^128. A wrapped sum has |sum| >= 2^127, so this asks ExactSum only then.
+  [[nodiscard]] constexpr bool fits_128() const noexcept {
+    return wraps_ == 0 || exact().fits_128();
+  }
+
+  /// |sum| when it fits in 128 bits (check with fits_128 first): |sum| modulo 2^128, which is acc_
+  /// or its negation as an unsigned value whatever the wrap count.
+  [[nodiscard]] constexpr wide::U128 magnitude_128() const noexcept {
+    const auto bits = static_cast<wide::uint128_t>(acc_);
+    const wide::uint128_t m = negative() ? 0U - bits : bits;
+    return {static_cast<std::uint64_t>(m >> 64), static_cast<std::uint64_t>(m)};
+  }
+
+  /// sum / 2^shift rounded to nearest, ties to even, saturated to the int64 range; 1 <= shift <=
+  /// 128, exactly as ExactSum<3>::round_to_raw.
+  [[nodiscard]] constexpr std::int64_t round_to_raw(unsigned shift) const noexcept {
+    if (wraps_ == 0 && shift < 64) [[likely]]
+      return round_shift_saturate(acc_, shift);
+    return round_exact(shift);
+  }
+
+  /// The sum of Q64.64 terms rounded to Fixed.
+  [[nodiscard]] constexpr Fixed to_fixed() const noexcept {
+    return Fixed::from_raw(round_to_raw(Fixed::fraction_bits));
+  }
+
+  /// The same sum as an ExactSum<3> (the reference the fast path must agree with).
+  [[nodiscard]] constexpr ExactSum<3> exact() const noexcept {
+    // Two's complement over 192 bits: acc_ sign-extended, plus wraps_ in the top limb.
+    const auto bits = static_cast<wide::uint128_t>(acc_);
+    const std::uint64_t sign = acc_ < 0 ? ~std::uint64_t{0} : 0U;
+    ExactSum<3> e;
+    e.add(false, std::array<std::uint64_t, 3>{static_cast<std::uint64_t>(bits),
+                                              static_cast<std::uint64_t>(bits >> 64),
+                                              sign + static_cast<std::uint64_t>(wraps_)});
+    return e;
+  }
+
+ private:
+  // __builtin_{add,sub}_overflow wrap the 128-bit sum and report it instead of overflowing (which
+  // would be undefined); the carry out of bit 127 goes into wraps_.
+  constexpr void add_term(int128 term) noexcept {
+    if (__builtin_add_overflow(acc_, term, &acc_)) [[unlikely]]
+      wraps_ += term < 0 ? -1 : 1;
+  }
+  constexpr void sub_term(int128 term) noexcept {
+    if (__builtin_sub_overflow(acc_, term, &acc_)) [[unlikely]]
+      wraps_ += term < 0 ? 1 : -1;
+  }
+
+  [[gnu::cold, gnu::noinline]] constexpr std::int64_t round_exact(unsigned shift) const noexcept {
+    return exact().round_to_raw(shift);
+  }
+
+  int128 acc_ = 0;
+  std::int64_t wraps_ = 0;
+};
+
+/// The sum of products used by dot and cross products: exact for any number of terms that matters.
+using ProductSum = NativeProductSum;
+#else
 /// The sum of products used by dot and cross products: exact for any number of terms that matters.
 using ProductSum = ExactSum<3>;
+#endif
 /// The sum of products of three raws (determinants, tensor rotation).
 using TripleProductSum = ExactSum<4>;
 

@@ -54,23 +54,33 @@ constexpr std::uint64_t round_shift_right(wide::U128 v, unsigned shift) noexcept
   return q.lo + (up ? 1U : 0U);
 }
 
+#if DETSIM_HAS_INT128
+/// v / 2^shift rounded to nearest, ties to even, saturated to the int64 range; 1 <= shift <= 63.
+/// The signed form for 64-bit targets, shared by Fixed * and the native product sum: 64-bit work on
+/// bits shift..shift+63 of v (the candidate result q, floor(v / 2^shift) if it fits) and the bits
+/// above (which must be q's sign extension, else the result saturates; rounding up by one cannot
+/// bring a floor of 2^63 or more back into range, nor push one below -2^63 out of it). Ties to
+/// even: add 1 iff the dropped bits plus q's lowest bit exceed 2^(shift-1) - 1.
+constexpr std::int64_t round_shift_saturate(wide::int128_t v, unsigned shift) noexcept {
+  const auto lo = static_cast<std::uint64_t>(v);
+  const auto hi = static_cast<std::uint64_t>(v >> 64);
+  const std::uint64_t q = (lo >> shift) | (hi << (64 - shift));
+  const auto top = static_cast<std::int64_t>(hi) >> shift;
+  if (top != (static_cast<std::int64_t>(q) >> 63)) return top < 0 ? raw_min : raw_max;
+  const std::uint64_t half = std::uint64_t{1} << (shift - 1);
+  const std::uint64_t rest = lo & ((half << 1) - 1);
+  const std::uint64_t up = (rest + (q & 1U) + (half - 1)) >> shift;  // < 2^64 for shift <= 63
+  const auto rounded = static_cast<std::int64_t>(q + up);
+  return rounded < static_cast<std::int64_t>(q) ? raw_max : rounded;  // q == max rounded up
+}
+#endif
+
 template <class Ops>
 constexpr std::int64_t fixed_mul(std::int64_t a, std::int64_t b) noexcept {
 #if DETSIM_HAS_INT128
   if constexpr (std::is_same_v<Ops, wide::Native>) {
-    // Signed form for 64-bit targets: one widening multiply, then 64-bit work on bits 32..95 (the
-    // candidate result q) and 96..127 (which must be q's sign extension, else the result does not
-    // fit). Ties to even: add 1 iff the dropped 32 bits plus q's lowest bit exceed 2^31 - 1.
-    __extension__ using int128 = __int128;
-    const int128 p = static_cast<int128>(a) * b;
-    const auto lo = static_cast<std::uint64_t>(p);
-    const auto hi = static_cast<std::uint64_t>(p >> 64);
-    const std::uint64_t q = (lo >> fraction_bits) | (hi << fraction_bits);
-    const auto top = static_cast<std::int64_t>(hi) >> fraction_bits;
-    if (top != (static_cast<std::int64_t>(q) >> 63)) return top < 0 ? raw_min : raw_max;
-    const std::uint64_t up = ((lo & 0xFFFFFFFFU) + (q & 1U) + 0x7FFFFFFFU) >> fraction_bits;
-    const auto rounded = static_cast<std::int64_t>(q + up);
-    return rounded < static_cast<std::int64_t>(q) ? raw_max : rounded;  // q == max rounded up
+    // One widening signed multiply (|a b| <= 2^126 always fits), then one rounding.
+    return round_shift_saturate(static_cast<wide::int128_t>(a) * b, fraction_bits);
   }
 #endif
   // Portable: sign-magnitude. Round the magnitude, then apply the sign; ties to even is symmetric,

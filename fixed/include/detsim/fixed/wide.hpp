@@ -116,6 +116,7 @@ struct Portable {
 
 #if DETSIM_HAS_INT128
 __extension__ using uint128_t = unsigned __int128;
+__extension__ using int128_t = __int128;
 
 /// The compiler's 128-bit integers (a single widening multiply on 64-bit targets).
 struct Native {
