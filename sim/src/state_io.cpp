@@ -328,16 +328,36 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
 
 }  // namespace sim_detail
 
-std::vector<std::uint8_t> World::save() const {
+namespace sim_detail {
+namespace {
+
+/// The canonical bytes of the whole state (what save() returns) and where each part starts.
+struct Encoded {
   ByteWriter w;
-  w.reserve(64 + s_->bodies.size() * 300 + s_->contacts.size() * 64);
-  w.u32(sim_detail::kMagic);
-  w.u32(sim_detail::kVersion);
-  sim_detail::write_globals(*s_, w);
-  sim_detail::write_rng(s_->rng, w);
-  sim_detail::write_bodies(*s_, w);
-  sim_detail::write_contacts(*s_, w);
-  return w.take();
+  std::size_t globals = 0, rng = 0, bodies = 0, contacts = 0;
+};
+
+void encode(const WorldState& s, Encoded& e) {
+  e.w.reserve(64 + s.bodies.size() * 300 + s.contacts.size() * 64);
+  e.w.u32(kMagic);
+  e.w.u32(kVersion);
+  e.globals = e.w.size();
+  write_globals(s, e.w);
+  e.rng = e.w.size();
+  write_rng(s.rng, e.w);
+  e.bodies = e.w.size();
+  write_bodies(s, e.w);
+  e.contacts = e.w.size();
+  write_contacts(s, e.w);
+}
+
+}  // namespace
+}  // namespace sim_detail
+
+std::vector<std::uint8_t> World::save() const {
+  sim_detail::Encoded e;
+  sim_detail::encode(*s_, e);
+  return e.w.take();
 }
 
 Status World::restore(std::span<const std::uint8_t> bytes) {
@@ -349,20 +369,19 @@ Status World::restore(std::span<const std::uint8_t> bytes) {
 }
 
 StateHashes World::hashes() const {
+  // One encoding: the total is the hash of save()'s bytes, each part the hash of its slice.
+  sim_detail::Encoded e;
+  sim_detail::encode(*s_, e);
+  const std::uint8_t* bytes = e.w.bytes().data();
+  const auto slice = [&](std::size_t from, std::size_t to) {
+    return XXH3_64bits(bytes + from, to - from);
+  };
   StateHashes h;
-  ByteWriter w;
-  sim_detail::write_globals(*s_, w);
-  h.globals = sim_detail::xxh3(w.bytes());
-  w.clear();
-  sim_detail::write_rng(s_->rng, w);
-  h.rng = sim_detail::xxh3(w.bytes());
-  w.clear();
-  sim_detail::write_bodies(*s_, w);
-  h.bodies = sim_detail::xxh3(w.bytes());
-  w.clear();
-  sim_detail::write_contacts(*s_, w);
-  h.contacts = sim_detail::xxh3(w.bytes());
-  h.total = sim_detail::xxh3(save());
+  h.globals = slice(e.globals, e.rng);
+  h.rng = slice(e.rng, e.bodies);
+  h.bodies = slice(e.bodies, e.contacts);
+  h.contacts = slice(e.contacts, e.w.size());
+  h.total = slice(0, e.w.size());
   return h;
 }
 
