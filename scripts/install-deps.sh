@@ -8,7 +8,7 @@ packages=(
   libgtest-dev                                                 # tests
   libxxhash-dev libcli11-dev                                   # state hashing, the CLI
   libmpfr-dev libgmp-dev                                       # reference for the accuracy tests
-  libbenchmark-dev libfixmath-dev                              # benchmarks and their peer
+  libbenchmark-dev libfixmath-dev libbullet-dev               # benchmarks and their peers
   python3                                                      # docs/ table generation
 )
 
