@@ -16,7 +16,7 @@ namespace sim_detail {
 namespace {
 
 constexpr std::uint32_t kMagic = 0x4D495344;  // "DSIM" read as little-endian bytes
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = state_encoding_version;
 
 // Smallest encodings, to bound counts by the bytes that remain before allocating.
 constexpr std::size_t kMinBodyBytes = 4 + 1 + 1 + 8 * 2 + 8 * 3;

@@ -117,6 +117,10 @@ class ByteReader {
   [[nodiscard]] bool at_end() const noexcept { return offset_ == data_.size(); }
   /// "byte 132: body orientation: expected a unit quaternion" or "" while ok().
   [[nodiscard]] std::string error() const;
+  /// Where the first failure is, and what it is without the offset ("body orientation: expected a
+  /// unit quaternion"), for callers that report offsets within a larger file.
+  [[nodiscard]] std::size_t error_offset() const noexcept { return error_offset_; }
+  [[nodiscard]] std::string error_detail() const;
 
  private:
   std::uint64_t get(std::size_t n, const char* what) noexcept {
