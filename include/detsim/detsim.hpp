@@ -2,4 +2,5 @@
 #pragma once
 
 #include <detsim/fixed.hpp>
+#include <detsim/replay.hpp>
 #include <detsim/sim.hpp>

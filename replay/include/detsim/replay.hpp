@@ -1,0 +1,5 @@
+// The replay layer: replay files, and recording, verifying and seeking scenario replays.
+#pragma once
+
+#include <detsim/replay/replay.hpp>
+#include <detsim/replay/scenario_replay.hpp>

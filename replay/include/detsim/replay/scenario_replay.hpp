@@ -1,0 +1,67 @@
+// Recording, verifying and seeking replays of the registered scenarios (<detsim/sim/scenario.hpp>):
+// what `detsim run --record`, `detsim verify` and the golden replays use.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include <detsim/replay/replay.hpp>
+#include <detsim/sim/scenario.hpp>
+#include <detsim/sim/status.hpp>
+
+namespace detsim::replay {
+
+/// Called after each frame with (frames done, frames in all); return false to stop early.
+using Progress = std::function<bool(std::uint64_t done, std::uint64_t total)>;
+
+/// The inputs of every player at a frame (player order). Default: scripted_input with the
+/// scenario's seed.
+using InputSource = std::function<void(std::uint64_t frame, std::span<PlayerInput> out)>;
+
+struct RecordOptions {
+  std::uint32_t frames = 0;  ///< 0: the scenario's default
+  std::uint32_t keyframe_interval = default_keyframe_interval;
+  InputSource inputs;  ///< empty: scripted_input(seed, frame, player)
+  Progress progress;   ///< optional
+};
+
+struct RecordResult {
+  std::uint64_t frames = 0;
+  std::uint64_t final_hash = 0;
+  std::uint64_t chain_hash = 0;
+};
+
+/// Runs `scenario` from its current state (which must be frame 0) for options.frames frames and
+/// records the replay to `path` (unless `path` is empty: then it only runs).
+Expected<RecordResult> record(Scenario& scenario, const std::string& path,
+                              const RecordOptions& options = {});
+
+/// What verification found.
+struct VerifyResult {
+  bool ok = false;
+  std::uint64_t frames = 0;                     ///< frames re-simulated and compared
+  std::optional<std::uint64_t> first_mismatch;  ///< the first frame whose hash differs
+  StateHashes expected;                         ///< at first_mismatch (from the file)
+  StateHashes actual;                           ///< at first_mismatch (re-simulated)
+  std::uint64_t final_hash = 0;                 ///< re-simulated hash of the last frame compared
+  std::string note;  ///< e.g. the file ended early, or a keyframe disagreed; empty otherwise
+};
+
+/// Re-creates the recorded scenario and re-simulates every frame with the recorded inputs,
+/// comparing each frame's hashes; also checks every keyframe's state against its frame's hash and
+/// the end marker's chain hash. Errors (not mismatches): a fingerprint this build cannot reproduce
+/// (unknown scenario, other Fixed format or input size), which the message names.
+Expected<VerifyResult> verify(const ReplayReader& reader, const Progress& progress = {});
+
+/// The recorded scenario at frame `frame` (0 .. frame_count()): restores the nearest keyframe at
+/// or before it and re-simulates the rest with the recorded inputs (at most one keyframe interval).
+/// `resimulated`, when given, receives the number of frames stepped.
+Expected<Scenario> seek(const ReplayReader& reader, std::uint64_t frame,
+                        std::uint64_t* resimulated = nullptr);
+
+/// The scenario a replay was recorded from, at frame 0 (checks the fingerprint, as verify does).
+Expected<Scenario> scenario_of(const ReplayReader& reader);
+
+}  // namespace detsim::replay

@@ -1,0 +1,43 @@
+// Internals of the replay format shared by its reader, writer and the scenario layer.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include <detsim/replay/replay.hpp>
+#include <detsim/sim/bytes.hpp>
+
+namespace detsim::replay::detail {
+
+inline constexpr char kFileMagic[9] = "DSREPLAY";
+inline constexpr std::size_t kFileHeaderSize = 16;
+
+/// A chunk type: four ASCII bytes, read as a little-endian u32.
+constexpr std::uint32_t chunk_type(const char (&name)[5]) noexcept {
+  return static_cast<std::uint32_t>(static_cast<unsigned char>(name[0])) |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(name[1])) << 8 |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(name[2])) << 16 |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(name[3])) << 24;
+}
+
+inline constexpr std::uint32_t kChunkHead = chunk_type("HEAD");
+inline constexpr std::uint32_t kChunkFrames = chunk_type("FRAM");
+inline constexpr std::uint32_t kChunkKeyframe = chunk_type("KEYF");
+inline constexpr std::uint32_t kChunkEnd = chunk_type("END ");
+
+inline constexpr std::uint32_t max_players = 64;
+inline constexpr std::uint32_t max_input_size = 1024;
+
+/// 16 lowercase hex digits.
+std::string hex64(std::uint64_t v);
+/// A chunk type as text ('?' for bytes that are not printable).
+std::string chunk_name(std::uint32_t type);
+
+void write_fingerprint(const Fingerprint& f, ByteWriter& w);
+/// Reads and validates a fingerprint payload; false with the reader's error set.
+bool read_fingerprint(ByteReader& r, Fingerprint& f);
+void encode_hashes(const StateHashes& h, ByteWriter& w);
+StateHashes decode_hashes(ByteReader& r);
+
+}  // namespace detsim::replay::detail

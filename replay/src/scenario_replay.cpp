@@ -1,0 +1,249 @@
+// Recording, verifying and seeking replays of the registered scenarios.
+#include <xxhash.h>
+
+#include <algorithm>
+#include <array>
+#include <optional>
+#include <utility>
+
+#include <detsim/fixed/decimal.hpp>
+#include <detsim/replay/scenario_replay.hpp>
+#include <detsim/version.hpp>
+
+#include "replay_detail.hpp"
+
+namespace detsim::replay {
+
+using detail::hex64;
+
+namespace {
+
+void encode_inputs(std::span<const PlayerInput> inputs, std::vector<std::uint8_t>& out) {
+  out.resize(inputs.size() * PlayerInput::encoded_size);
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    encode_input(inputs[i],
+                 std::span<std::uint8_t, PlayerInput::encoded_size>(
+                     out.data() + i * PlayerInput::encoded_size, PlayerInput::encoded_size));
+  }
+}
+
+void decode_inputs(std::span<const std::uint8_t> bytes, std::vector<PlayerInput>& out) {
+  out.resize(bytes.size() / PlayerInput::encoded_size);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = decode_input(std::span<const std::uint8_t, PlayerInput::encoded_size>(
+        bytes.data() + i * PlayerInput::encoded_size, PlayerInput::encoded_size));
+  }
+}
+
+std::string fixed_text(Fixed v) {
+  return to_string(v) + " (raw " + std::to_string(v.raw()) + ")";
+}
+
+}  // namespace
+
+Fingerprint fingerprint_of(const Scenario& scenario, std::uint32_t keyframe_interval) {
+  Fingerprint f;
+  f.detsim_version = std::string(detsim::version);
+  f.fixed_fraction_bits = Fixed::fraction_bits;
+  f.state_version = state_encoding_version;
+  f.scenario = std::string(scenario.info().name);
+  f.params = scenario.params();
+  const WorldDef& def = scenario.world().def();
+  f.dt = def.dt;
+  f.substeps = def.substeps;
+  f.iterations = def.iterations;
+  f.players = scenario.params().players;
+  f.input_size = PlayerInput::encoded_size;
+  f.keyframe_interval = keyframe_interval;
+  f.initial_hash = scenario.world().hashes().total;
+  return f;
+}
+
+Expected<Scenario> scenario_of(const ReplayReader& reader) {
+  const Fingerprint& f = reader.fingerprint();
+  const std::string where = reader.path() + ": fingerprint: ";
+  if (f.fixed_fraction_bits != Fixed::fraction_bits)
+    return Status::error(where + "recorded with Q" + std::to_string(64 - f.fixed_fraction_bits) +
+                         "." + std::to_string(f.fixed_fraction_bits) +
+                         " numbers, this build computes in Q32.32");
+  if (find_scenario(f.scenario) == nullptr)
+    return Status::error(where + "scenario \"" + f.scenario +
+                         "\" is not one of this build's scenarios (detsim scenarios lists them)");
+  if (f.input_size != PlayerInput::encoded_size)
+    return Status::error(where + "inputs of " + std::to_string(f.input_size) +
+                         " bytes, this build's scenarios take " +
+                         std::to_string(PlayerInput::encoded_size));
+  if (f.players != f.params.players)
+    return Status::error(where + std::to_string(f.players) + " inputs per frame for " +
+                         std::to_string(f.params.players) + " players");
+  auto scenario = Scenario::create(f.scenario, f.params);
+  if (!scenario) return Status::error(where + scenario.message());
+  if (scenario->params() != f.params)
+    return Status::error(where + "the parameters are not the ones this build's scenario fills in");
+  const WorldDef& def = scenario->world().def();
+  if (def.dt != f.dt)
+    return Status::error(where + "dt " + fixed_text(f.dt) + ", this build's " + f.scenario +
+                         " steps " + fixed_text(def.dt));
+  if (def.substeps != f.substeps || def.iterations != f.iterations)
+    return Status::error(where + std::to_string(f.substeps) + " substeps x " +
+                         std::to_string(f.iterations) + " iterations, this build's " + f.scenario +
+                         " uses " + std::to_string(def.substeps) + " x " +
+                         std::to_string(def.iterations));
+  return scenario;
+}
+
+Expected<RecordResult> record(Scenario& scenario, const std::string& path,
+                              const RecordOptions& options) {
+  if (scenario.world().frame() != 0)
+    return Status::error("record: the scenario is at frame " +
+                         std::to_string(scenario.world().frame()) + ", expected frame 0");
+  if (options.keyframe_interval == 0)
+    return Status::error("record: the keyframe interval must be at least 1");
+  const std::uint64_t frames =
+      options.frames != 0 ? options.frames : scenario.info().default_frames;
+  std::optional<ReplayWriter> writer;
+  if (!path.empty()) {
+    auto created = ReplayWriter::create(path, fingerprint_of(scenario, options.keyframe_interval));
+    if (!created) return created.status();
+    writer.emplace(std::move(created.value()));
+  }
+  const std::uint32_t players = scenario.params().players;
+  const std::uint64_t seed = scenario.params().seed;
+  std::vector<PlayerInput> inputs(players);
+  std::vector<std::uint8_t> bytes;
+  HashChain chain;
+  RecordResult result;
+  for (std::uint64_t f = 1; f <= frames; ++f) {
+    if (options.inputs) {
+      options.inputs(f, inputs);
+    } else {
+      for (std::uint32_t p = 0; p < players; ++p)
+        inputs[p] = scripted_input(seed, f, p);
+    }
+    scenario.step(inputs);
+    const StateHashes hashes = scenario.world().hashes();
+    chain.add(hashes.total);
+    result.final_hash = hashes.total;
+    result.frames = f;
+    if (writer) {
+      encode_inputs(inputs, bytes);
+      if (Status s = writer->frame(bytes, hashes); !s) return s;
+      if (f % options.keyframe_interval == 0) {
+        if (Status s = writer->keyframe(f, scenario.world().save()); !s) return s;
+      }
+    }
+    if (options.progress && !options.progress(f, frames)) break;
+  }
+  if (writer) {
+    if (Status s = writer->finish(); !s) return s;
+  }
+  result.chain_hash = chain.value();
+  return result;
+}
+
+Expected<VerifyResult> verify(const ReplayReader& reader, const Progress& progress) {
+  auto created = scenario_of(reader);
+  if (!created) return created.status();
+  Scenario& scenario = created.value();
+  const Fingerprint& fp = reader.fingerprint();
+  VerifyResult result;
+  const std::uint64_t initial = scenario.world().hashes().total;
+  result.final_hash = initial;
+  if (initial != fp.initial_hash) {
+    result.first_mismatch = 0;
+    result.expected.total = fp.initial_hash;
+    result.actual = scenario.world().hashes();
+    result.note = "the scenario's initial state differs from the recorded one";
+    return result;
+  }
+  const std::vector<KeyframeInfo>& keyframes = reader.keyframes();
+  std::size_t next_keyframe = 0;
+  std::vector<PlayerInput> inputs;
+  HashChain chain;
+  Status keyframe_error;
+  const std::uint64_t total = reader.frame_count();
+  const Status read = reader.for_each_frame(1, total, [&](const FrameRecord& record) {
+    decode_inputs(record.inputs, inputs);
+    scenario.step(inputs);
+    const StateHashes hashes = scenario.world().hashes();
+    chain.add(hashes.total);
+    result.frames = record.frame;
+    result.final_hash = hashes.total;
+    if (hashes != record.hashes) {
+      result.first_mismatch = record.frame;
+      result.expected = record.hashes;
+      result.actual = hashes;
+      return false;
+    }
+    if (next_keyframe < keyframes.size() && keyframes[next_keyframe].frame == record.frame) {
+      auto state = reader.keyframe_state(keyframes[next_keyframe]);
+      if (!state) {
+        keyframe_error = state.status();
+        return false;
+      }
+      if (XXH3_64bits(state.value().data(), state.value().size()) != record.hashes.total) {
+        keyframe_error = Status::error(reader.path() + ": the keyframe of frame " +
+                                       std::to_string(record.frame) +
+                                       " does not hash to its frame's recorded hash");
+        return false;
+      }
+      ++next_keyframe;
+    }
+    return !progress || progress(record.frame, total);
+  });
+  if (!read) return read;
+  if (!keyframe_error) return keyframe_error;
+  if (result.first_mismatch) return result;
+  if (result.frames != total) {
+    result.note =
+        "stopped at frame " + std::to_string(result.frames) + " of " + std::to_string(total);
+    return result;
+  }
+  if (reader.complete()) {
+    if (chain.value() != *reader.chain_hash()) {
+      result.note = "the end marker's chain hash " + hex64(*reader.chain_hash()) +
+                    " disagrees with the frames' " + hex64(chain.value());
+      return result;
+    }
+  } else {
+    result.note = "the replay has no end marker (the recording stopped early): verified the " +
+                  std::to_string(total) + " frames it holds";
+  }
+  result.ok = true;
+  return result;
+}
+
+Expected<Scenario> seek(const ReplayReader& reader, std::uint64_t frame,
+                        std::uint64_t* resimulated) {
+  if (frame > reader.frame_count())
+    return Status::error(reader.path() + ": cannot seek to frame " + std::to_string(frame) +
+                         ": the replay holds frames 0 to " + std::to_string(reader.frame_count()));
+  auto created = scenario_of(reader);
+  if (!created) return created.status();
+  Scenario& scenario = created.value();
+  const std::vector<KeyframeInfo>& keyframes = reader.keyframes();
+  // The last keyframe at or before `frame`.
+  auto it = std::upper_bound(keyframes.begin(), keyframes.end(), frame,
+                             [](std::uint64_t f, const KeyframeInfo& k) { return f < k.frame; });
+  std::uint64_t from = 0;
+  if (it != keyframes.begin()) {
+    const KeyframeInfo& k = *std::prev(it);
+    auto state = reader.keyframe_state(k);
+    if (!state) return state.status();
+    if (Status s = scenario.world().restore(state.value()); !s)
+      return Status::error(reader.path() + ": the keyframe of frame " + std::to_string(k.frame) +
+                           " does not restore: " + s.message());
+    from = k.frame;
+  }
+  std::vector<PlayerInput> inputs;
+  const Status read = reader.for_each_frame(from + 1, frame, [&](const FrameRecord& record) {
+    decode_inputs(record.inputs, inputs);
+    scenario.step(inputs);
+    return true;
+  });
+  if (!read) return read;
+  if (resimulated != nullptr) *resimulated = frame - from;
+  return created;
+}
+
+}  // namespace detsim::replay
