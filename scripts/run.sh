@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# Builds detsim and runs the main job: the `detsim` command. With no arguments it prints the
-# accuracy table of the fixed-point layer (every function measured against MPFR); any arguments are
-# passed to `detsim` instead (try `scripts/run.sh --help`).
+# Builds detsim and runs the main job: the `detsim` command. With no arguments it runs `detsim demo`:
+# the arena scenario with four scripted players, headless, recorded to a replay, the replay
+# verified, and a summary (frames, final hash, verify result, time taken). Any arguments are passed
+# to `detsim` instead (try `scripts/run.sh --help`, or `scripts/run.sh accuracy` for the accuracy
+# table of the fixed-point layer).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DDETSIM_BUILD_TESTS=OFF >/dev/null
 cmake --build build/release --target detsim -j "$(nproc)"
-if [ $# -eq 0 ]; then set -- accuracy; fi
+if [ $# -eq 0 ]; then set -- demo; fi
 exec build/release/tools/detsim "$@"

@@ -1,4 +1,6 @@
-// The detsim command. Exit status: 0 success, 1 a check failed, 2 bad usage.
+// The detsim command: the command line (CLI11, only in this file) and the help texts; each
+// subcommand's work is in its cmd_*.cpp. Exit status: 0 success, 1 a check failed, 2 bad usage or
+// bad input.
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
@@ -7,6 +9,10 @@
 
 #include <CLI/CLI.hpp>
 #include <detsim/detsim.hpp>
+
+#include "commands.hpp"
+#include "output.hpp"
+#include "scenario_args.hpp"
 
 #if DETSIM_WITH_ACCURACY
 #include <detsim_accuracy/accuracy.hpp>
@@ -22,8 +28,8 @@
 
 namespace {
 
-constexpr const char* version_text = "detsim 0.1.0";
-constexpr int exit_usage = 2;
+const std::string version_text = "detsim " + std::string(detsim::version);
+constexpr int exit_usage = detsim::cli::exit_usage;
 
 // ---- detsim accuracy ---------------------------------------------------------------------------
 
@@ -172,16 +178,149 @@ void add_accuracy(CLI::App& app, AccuracyArgs& args, int& exit_code) {
 #endif
 }
 
+// ---- Scenario, replay and golden commands -------------------------------------------------------
+
+constexpr const char* exit_footer =
+    "\nExit status: 0 success; 1 a check failed (hash mismatch, desync); 2 bad usage or bad input\n"
+    "(the message on stderr names what is wrong). --json prints exactly one JSON object on stdout.";
+
+void add_scenario_options(CLI::App* cmd, detsim::cli::ScenarioArgs& a) {
+  cmd->add_option("--scenario", a.scenario, "Scenario name (detsim scenarios lists them)")
+      ->required()
+      ->type_name("NAME");
+  cmd->add_option("--frames", a.frames, "Frames to simulate (default: the scenario's own)")
+      ->type_name("N")
+      ->check(CLI::Range(std::uint64_t{1}, detsim::cli::max_frames));
+  cmd->add_option("--seed", a.seed,
+                  "Seed of the world's RNG and of the scripted players (default 1)")
+      ->type_name("S");
+  cmd->add_option("--players", a.players,
+                  "Players, for scenarios that have them (default: the scenario's own)")
+      ->type_name("P");
+  cmd->add_option("--count", a.count, "Bodies, for the pile scenarios (default 1000)")
+      ->type_name("N");
+}
+
+void add_scenario_commands(CLI::App& app, int& exit_code) {
+  namespace cli = detsim::cli;
+  static cli::ScenariosArgs scenarios;
+  static cli::RunArgs run;
+  static cli::VerifyArgs verify;
+  static cli::InfoArgs info;
+  static cli::SynctestArgs synctest;
+  static cli::GoldenArgs golden_check;
+  static cli::GoldenArgs golden_update;
+  static cli::DemoArgs demo;
+
+  auto* c = app.add_subcommand("scenarios", "List the scenarios and their parameters");
+  c->add_flag("--json", scenarios.json, "Print one JSON object");
+  c->footer(exit_footer);
+  c->callback([&exit_code] { exit_code = cli::scenarios_command(scenarios); });
+
+  c = app.add_subcommand("run", "Run a scenario headless; print its frame count and final hash");
+  add_scenario_options(c, run.scene);
+  c->add_option("--record", run.record, "Record the run to a replay file (replay/FORMAT.md)")
+      ->type_name("FILE");
+  c->add_option("--keyframe-interval", run.keyframe_interval,
+                "Frames between the replay's keyframes, for seeking (default 300)")
+      ->type_name("K")
+      ->check(CLI::Range(1U, 1'000'000U));
+  c->add_flag("--json", run.json,
+              "Print one JSON object: scenario, frames, final_hash (16 hex digits), ...");
+  c->footer(std::string(R"(
+Players are driven by a deterministic script (a function of the seed, the frame and the player), so
+the same arguments give the same final hash on every machine.)") +
+            exit_footer);
+  c->callback([&exit_code] { exit_code = cli::run_command(run); });
+
+  c = app.add_subcommand(
+      "verify", "Re-simulate a replay and compare every frame's hash with the recorded one");
+  c->add_option("FILE", verify.file, "Replay file")->required();
+  c->add_flag("--json", verify.json,
+              "Print one JSON object: ok, frames, first_mismatch (null or a frame), ...");
+  c->footer(std::string(R"(
+Prints the first frame whose hash differs, both hashes, which parts of the state differ (globals,
+rng, bodies, contacts) and the last frame both agreed on; also the speed in frames/s. A replay
+without its end marker (a recording that stopped early) verifies up to its last complete chunk.)") +
+            exit_footer);
+  c->callback([&exit_code] { exit_code = cli::verify_command(verify); });
+
+  c = app.add_subcommand("info", "Describe a replay: fingerprint, frames, keyframes");
+  c->add_option("FILE", info.file, "Replay file")->required();
+  c->add_flag("--json", info.json, "Print one JSON object");
+  c->footer(exit_footer);
+  c->callback([&exit_code] { exit_code = cli::info_command(info); });
+
+  c = app.add_subcommand("synctest",
+                         "Every frame, roll back K frames, re-simulate and compare the hashes");
+  add_scenario_options(c, synctest.scene);
+  c->add_option("--check-distance", synctest.check_distance,
+                "Frames to roll back every frame (default 8, at most 600)")
+      ->type_name("K");
+  c->add_flag("--json", synctest.json,
+              "Print one JSON object: ok, frames, first_mismatch (null or a frame), ...");
+  c->footer(std::string(R"(
+GGPO's sync test: state that save() misses, or a dependence on history, shows up as a hash that a
+re-simulation does not reproduce. It names the first such frame.)") +
+            exit_footer);
+  c->callback([&exit_code] { exit_code = cli::synctest_command(synctest); });
+
+  auto* golden = app.add_subcommand("golden", "Check or rewrite the golden hashes and replays");
+  golden->require_subcommand(1);
+  golden->footer(R"(
+golden/scenarios.txt holds, for every scenario, the state hash at frames 1, 10, 100, 1000 and the
+last frame, and the hash of the chain of all frame hashes; golden/replays/ holds replays that must
+verify. Every architecture must reproduce them (golden/README.md).)");
+  c = golden->add_subcommand("check", "Recompute every golden run and verify the golden replays");
+  c->add_option("--dir", golden_check.dir, "Golden directory (default: the source tree's golden/)")
+      ->type_name("DIR");
+  c->add_flag("--json", golden_check.json, "Print one JSON object: ok, runs, replays, mismatches");
+  c->footer(
+      std::string("\nA mismatch prints the run, the frame, and the expected and actual hash.") +
+      exit_footer);
+  c->callback([&exit_code] { exit_code = cli::golden_command(golden_check); });
+  c = golden->add_subcommand("update",
+                             "Rewrite the golden hashes and replays (on purpose only: say why in "
+                             "the commit)");
+  c->add_option("--dir", golden_update.dir, "Golden directory (default: the source tree's golden/)")
+      ->type_name("DIR");
+  c->add_flag("--json", golden_update.json, "Print one JSON object");
+  c->footer(exit_footer);
+  c->callback([&exit_code] {
+    golden_update.update = true;
+    exit_code = cli::golden_command(golden_update);
+  });
+
+  c = app.add_subcommand("demo",
+                         "The main job: run a scenario, record its replay, verify it, summarise");
+  demo.scene.scenario = "arena";
+  demo.scene.players = 4;
+  c->add_option("--scenario", demo.scene.scenario, "Scenario name (default arena)")
+      ->type_name("NAME");
+  c->add_option("--frames", demo.scene.frames, "Frames (default: the scenario's own)")
+      ->type_name("N")
+      ->check(CLI::Range(std::uint64_t{1}, detsim::cli::max_frames));
+  c->add_option("--seed", demo.scene.seed, "Seed (default 1)")->type_name("S");
+  c->add_option("--players", demo.scene.players, "Players (default 4 for arena)")->type_name("P");
+  c->add_option("--count", demo.scene.count, "Bodies, for the piles")->type_name("N");
+  c->add_option("--record", demo.record, "Replay file (default: a temporary file)")
+      ->type_name("FILE");
+  c->add_flag("--json", demo.json, "Print one JSON object");
+  c->footer(exit_footer);
+  c->callback([&exit_code] { exit_code = cli::demo_command(demo); });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"detsim: deterministic fixed-point simulation core"};
-  app.set_version_flag("--version", std::string(version_text));
+  app.set_version_flag("--version", version_text);
   app.require_subcommand(0, 1);
   int exit_code = 0;
 
   auto* version = app.add_subcommand("version", "Print the detsim version");
-  version->callback([] { std::puts(version_text); });
+  version->callback([] { std::puts(version_text.c_str()); });
+  add_scenario_commands(app, exit_code);
   AccuracyArgs accuracy;
   add_accuracy(app, accuracy, exit_code);
 

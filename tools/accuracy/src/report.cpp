@@ -1,4 +1,5 @@
 #include <detsim_accuracy/report.hpp>
+#include <detsim_tools/json_text.hpp>
 
 #include <algorithm>
 #include <cinttypes>
@@ -78,32 +79,7 @@ std::string summary(std::span<const Report> reports) {
 // ---- JSON --------------------------------------------------------------------------------------
 
 std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    switch (ch) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(ch) < 0x20) {
-          char buffer[8];
-          std::snprintf(buffer, sizeof buffer, "\\u%04x", static_cast<unsigned>(ch));
-          out += buffer;
-        } else {
-          out += ch;
-        }
-    }
-  }
-  return out + "\"";
+  return tools::json_quote(s);
 }
 
 std::string json_number(double v) {

@@ -1,0 +1,252 @@
+// The detsim command as a user meets it: exit codes (0 ok, 1 a check failed, 2 bad usage or
+// input), exactly one JSON object with --json, errors on stderr naming what is wrong, no progress
+// output when stderr is not a terminal, and the golden check against the checked-in golden/.
+#include <sys/wait.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <detsim/replay.hpp>
+
+#include "support/replay_files.hpp"
+
+namespace detsim {
+namespace {
+
+using test::read_bytes;
+using test::TempFile;
+using test::write_bytes;
+
+struct Result {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string read_text(const std::string& path) {
+  const auto bytes = read_bytes(path);
+  return {bytes.begin(), bytes.end()};
+}
+
+/// Runs `detsim <args>` with stdin from /dev/null, capturing stdout and stderr.
+Result detsim_cli(const std::string& args) {
+  TempFile out("out.txt");
+  TempFile err("err.txt");
+  const std::string command = std::string(DETSIM_BINARY_DIR) + "/tools/detsim " + args +
+                              " </dev/null >" + out.path() + " 2>" + err.path();
+  const int status = std::system(command.c_str());
+  Result r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = read_text(out.path());
+  r.err = read_text(err.path());
+  return r;
+}
+
+bool has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// One JSON object on one line, and nothing else.
+void expect_one_json_object(const std::string& out) {
+  ASSERT_FALSE(out.empty());
+  EXPECT_EQ(out.front(), '{') << out;
+  EXPECT_EQ(out.substr(out.size() - 2), "}\n") << out;
+  EXPECT_EQ(out.find('\n'), out.size() - 1) << out;
+}
+
+/// The value of "key": in a flat JSON object (a string without quotes, or a literal).
+std::string json_value(const std::string& json, const std::string& key) {
+  const std::string k = "\"" + key + "\":";
+  const auto at = json.find(k);
+  if (at == std::string::npos) return "<missing>";
+  std::size_t from = at + k.size();
+  if (json[from] == '"') {
+    const auto end = json.find('"', from + 1);
+    return json.substr(from + 1, end - from - 1);
+  }
+  const auto end = json.find_first_of(",}", from);
+  return json.substr(from, end - from);
+}
+
+std::string hex16(std::uint64_t v) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(v));
+  return text;
+}
+
+/// The final hash of `scenario` after `frames` frames with scripted players, from the library.
+std::uint64_t library_final_hash(const std::string& name, const ScenarioParams& params,
+                                 std::uint32_t frames) {
+  auto s = Scenario::create(name, params);
+  EXPECT_TRUE(s) << s.message();
+  replay::RecordOptions options;
+  options.frames = frames;
+  auto r = replay::record(s.value(), "", options);
+  EXPECT_TRUE(r) << r.message();
+  return r->final_hash;
+}
+
+TEST(Cli, HelpListsEverySubcommandAndEachHasItsOwnHelp) {
+  const Result top = detsim_cli("--help");
+  EXPECT_EQ(top.exit_code, 0);
+  for (const char* sub : {"scenarios", "run", "verify", "info", "synctest", "golden", "demo"}) {
+    EXPECT_TRUE(has(top.out, std::string("  ") + sub)) << sub;
+    const Result help = detsim_cli(std::string(sub) + " --help");
+    EXPECT_EQ(help.exit_code, 0) << sub;
+    EXPECT_TRUE(has(help.out, "Usage:")) << sub;
+  }
+  for (const char* sub : {"run", "verify", "synctest", "golden check"}) {
+    EXPECT_TRUE(has(detsim_cli(std::string(sub) + " --help").out, "Exit status: 0")) << sub;
+  }
+  EXPECT_EQ(detsim_cli("--version").out, "detsim " + std::string(version) + "\n");
+  EXPECT_EQ(version, DETSIM_PROJECT_VERSION);  // <detsim/version.hpp> follows CMakeLists.txt
+}
+
+TEST(Cli, RunPrintsTheFrameCountAndTheLibrarysFinalHash) {
+  const std::string expected = hex16(library_final_hash("arena", {.seed = 5, .players = 3}, 40));
+  const Result json = detsim_cli("run --scenario arena --seed 5 --players 3 --frames 40 --json");
+  EXPECT_EQ(json.exit_code, 0) << json.err;
+  expect_one_json_object(json.out);
+  EXPECT_EQ(json_value(json.out, "scenario"), "arena");
+  EXPECT_EQ(json_value(json.out, "frames"), "40");
+  EXPECT_EQ(json_value(json.out, "final_hash"), expected);
+  EXPECT_EQ(json.err, "");  // no progress bar when stderr is not a terminal
+  const Result text = detsim_cli("run --scenario arena --seed 5 --players 3 --frames 40");
+  EXPECT_EQ(text.exit_code, 0);
+  EXPECT_TRUE(has(text.out, "40 frames, final hash " + expected)) << text.out;
+}
+
+TEST(Cli, RecordVerifyInfoAndATamperedReplay) {
+  TempFile file("cli.dsr");
+  const Result run =
+      detsim_cli("run --scenario spray --frames 90 --keyframe-interval 30 --record " + file.path() +
+                 " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const Result verify = detsim_cli("verify " + file.path() + " --json");
+  EXPECT_EQ(verify.exit_code, 0) << verify.err;
+  expect_one_json_object(verify.out);
+  EXPECT_EQ(json_value(verify.out, "ok"), "true");
+  EXPECT_EQ(json_value(verify.out, "frames"), "90");
+  EXPECT_EQ(json_value(verify.out, "first_mismatch"), "null");
+  EXPECT_EQ(json_value(verify.out, "final_hash"), json_value(run.out, "final_hash"));
+  const Result info = detsim_cli("info " + file.path() + " --json");
+  EXPECT_EQ(info.exit_code, 0);
+  expect_one_json_object(info.out);
+  EXPECT_EQ(json_value(info.out, "frames"), "90");
+  EXPECT_TRUE(has(info.out, "\"keyframes\":[{\"frame\":30,")) << info.out;
+  EXPECT_TRUE(has(detsim_cli("info " + file.path()).out, "keyframes         3 every 30 frames"));
+
+  // The hash of frame 47 changed: verification fails there, exit code 1.
+  auto b = read_bytes(file.path());
+  for (const auto& c : test::chunks_of(b)) {
+    if (c.type != "FRAM" || test::get_u64(b, c.payload()) > 47) continue;
+    const std::uint64_t first = test::get_u64(b, c.payload());
+    if (first + test::get_u32(b, c.payload() + 8) <= 47) continue;
+    const std::size_t at = c.payload() + 12 + (47 - first) * 40;  // spray has no players
+    b[at] = static_cast<std::uint8_t>(b[at] ^ 1U);
+    test::reseal(b, c);
+  }
+  write_bytes(file.path(), b);
+  const Result bad = detsim_cli("verify " + file.path() + " --json");
+  EXPECT_EQ(bad.exit_code, 1);
+  expect_one_json_object(bad.out);
+  EXPECT_EQ(json_value(bad.out, "ok"), "false");
+  EXPECT_EQ(json_value(bad.out, "first_mismatch"), "47");
+  const Result text = detsim_cli("verify " + file.path());
+  EXPECT_EQ(text.exit_code, 1);
+  EXPECT_TRUE(has(text.out, "MISMATCH at frame 47")) << text.out;
+  EXPECT_TRUE(has(text.out, "last agreed frame: 46")) << text.out;
+}
+
+TEST(Cli, BadUsageAndBadInputExitWithTwoAndSayWhatIsWrong) {
+  TempFile junk("junk.dsr");
+  write_bytes(junk.path(), std::vector<std::uint8_t>(100, 0x41));
+  struct Case {
+    std::string args;
+    std::string message;  ///< on stderr
+  };
+  const std::vector<Case> cases = {
+      {"run", "--scenario is required"},
+      {"run --scenario nope", "unknown scenario 'nope'; known: arena,"},
+      {"run --scenario arena --players 9", "takes 2 to 8 players, got 9"},
+      {"run --scenario arena --frames 0", "--frames"},
+      {"run --scenario arena --frames abc", "--frames"},
+      {"run --scenario stack --frames 1 --record /nonexistent-dir/x.dsr",
+       "/nonexistent-dir/x.dsr: cannot create"},
+      {"synctest --scenario stack --check-distance 0", "--check-distance must be 1 to 600"},
+      {"verify", "FILE is required"},
+      {"verify " + junk.path(), junk.path() + ": byte 0: expected the magic"},
+      {"verify /nonexistent-file.dsr", "/nonexistent-file.dsr: cannot open"},
+      {"info " + junk.path(), "this is not a detsim replay"},
+      {"golden check --dir /nonexistent-dir", "cannot read /nonexistent-dir/scenarios.txt"},
+      {"frobnicate", "frobnicate"},
+      {"run --scenario arena --bogus-flag", "--bogus-flag"},
+  };
+  for (const Case& c : cases) {
+    const Result r = detsim_cli(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.err;
+    EXPECT_TRUE(has(r.err, c.message)) << c.args << "\nstderr: " << r.err;
+    EXPECT_EQ(r.out, "") << c.args;
+  }
+}
+
+TEST(Cli, SynctestPassesOnEveryKindOfScene) {
+  for (const char* scene : {"arena --players 3", "spray", "dominoes"}) {
+    const Result r = detsim_cli(std::string("synctest --scenario ") + scene +
+                                " --frames 40 --check-distance 7 --json");
+    EXPECT_EQ(r.exit_code, 0) << scene << r.err;
+    expect_one_json_object(r.out);
+    EXPECT_EQ(json_value(r.out, "ok"), "true") << r.out;
+    EXPECT_EQ(json_value(r.out, "first_mismatch"), "null");
+    EXPECT_EQ(json_value(r.out, "resimulated_frames"), std::to_string((40 - 7 + 1) * 7));
+  }
+}
+
+TEST(Cli, ScenariosListsTheRegistry) {
+  const Result json = detsim_cli("scenarios --json");
+  EXPECT_EQ(json.exit_code, 0);
+  expect_one_json_object(json.out);
+  const Result text = detsim_cli("scenarios");
+  for (const ScenarioInfo& info : scenario_list()) {
+    EXPECT_TRUE(has(json.out, "{\"name\":\"" + std::string(info.name) + "\"")) << info.name;
+    EXPECT_TRUE(has(text.out, std::string(info.name) + " ")) << info.name;
+  }
+}
+
+/// The checked-in golden hashes and replays reproduce on this machine; a changed golden hash is
+/// reported with the run, the frame and both hashes, exit code 1.
+TEST(Cli, GoldenCheckPassesAndNamesAMismatch) {
+  const std::string golden = std::string(DETSIM_SOURCE_DIR) + "/golden";
+  const Result ok = detsim_cli("golden check --dir " + golden + " --json");
+  EXPECT_EQ(ok.exit_code, 0) << ok.out << ok.err;
+  EXPECT_EQ(json_value(ok.out, "ok"), "true");
+  EXPECT_EQ(json_value(ok.out, "mismatches"), "[]");
+
+  namespace fs = std::filesystem;
+  const fs::path copy = fs::temp_directory_path() / ("detsim_golden_" + std::to_string(getpid()));
+  fs::remove_all(copy);
+  fs::copy(golden, copy, fs::copy_options::recursive);
+  std::string text = read_text((copy / "scenarios.txt").string());
+  const auto line = text.find("\nbounce ");
+  ASSERT_NE(line, std::string::npos);
+  const auto at = text.find(" 100=", line) + 5;
+  const std::string recorded = text.substr(at, 16);
+  text[at] = text[at] == '0' ? '1' : '0';
+  const std::string changed = text.substr(at, 16);
+  write_bytes((copy / "scenarios.txt").string(), {text.begin(), text.end()});
+  const Result bad = detsim_cli("golden check --dir " + copy.string());
+  fs::remove_all(copy);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_TRUE(has(bad.out,
+                  "golden MISMATCH: bounce seed=1 players=0 count=0 frames=600: frame "
+                  "100: expected " +
+                      changed + ", got " + recorded))
+      << bad.out;
+}
+
+}  // namespace
+}  // namespace detsim

@@ -1,0 +1,175 @@
+// detsim verify and detsim info.
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <detsim/fixed/decimal.hpp>
+#include <detsim/replay.hpp>
+
+#include "commands.hpp"
+#include "output.hpp"
+
+namespace detsim::cli {
+
+namespace {
+
+std::string hashes_json(const StateHashes& h) {
+  return Json()
+      .hash("total", h.total)
+      .hash("globals", h.globals)
+      .hash("rng", h.rng)
+      .hash("bodies", h.bodies)
+      .hash("contacts", h.contacts)
+      .text();
+}
+
+/// The parts whose hashes differ: "globals", "rng", "bodies", "contacts".
+std::vector<std::string> differing_parts(const StateHashes& a, const StateHashes& b) {
+  std::vector<std::string> out;
+  if (a.globals != b.globals) out.emplace_back("globals");
+  if (a.rng != b.rng) out.emplace_back("rng");
+  if (a.bodies != b.bodies) out.emplace_back("bodies");
+  if (a.contacts != b.contacts) out.emplace_back("contacts");
+  return out;
+}
+
+std::string describe(const replay::Fingerprint& f) {
+  std::string out = f.scenario + " (seed " + std::to_string(f.params.seed);
+  if (f.params.players != 0) out += ", " + std::to_string(f.params.players) + " players";
+  if (f.params.count != 0) out += ", " + std::to_string(f.params.count) + " bodies";
+  return out + ")";
+}
+
+}  // namespace
+
+int verify_command(const VerifyArgs& args) {
+  auto reader = replay::ReplayReader::open(args.file);
+  if (!reader) return usage_error("verify", reader.message());
+  const replay::Fingerprint& fp = reader->fingerprint();
+  Progress progress("verify");
+  const auto start = std::chrono::steady_clock::now();
+  auto result =
+      replay::verify(reader.value(), [&progress](std::uint64_t done, std::uint64_t total) {
+        progress.update(done, total);
+        return true;
+      });
+  const double seconds = seconds_since(start);
+  progress.done();
+  if (!result) return usage_error("verify", result.message());
+  const replay::VerifyResult& v = result.value();
+  const double fps = seconds > 0 ? static_cast<double>(v.frames) / seconds : 0.0;
+  const double realtime = fps * fp.dt.to_double();
+  const std::vector<std::string> parts = differing_parts(v.expected, v.actual);
+  if (args.json) {
+    std::vector<std::string> quoted;
+    for (const std::string& p : parts)
+      quoted.push_back(Json::quote(p));
+    Json j;
+    j.boolean("ok", v.ok)
+        .num("frames", v.frames)
+        .frame("first_mismatch", v.first_mismatch)
+        .str("file", args.file)
+        .str("scenario", fp.scenario)
+        .num("recorded_frames", reader->frame_count())
+        .boolean("complete", reader->complete())
+        .hash("final_hash", v.final_hash);
+    if (v.first_mismatch) {
+      j.raw("expected", hashes_json(v.expected))
+          .raw("actual", hashes_json(v.actual))
+          .raw("differing_parts", Json::array(quoted));
+    }
+    if (v.note.empty()) {
+      j.null("note");
+    } else {
+      j.str("note", v.note);
+    }
+    j.real("seconds", seconds).real("frames_per_second", fps).real("realtime_factor", realtime);
+    j.print();
+    return v.ok ? exit_ok : exit_check_failed;
+  }
+  if (v.ok) {
+    std::printf("%s: ok: %llu frames of %s reproduce every recorded hash; final hash %s\n",
+                args.file.c_str(), static_cast<unsigned long long>(v.frames), describe(fp).c_str(),
+                hex(v.final_hash).c_str());
+    std::printf("%.2f s, %.0f frames/s (%.0fx real time)\n", seconds, fps, realtime);
+  } else if (v.first_mismatch) {
+    const std::uint64_t f = *v.first_mismatch;
+    std::printf("%s: MISMATCH at frame %llu of %s\n", args.file.c_str(),
+                static_cast<unsigned long long>(f), describe(fp).c_str());
+    std::printf("  recorded hash %s, this machine computes %s\n", hex(v.expected.total).c_str(),
+                hex(v.actual.total).c_str());
+    std::string list;
+    for (const std::string& p : parts)
+      list += (list.empty() ? "" : ", ") + p;
+    if (!list.empty()) std::printf("  differing parts: %s\n", list.c_str());
+    if (f > 0) std::printf("  last agreed frame: %llu\n", static_cast<unsigned long long>(f - 1));
+  } else {
+    std::printf("%s: FAILED after %llu frames\n", args.file.c_str(),
+                static_cast<unsigned long long>(v.frames));
+  }
+  if (!v.note.empty()) std::printf("  note: %s\n", v.note.c_str());
+  return v.ok ? exit_ok : exit_check_failed;
+}
+
+int info_command(const InfoArgs& args) {
+  auto reader = replay::ReplayReader::open(args.file);
+  if (!reader) return usage_error("info", reader.message());
+  const replay::ReplayReader& r = reader.value();
+  const replay::Fingerprint& f = r.fingerprint();
+  if (args.json) {
+    std::vector<std::string> keyframes;
+    for (const replay::KeyframeInfo& k : r.keyframes())
+      keyframes.push_back(Json().num("frame", k.frame).num("bytes", k.size).text());
+    Json fingerprint;
+    fingerprint.str("detsim_version", f.detsim_version)
+        .num("fixed_fraction_bits", f.fixed_fraction_bits)
+        .num("state_version", f.state_version)
+        .str("scenario", f.scenario)
+        .num("seed", f.params.seed)
+        .num("players", f.players)
+        .num("count", f.params.count)
+        .str("dt", to_string(f.dt))
+        .num("substeps", f.substeps)
+        .num("iterations", f.iterations)
+        .num("input_size", f.input_size)
+        .num("keyframe_interval", f.keyframe_interval)
+        .hash("initial_hash", f.initial_hash);
+    Json j;
+    j.str("file", args.file)
+        .num("format_version", replay::format_version)
+        .num("bytes", r.file_size())
+        .raw("fingerprint", fingerprint.text())
+        .num("frames", r.frame_count())
+        .boolean("complete", r.complete());
+    if (r.chain_hash()) {
+      j.hash("chain_hash", *r.chain_hash());
+    } else {
+      j.null("chain_hash");
+    }
+    j.raw("keyframes", Json::array(keyframes)).num("ignored_tail_bytes", r.ignored_tail_bytes());
+    j.print();
+    return exit_ok;
+  }
+  std::printf("file              %s (%llu bytes, replay format %u)\n", args.file.c_str(),
+              static_cast<unsigned long long>(r.file_size()), replay::format_version);
+  std::printf("scenario          %s\n", describe(f).c_str());
+  std::printf("recorded by       detsim %s, Q%u.%u, state encoding %u\n", f.detsim_version.c_str(),
+              64 - f.fixed_fraction_bits, f.fixed_fraction_bits, f.state_version);
+  std::printf("step              dt %s s, %u substeps x %u iterations\n", to_string(f.dt).c_str(),
+              f.substeps, f.iterations);
+  std::printf("inputs            %u players x %u bytes per frame\n", f.players, f.input_size);
+  std::printf("initial hash      %s\n", hex(f.initial_hash).c_str());
+  std::printf("frames            %llu%s\n", static_cast<unsigned long long>(r.frame_count()),
+              r.complete() ? "" : " (no end marker: the recording stopped early)");
+  if (r.chain_hash()) std::printf("chain hash        %s\n", hex(*r.chain_hash()).c_str());
+  std::string frames;
+  for (const replay::KeyframeInfo& k : r.keyframes())
+    frames += (frames.empty() ? "" : ", ") + std::to_string(k.frame);
+  std::printf("keyframes         %zu every %u frames%s%s\n", r.keyframes().size(),
+              f.keyframe_interval, frames.empty() ? "" : ": ", frames.c_str());
+  if (r.ignored_tail_bytes() != 0) std::printf("note              %s\n", r.tail_note().c_str());
+  return exit_ok;
+}
+
+}  // namespace detsim::cli
