@@ -163,9 +163,16 @@ int info_command(const InfoArgs& args) {
   std::printf("frames            %llu%s\n", static_cast<unsigned long long>(r.frame_count()),
               r.complete() ? "" : " (no end marker: the recording stopped early)");
   if (r.chain_hash()) std::printf("chain hash        %s\n", hex(*r.chain_hash()).c_str());
+  // The keyframes' frames; a long list shows its first eight and its last.
   std::string frames;
-  for (const replay::KeyframeInfo& k : r.keyframes())
-    frames += (frames.empty() ? "" : ", ") + std::to_string(k.frame);
+  const auto& keys = r.keyframes();
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (keys.size() > 10 && i == 8) {
+      frames += ", ..., " + std::to_string(keys.back().frame);
+      break;
+    }
+    frames += (frames.empty() ? "" : ", ") + std::to_string(keys[i].frame);
+  }
   std::printf("keyframes         %zu every %u frames%s%s\n", r.keyframes().size(),
               f.keyframe_interval, frames.empty() ? "" : ": ", frames.c_str());
   if (r.ignored_tail_bytes() != 0) std::printf("note              %s\n", r.tail_note().c_str());
