@@ -281,9 +281,21 @@ def render_sim(data, args, add):
     for scene, title in (("pile_boxes", "boxes"), ("pile_spheres", "spheres")):
         d, b = whole[scene]
         r = d / b if d is not None and b is not None else None
+        # The speed goal counts as met only when the whole-run ratio and the load-filtered one
+        # agree: on a shared machine one of them alone can flatter either engine.
+        fd, fb = filtered[scene]
+        rf = fd / fb if fd is not None and fb is not None else None
+        status = status_le(r, SIM_SPEED_GOAL)
+        if rf is not None and r is not None and (r <= SIM_SPEED_GOAL) != (rf <= SIM_SPEED_GOAL):
+            status = (f"unsettled: the load-filtered ratio is {rf:.2f}× (below); "
+                      "needs a quieter machine")
+        d_h = stat(runs.get(f"{scene}/detsim"), "mean_height")
+        b_h = stat(runs.get(f"{scene}/bullet"), "mean_height")
+        if d_h is not None and b_h is not None and abs(d_h - b_h) > 0.2 * max(d_h, b_h):
+            status += "; the two scenes ended differently (see the pile table)"
         add(f"| `{scene}`, {title}: ms/step over the {steps}-step run | {fmt_ms(d)} | "
             f"{bullet_name}: {fmt_ms(b)} | {fmt_num(r)}× | ≤ {SIM_SPEED_GOAL:g}× | "
-            f"{status_le(r, SIM_SPEED_GOAL)} |")
+            f"{status} |")
     for name, ms in (("save", save), ("restore", restore), ("hash (all parts)", hashing)):
         p = pct(ms)
         add(f"| {name} of the {count}-box world at frame {frame} | {fmt_ms(ms)} | one step: "
@@ -357,8 +369,10 @@ def render_sim(data, args, add):
         if d_h is not None and b_h is not None and abs(d_h - b_h) > 0.25:
             add(f"- `{scene}`: the engines did not end alike (mean height {d_h:.2f} m in detsim, "
                 f"{b_h:.2f} m in {bullet_name}): the columns of the lattice stand in one and "
-                "collapse in the other, so the settled-phase windows do not compare like with like; "
-                "the whole run is the figure compared.")
+                "collapse in the other, so the two runs do not do the same work after the drop: "
+                f"neither the whole runs nor the last {window} steps compare like with like, and "
+                f"the first {window} steps (the drop, before the columns part ways) come "
+                "closest.")
     add("")
 
     # ---- state and sleep in detail ----
