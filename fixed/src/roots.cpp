@@ -112,7 +112,7 @@ constexpr EvenNormalised normalise_even(std::uint64_t x) noexcept {
 /// The error bound covers the interpolation remainder, coefficient rounding and both truncating
 /// shifts below (derived per interval by the generator). The result is < 2^31 (1 + 2^-21).
 constexpr std::uint64_t rsqrt_seed_q30(std::uint64_t m) noexcept {
-  const RsqrtSeed& seed = rsqrt_seed[(m >> 57) - 32];
+  const RsqrtSeed& seed = rsqrt_seed[static_cast<std::size_t>((m >> 57) - 32)];
   const std::uint64_t t = (m >> 25) & 0xFFFFFFFFU;  // Q0.32; the 25 bits dropped move y by < 2^-37
   const std::uint64_t u = (seed.c2 * t) >> 32;      // c2 t; c1 > c2 since 1/sqrt is decreasing
   const std::uint64_t v = ((seed.c1 - u) * t) >> 32;

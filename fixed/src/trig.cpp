@@ -69,7 +69,7 @@ struct QuarterTurns {
   U128 fraction;
 };
 
-QuarterTurns reduce(std::uint64_t magnitude) noexcept {
+QuarterTurns reduce_quarter_turns(std::uint64_t magnitude) noexcept {
   // magnitude * two_over_pi in 64-bit words w2:w1:w0 (bit 160 is the unit of y).
   const U128 low = wide::Default::mul(magnitude, two_over_pi_lo);
   const U128 high = wide::Default::mul(magnitude, two_over_pi_hi);
@@ -183,17 +183,17 @@ U128 sine_q127(U128 t) noexcept {
 }  // namespace
 
 Fixed sin(Fixed x) noexcept {
-  const KernelArgs a = kernel_args(reduce(detail::magnitude(x.raw())));
+  const KernelArgs a = kernel_args(reduce_quarter_turns(detail::magnitude(x.raw())));
   return with_sign(a.sin_negative != (x.raw() < 0), sin_magnitude(a));
 }
 
 Fixed cos(Fixed x) noexcept {
-  const KernelArgs a = kernel_args(reduce(detail::magnitude(x.raw())));
+  const KernelArgs a = kernel_args(reduce_quarter_turns(detail::magnitude(x.raw())));
   return with_sign(a.cos_negative, cos_magnitude(a));
 }
 
 SinCos sincos(Fixed x) noexcept {
-  const KernelArgs a = kernel_args(reduce(detail::magnitude(x.raw())));
+  const KernelArgs a = kernel_args(reduce_quarter_turns(detail::magnitude(x.raw())));
   const std::uint64_t sin_q63 = sine_q63(a.sin_t.hi);
   const std::uint64_t cos_q63 = sine_q63(a.cos_t.hi);
   std::uint64_t s = round_q63(sin_q63);
@@ -238,7 +238,7 @@ SinCos sincos(Fixed x) noexcept {
 }
 
 Fixed tan(Fixed x) noexcept {
-  const KernelArgs a = kernel_args(reduce(detail::magnitude(x.raw())));
+  const KernelArgs a = kernel_args(reduce_quarter_turns(detail::magnitude(x.raw())));
   // tan = sin / cos; its sign is negative in odd quadrants (sin and cos signs differ).
   const bool negative = (a.sin_negative != a.cos_negative) != (x.raw() < 0);
   if (a.sin_t == U128{}) return Fixed::zero();

@@ -154,12 +154,29 @@ std::uint64_t HashChain::value() const noexcept {
 
 // ---- Files --------------------------------------------------------------------------------------
 
-namespace {
+// File and FrameChunk are members of the writer's and reader's Impl, so they live in a named
+// namespace (a unity build would otherwise warn of members of anonymous types).
+namespace detail {
 
 struct FileCloser {
   void operator()(std::FILE* f) const noexcept { std::fclose(f); }
 };
 using File = std::unique_ptr<std::FILE, FileCloser>;
+
+/// A FRAM chunk: where its payload is and which frames it holds.
+struct FrameChunk {
+  std::uint64_t offset = 0;  ///< of the chunk
+  std::uint32_t length = 0;  ///< payload bytes
+  std::uint64_t first = 0;
+  std::uint32_t count = 0;
+};
+
+}  // namespace detail
+
+using detail::File;
+using detail::FrameChunk;
+
+namespace {
 
 std::string os_error() {
   return std::strerror(errno);
@@ -308,18 +325,6 @@ const std::string& ReplayWriter::path() const noexcept {
 }
 
 // ---- Reader -------------------------------------------------------------------------------------
-
-namespace {
-
-/// A FRAM chunk: where its payload is and which frames it holds.
-struct FrameChunk {
-  std::uint64_t offset = 0;  ///< of the chunk
-  std::uint32_t length = 0;  ///< payload bytes
-  std::uint64_t first = 0;
-  std::uint32_t count = 0;
-};
-
-}  // namespace
 
 struct ReplayReader::Impl {
   std::vector<std::uint8_t> memory;  ///< the bytes of a replay read from memory

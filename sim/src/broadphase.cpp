@@ -96,8 +96,8 @@ void update_contacts(WorldState& s) {
   merged.reserve(pairs.size());
   std::size_t old = 0;
   for (const std::uint64_t pair : pairs) {
-    const std::uint32_t a = s.bodies[pair >> 32].id.value;
-    const std::uint32_t b = s.bodies[pair & 0xFFFFFFFFU].id.value;
+    const std::uint32_t a = s.bodies[static_cast<std::size_t>(pair >> 32)].id.value;
+    const std::uint32_t b = s.bodies[static_cast<std::size_t>(pair & 0xFFFFFFFFU)].id.value;
     while (old < s.contacts.size() &&
            (s.contacts[old].a < a || (s.contacts[old].a == a && s.contacts[old].b < b)))
       report_end(s, s.contacts[old++]);  // a pair whose boxes parted

@@ -39,15 +39,19 @@ SyncResult run_synctest(Scenario& s, std::uint64_t frames, std::uint32_t distanc
   std::vector<std::vector<std::uint8_t>> saved(distance + 1);
   std::vector<StateHashes> first_pass(distance + 1);
   std::vector<PlayerInput> inputs;
+  // The ring slot of frame f (distance + 1 slots; the remainder fits size_t on every target).
+  const auto slot_of = [&](std::uint64_t f) {
+    return static_cast<std::size_t>(f % (std::uint64_t{distance} + 1));
+  };
   saved[0] = s.world().save();
   first_pass[0] = s.world().hashes();
   for (std::uint64_t f = 1; f <= frames; ++f) {
     inputs_at(s, f, inputs);
     s.step(inputs);
-    const std::size_t slot = f % (distance + 1);
+    const std::size_t slot = slot_of(f);
     first_pass[slot] = s.world().hashes();
     if (f >= distance && distance > 0) {
-      const Status restored = s.world().restore(saved[(f - distance) % (distance + 1)]);
+      const Status restored = s.world().restore(saved[slot_of(f - distance)]);
       if (!restored) {
         r.error = "frame " + std::to_string(f) + ": restoring frame " +
                   std::to_string(f - distance) + " failed: " + restored.message();
@@ -58,7 +62,7 @@ SyncResult run_synctest(Scenario& s, std::uint64_t frames, std::uint32_t distanc
         s.step(inputs);
         ++r.resimulated;
         const StateHashes again = s.world().hashes();
-        const StateHashes& want = first_pass[g % (distance + 1)];
+        const StateHashes& want = first_pass[slot_of(g)];
         if (again != want) {
           r.frames = f;
           r.first_mismatch = g;

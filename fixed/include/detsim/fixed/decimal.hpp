@@ -103,14 +103,16 @@ inline constexpr int integer_places = 10;
 // clamps change nothing for any text shorter than 10^18 - 50 characters: a nonzero digit whose
 // place depends on the clamped part is then far outside the window of places -10 .. 33.
 inline constexpr std::uint64_t exponent_clamp = pow10[18];
-inline constexpr std::size_t count_clamp = std::size_t{1} << 61;
+// (A count, not a size: a 32-bit size_t never reaches it, so the comparison is made in 64 bits.)
+inline constexpr std::uint64_t count_clamp = std::uint64_t{1} << 61;
 
 constexpr bool is_digit(char c) noexcept {
   return c >= '0' && c <= '9';
 }
 
 constexpr std::int64_t clamped_count(std::size_t n) noexcept {
-  return static_cast<std::int64_t>(n < count_clamp ? n : count_clamp);
+  const std::uint64_t count = n;
+  return static_cast<std::int64_t>(count < count_clamp ? count : count_clamp);
 }
 
 constexpr ParseResult failure(ParseError error, std::size_t position) noexcept {
