@@ -206,11 +206,6 @@ namespace sim_detail {
 
 namespace {
 
-BodyId add(World& w, const BodyDef& def) {
-  // Scenario definitions are constants checked by the tests: a refusal is a bug here.
-  return w.create_body(def).value();
-}
-
 void add_ground(World& w, Fixed friction) {
   add(w, {.type = BodyType::static_body, .shape = Shape::plane(), .friction = friction});
 }

@@ -14,10 +14,6 @@ namespace {
 
 using namespace detsim::literals;
 
-BodyId add(World& w, const BodyDef& def) {
-  return w.create_body(def).value();  // scenario definitions are constants checked by tests
-}
-
 void add_wall(World& w, Vec3 half, Vec3 at) {
   add(w, {.type = BodyType::static_body, .shape = Shape::box(half), .position = at});
 }
@@ -151,7 +147,7 @@ void control_arena(World& w, std::span<const PlayerInput> inputs, const Scenario
   for (const BodyState& b : tagged(w, player_tag)) {
     const std::uint64_t player = b.user_data - player_tag;
     if (player >= inputs.size()) continue;
-    const PlayerInput& in = inputs[player];
+    const PlayerInput& in = inputs[static_cast<std::size_t>(player)];
     // The stick: -127 .. 127 maps to +-1 (-128 is clamped), times a 1600 N drive.
     const auto axis = [](std::int8_t v) {
       return Fixed::from_int(v < -127 ? -127 : v) / Fixed::from_int(127);
@@ -171,7 +167,7 @@ void control_arena(World& w, std::span<const PlayerInput> inputs, const Scenario
     const std::vector<BodyState> crates = tagged(w, crate_tag);
     if (!crates.empty()) {
       Rng& rng = w.rng();
-      const BodyId target = crates[rng.below(crates.size())].id;
+      const BodyId target = crates[static_cast<std::size_t>(rng.below(crates.size()))].id;
       const Fixed sideways = rng.uniform(-60_fx, 60_fx);
       const Fixed up = rng.uniform(80_fx, 160_fx);
       (void)w.apply_linear_impulse(target, {sideways, up, 0_fx});

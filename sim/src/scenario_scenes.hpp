@@ -8,6 +8,12 @@
 
 namespace detsim::sim_detail {
 
+// Adds a body to a scenario's world. Scenario definitions are constants checked by the tests: a
+// refusal is a bug here.
+inline BodyId add(World& w, const BodyDef& def) {
+  return w.create_body(def).value();
+}
+
 // Each builder fills an empty World made from the scenario's WorldDef.
 void build_pile(World& w, const ScenarioParams& p, bool spheres);
 void build_stack(World& w, const ScenarioParams& p);
