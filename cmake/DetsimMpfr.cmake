@@ -1,5 +1,9 @@
 # MPFR (with GMP) is the high-precision reference of the accuracy tests and of `detsim accuracy`.
 # It never reaches the detsim libraries.
+set(DETSIM_HAVE_MPFR OFF)
+if(NOT DETSIM_WITH_MPFR)
+  return()
+endif()
 find_path(MPFR_INCLUDE_DIR mpfr.h)
 find_library(MPFR_LIBRARY mpfr)
 find_library(GMP_LIBRARY gmp)
