@@ -55,6 +55,9 @@ TEST(ScenarioRegistry, BadNamesAndParametersAreErrorsThatSayWhatIsAllowed) {
   bad = Scenario::create("pile_boxes", {.count = 100001});
   ASSERT_FALSE(bad.ok());
   EXPECT_TRUE(contains(bad.message(), "1 to 100000 bodies")) << bad.message();
+  bad = Scenario::create("pyramid", {.count = 101});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_TRUE(contains(bad.message(), "1 to 100 rows")) << bad.message();
   bad = Scenario::create("bounce", {.count = 3});
   ASSERT_FALSE(bad.ok());
   EXPECT_TRUE(contains(bad.message(), "takes no body count")) << bad.message();
@@ -77,6 +80,14 @@ TEST(ScenarioRegistry, DefaultsAreFilledIn) {
   EXPECT_EQ(full->params().count, 1000U);
   EXPECT_EQ(full->world().body_count(), 1001U);
   EXPECT_EQ(full->world().def().seed, 1U);
+  // The pyramid's count is its rows: n rows hold n (n + 1) / 2 boxes.
+  auto pyramid = Scenario::create("pyramid");
+  ASSERT_TRUE(pyramid.ok());
+  EXPECT_EQ(pyramid->params().count, 20U);
+  EXPECT_EQ(pyramid->world().body_count(), 211U);  // the ground and 210 boxes
+  auto small = Scenario::create("pyramid", {.count = 8});
+  ASSERT_TRUE(small.ok());
+  EXPECT_EQ(small->world().body_count(), 37U);
   auto seeded = Scenario::create("spray", {.seed = 77});
   ASSERT_TRUE(seeded.ok());
   EXPECT_EQ(seeded->world().def().seed, 77U);

@@ -60,8 +60,8 @@ constexpr std::array entries{
            600, 0, 0, 0, 1000, 100000, false},
           build_pile_spheres,
           nullptr},
-    Entry{{"pyramid", "a 20-row pyramid of 1 m boxes (210 boxes) on a plane", 1200, 0, 0, 0, 0, 0,
-           false},
+    Entry{{"pyramid", "a pyramid of 1 m boxes on a plane, N rows (20 rows: 210 boxes)", 1200, 0, 0,
+           0, 20, 100, false, "rows"},
           sim_detail::build_pyramid,
           nullptr},
     Entry{
@@ -145,8 +145,8 @@ Expected<Scenario> Scenario::create(std::string_view name, const ScenarioParams&
       return Status::error("scenario '" + std::string(name) + "' takes no body count, got " +
                            std::to_string(p.count));
     return Status::error("scenario '" + std::string(name) + "' takes 1 to " +
-                         std::to_string(info.max_count) + " bodies, got " +
-                         std::to_string(p.count));
+                         std::to_string(info.max_count) + " " + std::string(info.count_unit) +
+                         ", got " + std::to_string(p.count));
   }
   WorldDef def;
   def.seed = p.seed;
@@ -249,9 +249,9 @@ void build_stack(World& w, const ScenarioParams&) {
   }
 }
 
-void build_pyramid(World& w, const ScenarioParams&) {
+void build_pyramid(World& w, const ScenarioParams& p) {
   add_ground(w, 0.6_fx);
-  constexpr int rows = 20;
+  const int rows = static_cast<int>(p.count);
   for (int row = 0; row < rows; ++row) {
     const int n = rows - row;
     for (int i = 0; i < n; ++i) {

@@ -42,7 +42,8 @@ std::string describe(const Scenario& scenario) {
   const ScenarioParams& p = scenario.params();
   std::string out = std::string(scenario.info().name) + " (seed " + std::to_string(p.seed);
   if (scenario.info().max_players != 0) out += ", " + std::to_string(p.players) + " players";
-  if (scenario.info().default_count != 0) out += ", " + std::to_string(p.count) + " bodies";
+  if (scenario.info().default_count != 0)
+    out += ", " + std::to_string(p.count) + " " + std::string(scenario.info().count_unit);
   return out + ")";
 }
 
@@ -60,7 +61,9 @@ int scenarios_command(const ScenariosArgs& args) {
             .num("default_players", s.default_players);
       }
       if (s.default_count != 0)
-        j.num("default_count", s.default_count).num("max_count", s.max_count);
+        j.num("default_count", s.default_count)
+            .num("max_count", s.max_count)
+            .str("count_unit", s.count_unit);
       j.boolean("uses_seed", s.uses_seed);
       items.push_back(j.text());
     }
@@ -76,8 +79,8 @@ int scenarios_command(const ScenariosArgs& args) {
                 std::to_string(s.max_players) + " (default " + std::to_string(s.default_players) +
                 ")";
     if (s.default_count != 0)
-      params += "; --count 1.." + std::to_string(s.max_count) + " (default " +
-                std::to_string(s.default_count) + ")";
+      params += "; --count 1.." + std::to_string(s.max_count) + " " + std::string(s.count_unit) +
+                " (default " + std::to_string(s.default_count) + ")";
     params += s.uses_seed ? "; --seed changes the run" : "; --seed only seeds the unused RNG";
     std::printf("%-13s %s\n", "", params.c_str());
   }

@@ -197,7 +197,9 @@ void add_scenario_options(CLI::App* cmd, detsim::cli::ScenarioArgs& a) {
   cmd->add_option("--players", a.players,
                   "Players, for scenarios that have them (default: the scenario's own)")
       ->type_name("P");
-  cmd->add_option("--count", a.count, "Bodies, for the pile scenarios (default 1000)")
+  cmd->add_option("--count", a.count,
+                  "Size of the scene: bodies for the piles (default 1000), rows for the pyramid "
+                  "(default 20)")
       ->type_name("N");
 }
 
@@ -302,7 +304,9 @@ verify. Every architecture must reproduce them (golden/README.md).)");
       ->check(CLI::Range(std::uint64_t{1}, detsim::cli::max_frames));
   c->add_option("--seed", demo.scene.seed, "Seed (default 1)")->type_name("S");
   c->add_option("--players", demo.scene.players, "Players (default 4 for arena)")->type_name("P");
-  c->add_option("--count", demo.scene.count, "Bodies, for the piles")->type_name("N");
+  c->add_option("--count", demo.scene.count,
+                "Size of the scene: bodies for the piles, rows for the pyramid")
+      ->type_name("N");
   c->add_option("--record", demo.record, "Replay file (default: a temporary file)")
       ->type_name("FILE");
   c->add_flag("--json", demo.json, "Print one JSON object");
