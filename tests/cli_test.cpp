@@ -242,7 +242,7 @@ TEST(Cli, GoldenCheckPassesAndNamesAMismatch) {
   fs::remove_all(copy);
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_TRUE(has(bad.out,
-                  "golden MISMATCH: bounce seed=1 players=0 count=0 frames=600: frame "
+                  "golden MISMATCH: bounce seed=1 players=0 count=0 frames=1000: frame "
                   "100: expected " +
                       changed + ", got " + recorded))
       << bad.out;
