@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages detsim needs to build, test and benchmark, if any is missing.
-# Non-interactive; safe to run again (it does nothing when everything is present).
+# Installs the Debian 12 packages detsim needs to build, test and benchmark, if any is missing,
+# and the packages named as arguments. Non-interactive; safe to run again (it does nothing when
+# everything is present).
 set -euo pipefail
 
 packages=(
@@ -10,6 +11,7 @@ packages=(
   libmpfr-dev libgmp-dev                                       # reference for the accuracy tests
   libbenchmark-dev libfixmath-dev libbullet-dev               # benchmarks and their peers
   python3                                                      # docs/ table generation
+  "$@"  # what the caller needs besides (scripts/matrix.sh: its legs' cross compilers, qemu-user)
 )
 
 missing=()

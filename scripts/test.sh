@@ -1,22 +1,44 @@
 #!/usr/bin/env bash
 # Builds and runs every test: the README's test command, and what CI runs.
 #   1. gcc, Release, warnings as errors: the whole suite, plus the installed-package consumer test.
-#   2. clang with AddressSanitizer + UndefinedBehaviorSanitizer, warnings as errors: the whole suite.
-#   3. clang-format: every C++ file is formatted.
+#   2. The determinism matrix (scripts/matrix.sh): every compiler, optimisation level and CPU
+#      architecture reproduces golden/ bit for bit; the gcc -O2 leg is the build of step 1.
+#   3. clang with AddressSanitizer + UndefinedBehaviorSanitizer, warnings as errors: the whole suite.
+#   4. clang-format: every C++ file is formatted.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 
 jobs=$(nproc)
-step() { printf '\n== %s ==\n' "$*"; }
+current=""
+step_start=$SECONDS
+finish_step() {
+  if [ -n "$current" ]; then printf '== %s: passed in %d s ==\n' "$current" $((SECONDS - step_start)); fi
+}
+step() {
+  finish_step
+  current=$*
+  step_start=$SECONDS
+  printf '\n== %s ==\n' "$*"
+}
 
 step "gcc Release"
 # Release at -O2 (the level the benchmarks report; CMake's Release default is -O3), test files at
-# -O1: on 2 cores compiling is most of this script's time (tests/CMakeLists.txt says why -O1).
+# -O1: on 2 cores compiling is most of this script's time (tests/CMakeLists.txt says why -O1). The
+# libraries build as unity batches (every test file is its own executable already), which parses
+# their headers once per batch instead of once per file.
 cmake -S . -B build/gcc-release -G Ninja -DCMAKE_CXX_COMPILER=g++ -DCMAKE_BUILD_TYPE=Release \
-  "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -DNDEBUG" -DDETSIM_TEST_OPTIMIZE=-O1 -DDETSIM_WERROR=ON >/dev/null
+  "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -DNDEBUG" -DDETSIM_TEST_OPTIMIZE=-O1 -DDETSIM_WERROR=ON \
+  -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build build/gcc-release -j "$jobs"
 ctest --test-dir build/gcc-release --output-on-failure -j "$jobs"
+
+step "determinism matrix"
+# The CI selection of legs by default; DETSIM_MATRIX=full runs every leg (docs/MATRIX.md has what
+# each costs: the full matrix alone takes longer on two cores than the CI budget allows).
+matrix=(--ci)
+[ "${DETSIM_MATRIX:-ci}" = full ] && matrix=()
+bash scripts/matrix.sh "${matrix[@]}" x86_64-gcc-O2=build/gcc-release
 
 step "clang ASan+UBSan"
 # -O1 with line tables only: what the sanitizers recommend (reports keep file:line stacks), and
@@ -24,7 +46,8 @@ step "clang ASan+UBSan"
 san="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
 cmake -S . -B build/clang-sanitize -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
-  -DCMAKE_CXX_FLAGS="$san" -DCMAKE_EXE_LINKER_FLAGS="$san" -DDETSIM_WERROR=ON >/dev/null
+  -DCMAKE_CXX_FLAGS="$san" -DCMAKE_EXE_LINKER_FLAGS="$san" -DDETSIM_WERROR=ON \
+  -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build build/clang-sanitize -j "$jobs"
 # The accuracy contract is proven on 1M inputs per function, and the decimal round trips on their
 # full counts, in the gcc build above; here the same tests look for undefined behaviour over every
@@ -36,3 +59,5 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
 step "clang-format"
 git ls-files '*.cpp' '*.hpp' '*.h' | xargs clang-format --dry-run --Werror
 echo "clang-format: all files formatted"
+finish_step
+echo "scripts/test.sh: every step passed in $SECONDS s"

@@ -1,0 +1,182 @@
+#!/usr/bin/env bash
+# The cross-architecture determinism matrix (part of the README's test command; docs/MATRIX.md).
+#
+# Each leg builds the detsim command for one CPU, compiler and optimisation level, then runs
+#   detsim golden check --dir golden          (every golden scenario's hashes, and the golden replays)
+#   detsim verify golden/replays/*.dsr        (each golden replay, frame by frame)
+# natively or under qemu-user. Every leg must reproduce the same golden/ data, bit for bit.
+#
+# Usage: scripts/matrix.sh [--list] [--ci] [LEG ...] [LEG=BUILD_DIR ...]
+#   LEG         run only the legs named (default: every leg, in the order of the table below)
+#   --ci        run only the legs marked "ci" below: the selection scripts/test.sh runs within the
+#               CI time budget (docs/MATRIX.md has the measured cost of every leg)
+#   LEG=DIR     for that leg, use the detsim already built in DIR instead of building it
+#               (scripts/test.sh passes its gcc -O2 build this way)
+#   --list      print the legs and exit
+# Exit status: 0 every leg matched; 1 some leg differed (the leg, scenario and frame are named);
+# 2 bad usage, or a leg that could not be built or run.
+#
+# Lean by design (the whole test command must fit its CI budget on two cores): a leg builds only the
+# detsim target, each library as one unity translation unit, with the CLI11 argument parser at -O0
+# (it computes nothing the golden data checks); the golden runs are short.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+
+# name | compiler | optimisation and code-generation flags | emulator ("" = run natively) | ci
+# The "ci" legs give the most independent evidence per minute: the gcc -O2 build of the test suite
+# (free), 32-bit little-endian without __int128 (i686, on the real CPU), and big-endian (s390x).
+legs=(
+  "x86_64-gcc-O0|g++|-O0||"
+  "x86_64-gcc-O2|g++|-O2||ci"
+  "x86_64-gcc-O3|g++|-O3||"
+  "x86_64-clang-O0|clang++|-O0||"
+  "x86_64-clang-O2|clang++|-O2||"
+  "x86_64-clang-O3|clang++|-O3||"
+  "x86_64-gcc-O3-fast-math-native|g++|-O3 -ffast-math -march=native||"
+  "i686|i686-linux-gnu-g++-12|-O2|qemu-i386|ci"
+  "armhf|arm-linux-gnueabihf-g++-12|-O2|qemu-arm|"
+  "aarch64|aarch64-linux-gnu-g++-12|-O2|qemu-aarch64|"
+  "riscv64|riscv64-linux-gnu-g++-12|-O2|qemu-riscv64|"
+  "ppc64le|powerpc64le-linux-gnu-g++-12|-O2|qemu-ppc64le|"
+  "s390x|s390x-linux-gnu-g++-12|-O2|qemu-s390x|ci"
+  "mips|mips-linux-gnu-g++-12|-O2|qemu-mips|"
+)
+
+usage() {
+  sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//' >&2
+  exit 2
+}
+
+declare -A prebuilt=()
+selected=()
+for arg in "$@"; do
+  case "$arg" in
+    --list)
+      for leg in "${legs[@]}"; do
+        IFS='|' read -r name cxx flags emu ci <<<"$leg"
+        printf '%-32s %-30s %-30s %-14s %s\n' "$name" "$cxx" "$flags" "${emu:-native}" "$ci"
+      done
+      exit 0
+      ;;
+    --ci)
+      for leg in "${legs[@]}"; do
+        [ "${leg##*|}" = ci ] && selected+=("${leg%%|*}")
+      done
+      ;;
+    -h | --help) usage ;;
+    -*) echo "matrix: unknown option '$arg'" >&2; usage ;;
+    *=*) prebuilt[${arg%%=*}]=${arg#*=} ;;
+    *) selected+=("$arg") ;;
+  esac
+done
+
+find_leg() {
+  local leg
+  for leg in "${legs[@]}"; do
+    [ "${leg%%|*}" = "$1" ] && { echo "$leg"; return 0; }
+  done
+  return 1
+}
+
+if [ ${#selected[@]} -eq 0 ]; then
+  for leg in "${legs[@]}"; do selected+=("${leg%%|*}"); done
+fi
+for name in "${selected[@]}" "${!prebuilt[@]}"; do
+  find_leg "$name" >/dev/null || { echo "matrix: unknown leg '$name' (--list shows them)" >&2; exit 2; }
+done
+for name in "${!prebuilt[@]}"; do
+  [ -x "${prebuilt[$name]}/tools/detsim" ] ||
+    { echo "matrix: leg $name: no detsim in ${prebuilt[$name]}/tools" >&2; exit 2; }
+done
+
+# The selected legs' cross compilers (Debian's g++-12-<triplet>) and qemu-user, if missing.
+packages=()
+for name in "${selected[@]}"; do
+  [ -n "${prebuilt[$name]:-}" ] && continue
+  IFS='|' read -r _ cxx _ emu _ <<<"$(find_leg "$name")"
+  if [ -n "$emu" ]; then packages+=("g++-12-${cxx%-g++-12}" qemu-user); fi
+done
+bash scripts/install-deps.sh "${packages[@]}"
+
+jobs=$(nproc)
+mkdir -p build/matrix
+results=()
+failed=0
+broken=0
+
+# build_leg NAME CXX FLAGS EMULATOR DIR: configures and builds the detsim target; returns nonzero
+# with the log in DIR.log on failure.
+build_leg() {
+  local name=$1 cxx=$2 flags=$3 emu=$4 dir=$5
+  local cross=()
+  if [ -n "$emu" ]; then
+    # Statically linked, so qemu-user needs no target C library; xxHash and CLI11 come from the
+    # host's headers (a cross build has no target libraries of them).
+    cross=(-DCMAKE_SYSTEM_NAME=Linux "-DCMAKE_SYSTEM_PROCESSOR=${name}"
+           -DCMAKE_EXE_LINKER_FLAGS=-static "-DCMAKE_CROSSCOMPILING_EMULATOR=${emu}")
+  fi
+  cmake -S "$root" -B "$dir" -G Ninja "-DCMAKE_CXX_COMPILER=$cxx" -DCMAKE_BUILD_TYPE=Release \
+    "-DCMAKE_CXX_FLAGS_RELEASE=$flags" "${cross[@]}" \
+    -DDETSIM_BUILD_TESTS=OFF -DDETSIM_INSTALL=OFF -DDETSIM_WITH_MPFR=OFF -DDETSIM_WERROR=ON \
+    -DDETSIM_HEADER_ONLY_DEPS=ON -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=0 \
+    -DDETSIM_CLI_PARSER_OPTIONS=-O0 >"$dir.log" 2>&1 &&
+    cmake --build "$dir" -j "$jobs" --target detsim >>"$dir.log" 2>&1
+}
+
+# check_leg EMULATOR BINARY: the golden check and the golden replays' verification. A cross binary
+# that this machine runs itself (i686 on an x86-64 kernel with 32-bit support) runs natively, on a
+# real CPU of its architecture and far faster than emulated; any other goes to its emulator.
+check_leg() {
+  local emu=$1 bin=$2 run=("$2")
+  if [ -n "$emu" ] && ! "$bin" --version >/dev/null 2>&1; then run=("$emu" "$bin"); fi
+  echo "running: ${run[*]}"
+  "${run[@]}" golden check --dir "$root/golden" || return
+  local replay
+  for replay in "$root"/golden/replays/*.dsr; do
+    "${run[@]}" verify "$replay" || return
+  done
+}
+
+for name in "${selected[@]}"; do
+  IFS='|' read -r _ cxx flags emu _ <<<"$(find_leg "$name")"
+  printf '\n-- matrix leg %s (%s %s%s)\n' "$name" "$cxx" "$flags" "${emu:+, run by $emu}"
+  start=$SECONDS
+  dir=${prebuilt[$name]:-build/matrix/$name}
+  if [ -z "${prebuilt[$name]:-}" ]; then
+    if ! command -v "$cxx" >/dev/null || { [ -n "$emu" ] && ! command -v "$emu" >/dev/null; }; then
+      echo "matrix: leg $name: $cxx${emu:+ or $emu} is not installed" >&2
+      results+=("$name|not run: toolchain missing|-|-"); broken=1; continue
+    fi
+    if ! build_leg "$name" "$cxx" "$flags" "$emu" "$dir"; then
+      tail -n 30 "$dir.log" >&2
+      echo "matrix: leg $name: the build failed (log: $dir.log)" >&2
+      results+=("$name|BUILD FAILED|$((SECONDS - start))|-"); broken=1; continue
+    fi
+  fi
+  built=$SECONDS
+  if output=$(check_leg "$emu" "$dir/tools/detsim" 2>&1); then
+    echo "$output"
+    results+=("$name|ok|$((built - start))|$((SECONDS - built))")
+  else
+    echo "$output"
+    echo "matrix: leg $name DIFFERS from golden/: see the mismatches above (scenario, frame," \
+         "expected and actual hash)" >&2
+    results+=("$name|DIFFERS|$((built - start))|$((SECONDS - built))"); failed=1
+  fi
+done
+
+printf '\n%-32s %-28s %8s %8s\n' "leg" "result" "build s" "check s"
+for r in "${results[@]}"; do
+  IFS='|' read -r name result build check <<<"$r"
+  printf '%-32s %-28s %8s %8s\n' "$name" "$result" "$build" "$check"
+done
+if [ $failed -ne 0 ]; then
+  echo "matrix: FAILED: some leg does not reproduce golden/" >&2
+  exit 1
+fi
+if [ $broken -ne 0 ]; then
+  echo "matrix: some leg could not be built or run" >&2
+  exit 2
+fi
+echo "matrix: every leg reproduces golden/ bit for bit"
