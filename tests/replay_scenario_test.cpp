@@ -43,7 +43,8 @@ std::vector<StateHashes> reference_run(const std::string& name, const ScenarioPa
 TEST(ScenarioReplay, EveryScenarioRecordsAndVerifies) {
   for (const ScenarioInfo& info : scenario_list()) {
     SCOPED_TRACE(std::string(info.name));
-    const ScenarioParams params{.seed = 9, .players = 0, .count = std::min(info.default_count, 27U)};
+    const ScenarioParams params{
+        .seed = 9, .players = 0, .count = std::min(info.default_count, 27U)};
     Scenario scenario = make(std::string(info.name), params);
     const std::uint32_t frames = std::min<std::uint32_t>(info.default_frames, 90);
     TempFile file(std::string(info.name) + ".dsr");
