@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds and runs every test: the README's test command, and what CI runs.
 #   1. gcc, Release, warnings as errors: the whole suite, plus the installed-package consumer test.
-#   2. The determinism matrix (scripts/matrix.sh): every compiler, optimisation level and CPU
-#      architecture reproduces golden/ bit for bit; the gcc -O2 leg is the build of step 1.
+#   2. The determinism matrix (scripts/matrix.sh): its CI legs (the gcc -O2 build of step 1, and
+#      i686) reproduce golden/ bit for bit; DETSIM_MATRIX=full runs every compiler, optimisation
+#      level and CPU architecture.
 #   3. clang with AddressSanitizer + UndefinedBehaviorSanitizer, warnings as errors: the whole suite.
 #   4. clang-format: every C++ file is formatted.
 set -euo pipefail
