@@ -2,5 +2,6 @@
 #pragma once
 
 #include <detsim/fixed.hpp>
+#include <detsim/net.hpp>
 #include <detsim/replay.hpp>
 #include <detsim/sim.hpp>

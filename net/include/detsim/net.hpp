@@ -1,0 +1,10 @@
+// The network layer: sessions (rollback, lockstep) over a transport (UDP, simulated network).
+#pragma once
+
+#include <detsim/net/game.hpp>
+#include <detsim/net/protocol.hpp>
+#include <detsim/net/scenario_game.hpp>
+#include <detsim/net/session.hpp>
+#include <detsim/net/sim_network.hpp>
+#include <detsim/net/transport.hpp>
+#include <detsim/net/udp.hpp>

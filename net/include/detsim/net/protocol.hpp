@@ -1,0 +1,142 @@
+// The session wire protocol (docs/NET.md, "Protocol"): what one datagram between two sessions
+// carries, and its canonical little-endian encoding.
+//
+// decode() is the gate every received byte passes through. It is pure (no session state) and
+// checks every field before the session sees it: magic, version, type, lengths, counts and the
+// trailing XXH3 checksum. A datagram that fails is dropped and counted by its DecodeError; nothing
+// in a session changes. The checksum catches corruption, not attackers: the session nonce and the
+// frame windows in the session are what keep stale and foreign datagrams out.
+//
+// Layout (all integers little-endian):
+//
+//     header   magic "DN" | version u8 | type u8 | sender nonce u32 | sequence u16     (10 bytes)
+//     body     by type (below)
+//     trailer  low 32 bits of XXH3-64 over header and body                             (4 bytes)
+//
+//     hello        fingerprint u64 | players u8 | player u8 | input_size u8 | challenge u32
+//     hello_reply  challenge u32
+//     input        ack_frame u32 | check_ack u32 | current_frame u32 | advantage i8 |
+//                  start_frame u32 | count u8 | deltas: run-length coded bytes (below) |
+//                  checks u8 | checks x (frame u32, hash u64)
+//     ping, pong   time u64 (microseconds of the pinging side's clock)
+//
+// Input deltas: the count inputs, each XORed with the one before it (the first with the input the
+// receiver already holds for start_frame - 1), so a held button costs nothing; then the
+// count * input_size XOR bytes in tokens: t < 128 is t + 1 literal bytes that follow, t >= 128 is
+// t - 127 zero bytes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include <detsim/net/transport.hpp>
+
+namespace detsim::net::protocol {
+
+/// Changes whenever the layout above changes; peers of different versions drop each other's
+/// datagrams (counted as bad_version) and never synchronise.
+inline constexpr std::uint8_t version = 1;
+inline constexpr std::uint8_t magic0 = 'D';
+inline constexpr std::uint8_t magic1 = 'N';
+inline constexpr std::size_t header_size = 10;
+inline constexpr std::size_t trailer_size = 4;
+/// The largest input a session exchanges, in bytes.
+inline constexpr std::size_t max_input_size = 64;
+/// The most inputs and hash checks one datagram carries.
+inline constexpr std::size_t max_inputs_per_packet = 255;
+inline constexpr std::size_t max_checks_per_packet = 8;
+/// The player byte of a spectator's hello.
+inline constexpr std::uint8_t spectator_player = 0xFF;
+
+enum class PacketType : std::uint8_t { hello = 1, hello_reply = 2, input = 3, ping = 4, pong = 5 };
+
+struct Header {
+  PacketType type = PacketType::hello;
+  std::uint32_t nonce = 0;     ///< the sender's session nonce (learned in the handshake)
+  std::uint16_t sequence = 0;  ///< per destination, +1 per datagram (loss statistics)
+};
+
+/// "I am `player` of a match of `players` with these settings; answer my challenge."
+struct Hello {
+  std::uint64_t fingerprint = 0;  ///< what both sides must agree on (SessionConfig::fingerprint)
+  std::uint8_t players = 0;
+  std::uint8_t player = 0;  ///< spectator_player for a spectator
+  std::uint8_t input_size = 0;
+  std::uint32_t challenge = 0;
+};
+
+struct HelloReply {
+  std::uint32_t challenge = 0;  ///< the challenge of the hello it answers
+};
+
+/// A confirmed-frame state hash, sent for desync detection until acknowledged.
+struct HashCheck {
+  std::uint32_t frame = 0;
+  std::uint64_t hash = 0;
+
+  friend constexpr bool operator==(const HashCheck&, const HashCheck&) noexcept = default;
+};
+
+struct InputBody {
+  std::uint32_t ack_frame = 0;       ///< the sender holds every input of the receiver before it
+  std::uint32_t check_ack = 0;       ///< the sender holds every hash check of the receiver up to it
+  std::uint32_t current_frame = 0;   ///< the sender's next frame to simulate (time sync)
+  std::int8_t advantage = 0;         ///< the sender's frame advantage over the receiver
+  std::uint32_t start_frame = 0;     ///< frame of the first input carried
+  std::uint8_t count = 0;            ///< inputs carried (0: an ack or keepalive only)
+  std::vector<std::uint8_t> deltas;  ///< count * input_size XOR deltas (see the file comment)
+  std::vector<HashCheck> checks;
+};
+
+struct PingBody {
+  std::uint64_t time_us = 0;
+};
+
+/// One decoded datagram. Only the body of `header.type` is meaningful.
+struct Packet {
+  Header header;
+  Hello hello;
+  HelloReply hello_reply;
+  InputBody input;
+  PingBody ping;  ///< ping and pong
+};
+
+/// Why a datagram was dropped.
+enum class DecodeError : std::uint8_t {
+  none = 0,
+  too_short,     ///< shorter than a header and trailer
+  too_long,      ///< longer than max_datagram
+  bad_magic,     ///< not a detsim datagram
+  bad_version,   ///< another protocol version
+  bad_type,      ///< an unknown packet type
+  bad_checksum,  ///< corrupted on the way
+  bad_length,    ///< the body is shorter or longer than its fields say
+  bad_field,     ///< a field out of its range (a count, an input size, a run past the end)
+};
+inline constexpr std::size_t decode_error_count = 9;
+
+/// A short name for logs and statistics ("bad_checksum").
+[[nodiscard]] std::string_view to_string(DecodeError error) noexcept;
+
+/// Decodes `bytes`, whose inputs (if any) are `input_size` bytes each (1 .. max_input_size).
+/// On success fills `out` and returns DecodeError::none; otherwise `out` is unspecified.
+[[nodiscard]] DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size,
+                                 Packet& out);
+
+/// Encodes `packet` (the body of packet.header.type) into `out`, replacing its contents. Returns
+/// false, leaving `out` empty, when it would exceed max_datagram or a field is out of range
+/// (count or deltas inconsistent with input_size, too many checks): a session bug, never input.
+[[nodiscard]] bool encode(const Packet& packet, std::size_t input_size,
+                          std::vector<std::uint8_t>& out);
+
+/// The XOR deltas of `inputs` (whole inputs of input_size bytes) against `reference` (one input,
+/// the receiver's input before the first) and each input against the one before it.
+void delta_encode(std::span<const std::uint8_t> reference, std::span<const std::uint8_t> inputs,
+                  std::vector<std::uint8_t>& deltas);
+/// The inverse of delta_encode: `deltas` back into inputs, in place.
+void delta_decode(std::span<const std::uint8_t> reference, std::span<std::uint8_t> deltas);
+
+}  // namespace detsim::net::protocol

@@ -1,0 +1,44 @@
+// detsim::net::ScenarioGame: the Game adapter that lets a session drive a detsim Scenario (and so
+// its World) directly: save and load are World::save / World::restore, the hash is the frame's
+// state hash, and each player's input is a PlayerInput in its 3-byte canonical encoding.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <detsim/net/game.hpp>
+#include <detsim/sim/scenario.hpp>
+
+namespace detsim::net {
+
+class ScenarioGame final : public Game {
+ public:
+  /// The input size of a scenario session: PlayerInput's canonical encoding.
+  static constexpr std::uint32_t input_size = PlayerInput::encoded_size;
+
+  /// Drives `scenario`, which must outlive this adapter.
+  explicit ScenarioGame(Scenario& scenario) noexcept : scenario_(&scenario) {}
+
+  std::uint64_t save(std::vector<std::uint8_t>& state) override;
+  /// Restores a state save() wrote. A state that does not restore (never the case for bytes this
+  /// adapter saved) leaves the world unchanged and is counted by failed_loads().
+  void load(std::span<const std::uint8_t> state) override;
+  /// Steps the scenario with every player's decoded input; a disconnected player's is neutral.
+  void advance(const FrameInputs& inputs, bool resimulating) override;
+
+  [[nodiscard]] Scenario& scenario() noexcept { return *scenario_; }
+  [[nodiscard]] std::uint64_t failed_loads() const noexcept { return failed_loads_; }
+  /// Frames stepped for the first time, and again after rollbacks.
+  [[nodiscard]] std::uint64_t frames_simulated() const noexcept { return simulated_; }
+  [[nodiscard]] std::uint64_t frames_resimulated() const noexcept { return resimulated_; }
+
+ private:
+  Scenario* scenario_;
+  std::vector<PlayerInput> inputs_;
+  std::uint64_t failed_loads_ = 0;
+  std::uint64_t simulated_ = 0;
+  std::uint64_t resimulated_ = 0;
+};
+
+}  // namespace detsim::net

@@ -1,0 +1,210 @@
+// detsim::net::Session: a peer-to-peer match in rollback (GGPO-style) or lockstep mode, for 1 to 8
+// players, one of them local, over any Transport (docs/NET.md has a complete integration example).
+//
+// Each tick the game calls
+//
+//     session.poll(now_us);                              // network in and out, timers
+//     auto r = session.advance_frame(local_input);       // may load, re-simulate and advance
+//     for (const net::Event& e : session.take_events()) ...
+//
+// Rollback mode: the local input is queued for frame current + input_delay and sent to every peer;
+// a remote input not yet received is predicted (the player's last confirmed input, or a custom
+// predictor); when a confirmed input differs from the prediction the game simulated, the session
+// loads the state of that first incorrect frame and re-simulates to the present, inside the same
+// advance_frame() call. At most max_prediction frames run ahead of the last frame every input is
+// confirmed for; at that limit advance_frame() returns Advance::prediction_limit and simulates
+// nothing new, but still performs any pending rollback (so the limit never loses a correction).
+//
+// Lockstep mode: frame F is simulated only when every player's input for F is confirmed; nothing is
+// predicted and nothing is rolled back.
+//
+// Desync detection compares only confirmed frames: every check_interval frames each peer sends the
+// hash of its state after the frame whose inputs were all confirmed, reliably (resent until
+// acknowledged). A different hash raises Event::desync with both hashes, and the session keeps this
+// machine's state at the last agreed frame and at the divergent one (desync_evidence()).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include <detsim/net/game.hpp>
+#include <detsim/net/protocol.hpp>
+#include <detsim/net/transport.hpp>
+#include <detsim/sim/status.hpp>
+
+namespace detsim::net {
+
+enum class SessionMode : std::uint8_t { rollback, lockstep };
+
+/// A remote player and the transport peer that plays it.
+struct RemotePlayer {
+  std::uint32_t player = 0;
+  PeerId peer = 0;
+};
+
+/// A session's settings: plain data with defaults. create() names the first invalid field.
+struct SessionConfig {
+  SessionMode mode = SessionMode::rollback;
+  std::uint32_t players = 2;          ///< 1 .. 8
+  std::uint32_t local_player = 0;     ///< 0 .. players - 1
+  std::uint32_t input_size = 4;       ///< bytes per input: 1 .. protocol::max_input_size
+  std::uint32_t input_delay = 2;      ///< frames: 0 .. 16 (set_input_delay() changes it later)
+  std::uint32_t max_prediction = 8;   ///< rollback mode: 1 .. 32 frames; lockstep ignores it
+  std::uint32_t check_interval = 30;  ///< desync check every N confirmed frames; 0: none
+  /// What every peer must agree on to play together (the game's settings, version, scenario): a
+  /// hello with another fingerprint is rejected. Use a hash of the replay fingerprint.
+  std::uint64_t fingerprint = 0;
+  /// Seeds this session's nonce and handshake challenges. Give each session a fresh random value
+  /// (from the operating system) in a real game; a fixed value in tests.
+  std::uint64_t random_seed = 0;
+  std::uint32_t frame_us = 16'667;  ///< the nominal frame duration (time sync): 1000 .. 1'000'000
+  std::uint64_t hello_interval_us = 200'000;  ///< handshake resend interval
+  std::uint64_t keepalive_us = 100'000;       ///< the longest silence towards a peer
+  std::uint64_t ping_interval_us = 250'000;
+  std::uint64_t disconnect_warning_us = 500'000;    ///< silence before Event::interrupted
+  std::uint64_t disconnect_timeout_us = 5'000'000;  ///< silence before Event::disconnected
+  std::vector<RemotePlayer> remotes;                ///< every other player, each exactly once
+};
+
+/// What advance_frame() did.
+enum class Advance : std::uint8_t {
+  advanced,            ///< simulated one new frame (after any rollback)
+  synchronizing,       ///< the handshake with some peer is not done; nothing simulated
+  prediction_limit,    ///< rollback: max_prediction frames ahead of the confirmed inputs
+  waiting_for_inputs,  ///< lockstep: some input of the next frame has not arrived
+};
+
+enum class EventType : std::uint8_t {
+  synchronized,    ///< the handshake with `player` completed
+  running,         ///< every peer is synchronized: frames can advance
+  interrupted,     ///< `player` has been silent for disconnect_warning_us
+  resumed,         ///< `player` was heard from again after an interruption
+  disconnected,    ///< `player` was silent for disconnect_timeout_us: its inputs are zero from
+                   ///< `frame` on (InputStatus::disconnected)
+  desync,          ///< `player` hashed confirmed frame `frame` differently
+  hello_rejected,  ///< a hello from `player`'s peer did not match this session (`reason`)
+};
+
+struct Event {
+  EventType type = EventType::running;
+  std::uint32_t player = 0;
+  std::uint64_t frame = 0;
+  std::uint64_t local_hash = 0;   ///< desync: this machine's hash of `frame`
+  std::uint64_t remote_hash = 0;  ///< desync: the peer's
+  std::string_view reason;        ///< hello_rejected: what differed
+};
+
+/// A frame whose inputs are all final, in frame order, each once: what a replay records.
+struct ConfirmedFrame {
+  std::uint64_t frame = 0;  ///< the step (0 is the first); the state after it is frame + 1
+  std::span<const std::uint8_t> inputs;  ///< players * input_size
+  std::span<const InputStatus> status;
+  std::uint64_t hash = 0;  ///< of the state after the step
+};
+
+/// This machine's side of the first desync: what a desync report needs.
+struct DesyncEvidence {
+  std::uint32_t player = 0;        ///< the peer that disagreed
+  std::uint64_t agreed_frame = 0;  ///< the last state frame every peer agreed on (0: the start)
+  std::vector<std::uint8_t> agreed_state;  ///< empty when agreed_frame is 0 and none was kept
+  std::uint64_t divergent_frame = 0;
+  std::vector<std::uint8_t> divergent_state;
+  std::uint64_t local_hash = 0;
+  std::uint64_t remote_hash = 0;
+};
+
+struct PeerStats {
+  std::uint32_t player = 0;
+  bool synchronized = false;
+  bool disconnected = false;
+  std::uint64_t ping_us = 0;       ///< smoothed round-trip time
+  std::uint64_t jitter_us = 0;     ///< smoothed deviation of the round-trip time
+  std::int64_t frames_ahead = 0;   ///< how many frames this machine is ahead of the peer (estimate)
+  std::uint64_t remote_frame = 0;  ///< the peer's frame as last reported
+  std::uint64_t packets_sent = 0;
+  std::uint64_t packets_received = 0;
+  std::uint64_t packets_lost = 0;  ///< gaps in the peer's sequence numbers
+  std::uint64_t bytes_sent = 0;    ///< payload bytes (without IP/UDP headers)
+  std::uint64_t bytes_received = 0;
+};
+
+struct SessionStats {
+  std::uint64_t frames = 0;  ///< frames simulated for the first time
+  std::uint64_t rollbacks = 0;
+  std::uint64_t resimulated_frames = 0;
+  std::uint64_t prediction_limit_waits = 0;  ///< advance_frame() calls that hit the limit
+  std::uint64_t dropped_inputs = 0;          ///< local inputs dropped when the input delay shrank
+  /// Received datagrams dropped by the decoder, by protocol::DecodeError.
+  std::array<std::uint64_t, protocol::decode_error_count> dropped_malformed{};
+  std::uint64_t dropped_wrong_session = 0;  ///< a nonce or peer this session does not know
+  std::uint64_t dropped_out_of_window = 0;  ///< frames outside what the session can hold
+};
+
+/// Predicts a remote player's input for a frame not received yet: writes the prediction to `out`
+/// given the player's last confirmed input (all zero before the first). Must be a pure function of
+/// its arguments, so that every re-simulation predicts alike.
+using Predictor = std::function<void(std::uint32_t player, std::span<const std::uint8_t> last,
+                                     std::span<std::uint8_t> out)>;
+
+class Session {
+ public:
+  /// A session driving `game` over `transport`; both must outlive it. Saves the game's state as
+  /// frame 0. Errors name the first invalid field of `config`.
+  static Expected<Session> create(const SessionConfig& config, Game& game, Transport& transport);
+  Session(Session&&) noexcept;
+  Session& operator=(Session&&) noexcept;
+  ~Session();
+
+  /// Receives and handles every pending datagram, then sends what is due (handshake, inputs,
+  /// acknowledgements, hash checks, pings, keepalives) and raises timeouts. A correction that
+  /// arrived is applied here (the game loads and re-simulates), and newly confirmed frames are
+  /// handed to the confirmed listener. `now_us` is a
+  /// monotonic clock in microseconds; it must not go backwards (an earlier value counts as the
+  /// last one).
+  void poll(std::uint64_t now_us);
+
+  /// Queues `local_input` (input_size bytes) for frame current_frame() + input_delay, performs a
+  /// pending rollback, and simulates the next frame if the mode allows. An input for a frame that
+  /// already has one (while waiting, or after the delay shrank) is dropped. An error (nothing
+  /// changes) when the input has the wrong size.
+  Expected<Advance> advance_frame(std::span<const std::uint8_t> local_input);
+
+  /// Changes the input delay from the next local input on (0 .. 16). Growing it repeats that
+  /// input to fill the gap; shrinking it drops local inputs until the gap closes.
+  Status set_input_delay(std::uint32_t frames);
+  /// A custom prediction of remote inputs (default: repeat the last confirmed input).
+  void set_predictor(Predictor predictor);
+  /// Called for every confirmed frame, in order (what replays record).
+  void set_confirmed_listener(std::function<void(const ConfirmedFrame&)> listener);
+
+  /// Moves the events raised since the last call out, oldest first.
+  [[nodiscard]] std::vector<Event> take_events();
+
+  [[nodiscard]] const SessionConfig& config() const noexcept;
+  [[nodiscard]] bool running() const noexcept;
+  /// The next frame to simulate: the game's state is at this frame.
+  [[nodiscard]] std::uint64_t current_frame() const noexcept;
+  /// Every frame before this one has all inputs confirmed (disconnected players count as
+  /// confirmed).
+  [[nodiscard]] std::uint64_t confirmed_frame() const noexcept;
+  /// Frames the game should skip (not advance) to let slower peers catch up: 0 when in time.
+  [[nodiscard]] std::uint32_t recommended_wait_frames() const noexcept;
+  [[nodiscard]] const SessionStats& stats() const noexcept;
+  /// The statistics of the peer playing `player`; nothing for the local player or an unknown one.
+  [[nodiscard]] std::optional<PeerStats> peer_stats(std::uint32_t player) const;
+  /// This machine's side of the first desync, once one was detected.
+  [[nodiscard]] const DesyncEvidence* desync_evidence() const noexcept;
+
+ private:
+  struct Impl;
+  explicit Session(std::unique_ptr<Impl> impl) noexcept;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace detsim::net

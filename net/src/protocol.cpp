@@ -1,0 +1,265 @@
+// The session wire protocol: encoding and the validating decoder (layout in protocol.hpp).
+//
+// Written by hand rather than with a serialisation library: the bytes on the wire are part of the
+// determinism contract (a peer on another CPU must read exactly what was meant) and every field
+// must be range-checked before use, so the decoder is a plain little-endian reader with an error
+// code per failure and no allocation beyond the packet's own bounded vectors.
+#include <detsim/net/protocol.hpp>
+
+#include <xxhash.h>
+
+#include <algorithm>
+
+namespace detsim::net::protocol {
+namespace {
+
+class Reader {
+ public:
+  explicit Reader(std::span<const std::uint8_t> bytes) noexcept : bytes_(bytes) {}
+
+  [[nodiscard]] bool ok() const noexcept { return ok_; }
+  [[nodiscard]] std::size_t remaining() const noexcept { return bytes_.size() - at_; }
+  [[nodiscard]] bool at_end() const noexcept { return at_ == bytes_.size(); }
+
+  std::uint64_t get(std::size_t n) noexcept {
+    if (!ok_ || n > remaining()) {
+      ok_ = false;
+      return 0;
+    }
+    std::uint64_t v = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      v |= std::uint64_t{bytes_[at_ + i]} << (8 * i);
+    at_ += n;
+    return v;
+  }
+  std::uint8_t u8() noexcept { return static_cast<std::uint8_t>(get(1)); }
+  std::uint16_t u16() noexcept { return static_cast<std::uint16_t>(get(2)); }
+  std::uint32_t u32() noexcept { return static_cast<std::uint32_t>(get(4)); }
+  std::uint64_t u64() noexcept { return get(8); }
+
+ private:
+  std::span<const std::uint8_t> bytes_;
+  std::size_t at_ = 0;
+  bool ok_ = true;
+};
+
+void put(std::vector<std::uint8_t>& out, std::uint64_t v, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i)
+    out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+}
+
+std::uint32_t checksum(std::span<const std::uint8_t> bytes) noexcept {
+  return static_cast<std::uint32_t>(XXH3_64bits(bytes.data(), bytes.size()));
+}
+
+// Run-length tokens over the XOR deltas: t < 128 -> t + 1 literals follow; t >= 128 -> t - 127
+// zero bytes. Inputs are small and mostly unchanged between frames, so zero runs dominate.
+void run_length_encode(std::span<const std::uint8_t> bytes, std::vector<std::uint8_t>& out) {
+  std::size_t i = 0;
+  while (i < bytes.size()) {
+    if (bytes[i] == 0) {
+      std::size_t run = 1;
+      while (i + run < bytes.size() && bytes[i + run] == 0 && run < 128)
+        ++run;
+      out.push_back(static_cast<std::uint8_t>(127 + run));
+      i += run;
+    } else {
+      std::size_t run = 1;
+      while (i + run < bytes.size() && bytes[i + run] != 0 && run < 128)
+        ++run;
+      out.push_back(static_cast<std::uint8_t>(run - 1));
+      out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(i),
+                 bytes.begin() + static_cast<std::ptrdiff_t>(i + run));
+      i += run;
+    }
+  }
+}
+
+// Decodes tokens until exactly `length` bytes are produced; a run that would pass `length` is
+// a bad field, never a write past the buffer.
+bool run_length_decode(Reader& in, std::size_t length, std::vector<std::uint8_t>& out) {
+  out.assign(length, 0);
+  std::size_t at = 0;
+  while (at < length) {
+    const std::uint8_t token = in.u8();
+    if (!in.ok()) return false;
+    if (token >= 128) {
+      const std::size_t run = token - 127U;
+      if (run > length - at) return false;
+      at += run;  // already zero
+    } else {
+      const std::size_t run = token + 1U;
+      if (run > length - at || run > in.remaining()) return false;
+      for (std::size_t k = 0; k < run; ++k)
+        out[at + k] = in.u8();
+      at += run;
+    }
+  }
+  return true;
+}
+
+bool body_ok(const Packet& p, std::size_t input_size) {
+  if (p.header.type != PacketType::input) return true;
+  const InputBody& b = p.input;
+  return b.deltas.size() == std::size_t{b.count} * input_size &&
+         b.checks.size() <= max_checks_per_packet;
+}
+
+}  // namespace
+
+std::string_view to_string(DecodeError error) noexcept {
+  switch (error) {
+    case DecodeError::none:
+      return "none";
+    case DecodeError::too_short:
+      return "too_short";
+    case DecodeError::too_long:
+      return "too_long";
+    case DecodeError::bad_magic:
+      return "bad_magic";
+    case DecodeError::bad_version:
+      return "bad_version";
+    case DecodeError::bad_type:
+      return "bad_type";
+    case DecodeError::bad_checksum:
+      return "bad_checksum";
+    case DecodeError::bad_length:
+      return "bad_length";
+    case DecodeError::bad_field:
+      return "bad_field";
+  }
+  return "unknown";
+}
+
+bool encode(const Packet& packet, std::size_t input_size, std::vector<std::uint8_t>& out) {
+  out.clear();
+  if (input_size == 0 || input_size > max_input_size || !body_ok(packet, input_size)) return false;
+  out.push_back(magic0);
+  out.push_back(magic1);
+  out.push_back(version);
+  out.push_back(static_cast<std::uint8_t>(packet.header.type));
+  put(out, packet.header.nonce, 4);
+  put(out, packet.header.sequence, 2);
+  switch (packet.header.type) {
+    case PacketType::hello:
+      put(out, packet.hello.fingerprint, 8);
+      out.push_back(packet.hello.players);
+      out.push_back(packet.hello.player);
+      out.push_back(packet.hello.input_size);
+      put(out, packet.hello.challenge, 4);
+      break;
+    case PacketType::hello_reply:
+      put(out, packet.hello_reply.challenge, 4);
+      break;
+    case PacketType::input: {
+      const InputBody& b = packet.input;
+      put(out, b.ack_frame, 4);
+      put(out, b.check_ack, 4);
+      put(out, b.current_frame, 4);
+      out.push_back(static_cast<std::uint8_t>(b.advantage));
+      put(out, b.start_frame, 4);
+      out.push_back(b.count);
+      run_length_encode(b.deltas, out);
+      out.push_back(static_cast<std::uint8_t>(b.checks.size()));
+      for (const HashCheck& c : b.checks) {
+        put(out, c.frame, 4);
+        put(out, c.hash, 8);
+      }
+      break;
+    }
+    case PacketType::ping:
+    case PacketType::pong:
+      put(out, packet.ping.time_us, 8);
+      break;
+    default:
+      out.clear();
+      return false;
+  }
+  if (out.size() + trailer_size > max_datagram) {
+    out.clear();
+    return false;
+  }
+  put(out, checksum(out), 4);
+  return true;
+}
+
+DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, Packet& out) {
+  if (bytes.size() > max_datagram) return DecodeError::too_long;
+  if (bytes.size() < header_size + trailer_size) return DecodeError::too_short;
+  if (bytes[0] != magic0 || bytes[1] != magic1) return DecodeError::bad_magic;
+  if (bytes[2] != version) return DecodeError::bad_version;
+  if (bytes[3] < static_cast<std::uint8_t>(PacketType::hello) ||
+      bytes[3] > static_cast<std::uint8_t>(PacketType::pong))
+    return DecodeError::bad_type;
+  const std::span<const std::uint8_t> signed_part = bytes.first(bytes.size() - trailer_size);
+  Reader trailer(bytes.last(trailer_size));
+  if (trailer.u32() != checksum(signed_part)) return DecodeError::bad_checksum;
+  if (input_size == 0 || input_size > max_input_size) return DecodeError::bad_field;
+
+  Reader in(signed_part);
+  in.get(4);  // magic, version, type: checked above
+  out.header.type = static_cast<PacketType>(bytes[3]);
+  out.header.nonce = in.u32();
+  out.header.sequence = in.u16();
+  switch (out.header.type) {
+    case PacketType::hello:
+      out.hello.fingerprint = in.u64();
+      out.hello.players = in.u8();
+      out.hello.player = in.u8();
+      out.hello.input_size = in.u8();
+      out.hello.challenge = in.u32();
+      break;
+    case PacketType::hello_reply:
+      out.hello_reply.challenge = in.u32();
+      break;
+    case PacketType::input: {
+      InputBody& b = out.input;
+      b.ack_frame = in.u32();
+      b.check_ack = in.u32();
+      b.current_frame = in.u32();
+      b.advantage = static_cast<std::int8_t>(in.u8());
+      b.start_frame = in.u32();
+      b.count = in.u8();
+      if (!in.ok()) return DecodeError::bad_length;
+      // count <= 255 and input_size <= 64 bound the allocation to 16 KiB whatever the bytes say.
+      if (!run_length_decode(in, std::size_t{b.count} * input_size, b.deltas))
+        return in.ok() ? DecodeError::bad_field : DecodeError::bad_length;
+      const std::uint8_t checks = in.u8();
+      if (!in.ok()) return DecodeError::bad_length;
+      if (checks > max_checks_per_packet) return DecodeError::bad_field;
+      if (in.remaining() != std::size_t{checks} * 12U) return DecodeError::bad_length;
+      b.checks.resize(checks);
+      for (HashCheck& c : b.checks) {
+        c.frame = in.u32();
+        c.hash = in.u64();
+      }
+      break;
+    }
+    case PacketType::ping:
+    case PacketType::pong:
+      out.ping.time_us = in.u64();
+      break;
+  }
+  if (!in.ok() || !in.at_end()) return DecodeError::bad_length;
+  return DecodeError::none;
+}
+
+void delta_encode(std::span<const std::uint8_t> reference, std::span<const std::uint8_t> inputs,
+                  std::vector<std::uint8_t>& deltas) {
+  const std::size_t size = reference.size();
+  deltas.resize(inputs.size());
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const std::uint8_t previous = i < size ? reference[i] : inputs[i - size];
+    deltas[i] = static_cast<std::uint8_t>(inputs[i] ^ previous);
+  }
+}
+
+void delta_decode(std::span<const std::uint8_t> reference, std::span<std::uint8_t> deltas) {
+  const std::size_t size = reference.size();
+  for (std::size_t i = 0; i < deltas.size(); ++i) {
+    const std::uint8_t previous = i < size ? reference[i] : deltas[i - size];
+    deltas[i] = static_cast<std::uint8_t>(deltas[i] ^ previous);
+  }
+}
+
+}  // namespace detsim::net::protocol

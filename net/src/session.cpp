@@ -1,0 +1,336 @@
+// The session's frame loop: local inputs, prediction, rollback, confirmed frames and desync checks.
+// The network side (handshake, packets, timers) is session_wire.cpp.
+//
+// Frame numbering: the game's state is "at frame F" after F steps; step F turns state F into
+// F + 1 using every player's input for frame F. After each step the session saves state F + 1 in a
+// ring of max_prediction + 3 states, so the oldest frame a correction can reach is always held.
+#include <algorithm>
+#include <string>
+
+#include "session_impl.hpp"
+
+namespace detsim::net {
+namespace {
+
+using detail::never;
+constexpr std::uint32_t max_players = 8;
+constexpr std::uint32_t max_input_delay = 16;
+constexpr std::uint32_t max_prediction_limit = 32;
+
+Status validate(const SessionConfig& c) {
+  const auto bad = [](const std::string& what) { return Status::error("session config: " + what); };
+  if (c.players < 1 || c.players > max_players)
+    return bad("players must be 1 .. 8, got " + std::to_string(c.players));
+  if (c.local_player >= c.players)
+    return bad("local_player must be below players (" + std::to_string(c.players) + "), got " +
+               std::to_string(c.local_player));
+  if (c.input_size < 1 || c.input_size > protocol::max_input_size)
+    return bad("input_size must be 1 .. 64 bytes, got " + std::to_string(c.input_size));
+  if (c.input_delay > max_input_delay)
+    return bad("input_delay must be 0 .. 16 frames, got " + std::to_string(c.input_delay));
+  if (c.mode == SessionMode::rollback &&
+      (c.max_prediction < 1 || c.max_prediction > max_prediction_limit))
+    return bad("max_prediction must be 1 .. 32 frames in rollback mode, got " +
+               std::to_string(c.max_prediction));
+  if (c.frame_us < 1000 || c.frame_us > 1'000'000)
+    return bad("frame_us must be 1000 .. 1000000, got " + std::to_string(c.frame_us));
+  if (c.hello_interval_us == 0 || c.keepalive_us == 0 || c.ping_interval_us == 0)
+    return bad("hello_interval_us, keepalive_us and ping_interval_us must be > 0");
+  if (c.disconnect_warning_us == 0 || c.disconnect_timeout_us <= c.disconnect_warning_us)
+    return bad("disconnect_timeout_us must exceed disconnect_warning_us, which must be > 0");
+  if (c.remotes.size() != c.players - 1)
+    return bad("remotes must list every other player once: expected " +
+               std::to_string(c.players - 1) + ", got " + std::to_string(c.remotes.size()));
+  std::vector<bool> seen(c.players, false);
+  seen[c.local_player] = true;
+  std::vector<PeerId> ids;
+  for (const RemotePlayer& r : c.remotes) {
+    if (r.player >= c.players || seen[r.player])
+      return bad("remotes: player " + std::to_string(r.player) +
+                 " is out of range, local, or listed twice");
+    seen[r.player] = true;
+    ids.push_back(r.peer);
+  }
+  std::sort(ids.begin(), ids.end());
+  if (std::adjacent_find(ids.begin(), ids.end()) != ids.end())
+    return bad("remotes: two players share one peer id");
+  return Status::success();
+}
+
+}  // namespace
+
+Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
+    : config(c),
+      game(&g),
+      transport(&t),
+      max_prediction(c.mode == SessionMode::lockstep ? 0 : c.max_prediction),
+      rng(c.random_seed) {
+  nonce = static_cast<std::uint32_t>(rng.next_u64());
+  for (std::uint32_t p = 0; p < c.players; ++p)
+    queues.emplace_back(c.input_size, detail::input_capacity);
+  disconnect_frame.assign(c.players, never);
+  std::vector<RemotePlayer> remotes = c.remotes;
+  std::sort(remotes.begin(), remotes.end(),
+            [](const RemotePlayer& a, const RemotePlayer& b) { return a.player < b.player; });
+  for (const RemotePlayer& r : remotes) {
+    detail::Peer peer;
+    peer.player = r.player;
+    peer.id = r.peer;
+    peer.challenge = static_cast<std::uint32_t>(rng.next_u64());
+    peer.stats.player = r.player;
+    peers.push_back(std::move(peer));
+  }
+  states.resize(max_prediction + 3U);
+  frame_inputs.resize(std::size_t{c.players} * c.input_size);
+  frame_status.resize(c.players);
+  scratch_input.resize(c.input_size);
+  running = peers.empty();
+  detail::State& zero = state_slot(0);
+  zero.frame = 0;
+  zero.hash = game->save(zero.bytes);
+}
+
+std::uint64_t Session::Impl::confirmed_frame() const noexcept {
+  std::uint64_t frame = never;
+  for (std::size_t p = 0; p < queues.size(); ++p)
+    if (disconnect_frame[p] == never) frame = std::min(frame, queues[p].next_confirmed());
+  return frame == never ? current : frame;
+}
+
+std::uint64_t Session::Impl::window_start() const noexcept {
+  const std::uint64_t oldest = std::min(next_emit, current);
+  return oldest == 0 ? 0 : oldest - 1;
+}
+
+void Session::Impl::add_local_input(std::span<const std::uint8_t> input) {
+  detail::InputQueue& q = queues[config.local_player];
+  const std::uint64_t target = current + config.input_delay;
+  if (target < q.next_confirmed()) {
+    ++stats.dropped_inputs;  // the delay shrank: this frame already has an input
+    return;
+  }
+  while (q.next_confirmed() <= target)
+    q.confirm(input);  // fills the gap when the delay grew
+}
+
+void Session::Impl::simulate(std::uint64_t frame, bool resimulating) {
+  const std::size_t size = config.input_size;
+  for (std::uint32_t p = 0; p < config.players; ++p) {
+    detail::InputQueue& q = queues[p];
+    std::span<const std::uint8_t> input;
+    if (frame >= disconnect_frame[p]) {
+      std::fill(scratch_input.begin(), scratch_input.end(), std::uint8_t{0});
+      input = scratch_input;
+      frame_status[p] = InputStatus::disconnected;
+    } else if (frame < q.next_confirmed()) {
+      input = q.confirmed(frame);
+      frame_status[p] = InputStatus::confirmed;
+    } else {
+      const std::span<std::uint8_t> guess = q.used_mut(frame);
+      if (predictor) {
+        predictor(p, q.last_confirmed(), guess);
+      } else {
+        const std::span<const std::uint8_t> last = q.last_confirmed();
+        std::copy(last.begin(), last.end(), guess.begin());
+      }
+      input = guess;
+      frame_status[p] = InputStatus::predicted;
+    }
+    std::copy(input.begin(), input.end(),
+              frame_inputs.begin() + static_cast<std::ptrdiff_t>(p * size));
+  }
+  game->advance(FrameInputs{frame, size, frame_inputs, frame_status}, resimulating);
+  current = frame + 1;
+  detail::State& saved = state_slot(current);
+  saved.frame = current;
+  saved.hash = game->save(saved.bytes);
+}
+
+void Session::Impl::rollback() {
+  const std::uint64_t from = *first_incorrect;
+  first_incorrect.reset();
+  const detail::State& saved = state_slot(from);
+  // The window guarantees the state is held: a correction is never older than the oldest
+  // unconfirmed frame, and the ring spans the whole prediction window.
+  if (saved.frame != from) return;
+  game->load(saved.bytes);
+  const std::uint64_t end = current;
+  for (std::uint64_t frame = from; frame < end; ++frame)
+    simulate(frame, true);
+  ++stats.rollbacks;
+  stats.resimulated_frames += end - from;
+}
+
+void Session::Impl::emit_confirmed() {
+  // A frame is final once its inputs are all confirmed, it was simulated, and no pending
+  // correction reaches back to it (states after first_incorrect are re-simulated first).
+  const std::uint64_t limit =
+      std::min({confirmed_frame(), current, first_incorrect.value_or(detail::never)});
+  const std::size_t size = config.input_size;
+  for (; next_emit < limit; ++next_emit) {
+    const std::uint64_t frame = next_emit;
+    for (std::uint32_t p = 0; p < config.players; ++p) {
+      const bool gone = frame >= disconnect_frame[p];
+      frame_status[p] = gone ? InputStatus::disconnected : InputStatus::confirmed;
+      const auto out = frame_inputs.begin() + static_cast<std::ptrdiff_t>(p * size);
+      if (gone) {
+        std::fill_n(out, size, std::uint8_t{0});
+      } else {
+        const std::span<const std::uint8_t> input = queues[p].confirmed(frame);
+        std::copy(input.begin(), input.end(), out);
+      }
+    }
+    const detail::State& after = state_slot(frame + 1);
+    const bool held = after.frame == frame + 1;
+    const std::uint64_t hash = held ? after.hash : 0;
+    if (confirmed_listener)
+      confirmed_listener(ConfirmedFrame{frame, frame_inputs, frame_status, hash});
+    if (config.check_interval != 0 && (frame + 1) % config.check_interval == 0 && held)
+      add_local_check(frame + 1, hash, &after);
+  }
+}
+
+void Session::Impl::add_local_check(std::uint64_t frame, std::uint64_t hash,
+                                    const detail::State* state) {
+  if (peers.empty()) return;
+  if (local_checks.size() >= detail::max_pending_checks) local_checks.pop_front();
+  local_checks.push_back(detail::LocalCheck{frame, hash, state->bytes});
+  for (detail::Peer& peer : peers)
+    compare_checks(peer);
+  retire_checks();
+}
+
+void Session::Impl::compare_checks(detail::Peer& peer) {
+  while (!peer.pending_checks.empty()) {
+    const protocol::HashCheck remote = peer.pending_checks.front();
+    if (local_checks.empty() || remote.frame > local_checks.back().frame) return;  // not yet here
+    const auto local =
+        std::find_if(local_checks.begin(), local_checks.end(),
+                     [&](const detail::LocalCheck& c) { return c.frame == remote.frame; });
+    peer.pending_checks.pop_front();
+    if (local == local_checks.end() || local->hash == remote.hash || peer.desynced) continue;
+    peer.desynced = true;
+    raise(Event{EventType::desync, peer.player, remote.frame, local->hash, remote.hash, {}});
+    if (!evidence) {
+      evidence = DesyncEvidence{peer.player,  agreed_frame, agreed_state, remote.frame,
+                                local->state, local->hash,  remote.hash};
+    }
+  }
+}
+
+void Session::Impl::retire_checks() {
+  while (!local_checks.empty()) {
+    const std::uint64_t frame = local_checks.front().frame;
+    bool everyone = true;
+    for (const detail::Peer& peer : peers) {
+      if (peer.disconnected) continue;
+      const bool compared =
+          peer.checks_through >= frame &&
+          (peer.pending_checks.empty() || peer.pending_checks.front().frame > frame);
+      if (!compared || peer.desynced) everyone = false;
+    }
+    if (!everyone) return;
+    agreed_frame = frame;
+    agreed_state = std::move(local_checks.front().state);
+    local_checks.pop_front();
+  }
+}
+
+void Session::Impl::receive_input(detail::Peer& peer, std::uint64_t frame,
+                                  std::span<const std::uint8_t> input) {
+  detail::InputQueue& q = queues[peer.player];
+  if (frame < current && !std::equal(input.begin(), input.end(), q.used(frame).begin()))
+    first_incorrect = std::min(first_incorrect.value_or(frame), frame);
+  q.confirm(input);
+}
+
+void Session::Impl::disconnect(detail::Peer& peer) {
+  peer.disconnected = true;
+  peer.stats.disconnected = true;
+  const std::uint64_t from = queues[peer.player].next_confirmed();
+  disconnect_frame[peer.player] = from;
+  // Frames from `from` on were simulated with predictions; they now take zero inputs.
+  if (from < current) first_incorrect = std::min(first_incorrect.value_or(from), from);
+  raise(Event{EventType::disconnected, peer.player, from, 0, 0, {}});
+  retire_checks();
+}
+
+// ---- the public face ----
+
+Expected<Session> Session::create(const SessionConfig& config, Game& game, Transport& transport) {
+  if (Status s = validate(config); !s) return s;
+  return Session(std::make_unique<Impl>(config, game, transport));
+}
+
+Session::Session(std::unique_ptr<Impl> impl) noexcept : impl_(std::move(impl)) {}
+Session::Session(Session&&) noexcept = default;
+Session& Session::operator=(Session&&) noexcept = default;
+Session::~Session() = default;
+
+Expected<Advance> Session::advance_frame(std::span<const std::uint8_t> local_input) {
+  Impl& s = *impl_;
+  if (local_input.size() != s.config.input_size)
+    return Status::error("advance_frame: the local input must be " +
+                         std::to_string(s.config.input_size) + " bytes, got " +
+                         std::to_string(local_input.size()));
+  if (!s.running) return Advance::synchronizing;
+  const std::uint64_t before = s.queues[s.config.local_player].next_confirmed();
+  s.add_local_input(local_input);
+  if (s.queues[s.config.local_player].next_confirmed() != before)
+    for (detail::Peer& peer : s.peers)
+      if (peer.synchronized && !peer.disconnected) s.send_inputs(peer);
+  if (s.first_incorrect) s.rollback();
+  s.emit_confirmed();
+  if (s.current >= s.confirmed_frame() + s.max_prediction) {
+    if (s.max_prediction == 0) return Advance::waiting_for_inputs;
+    ++s.stats.prediction_limit_waits;
+    return Advance::prediction_limit;
+  }
+  s.simulate(s.current, false);
+  ++s.stats.frames;
+  s.emit_confirmed();
+  return Advance::advanced;
+}
+
+Status Session::set_input_delay(std::uint32_t frames) {
+  if (frames > max_input_delay)
+    return Status::error("input delay must be 0 .. 16 frames, got " + std::to_string(frames));
+  impl_->config.input_delay = frames;
+  return Status::success();
+}
+
+void Session::set_predictor(Predictor predictor) {
+  impl_->predictor = std::move(predictor);
+}
+
+void Session::set_confirmed_listener(std::function<void(const ConfirmedFrame&)> listener) {
+  impl_->confirmed_listener = std::move(listener);
+}
+
+std::vector<Event> Session::take_events() {
+  std::vector<Event> out;
+  out.swap(impl_->events);
+  return out;
+}
+
+const SessionConfig& Session::config() const noexcept {
+  return impl_->config;
+}
+bool Session::running() const noexcept {
+  return impl_->running;
+}
+std::uint64_t Session::current_frame() const noexcept {
+  return impl_->current;
+}
+std::uint64_t Session::confirmed_frame() const noexcept {
+  return impl_->confirmed_frame();
+}
+const SessionStats& Session::stats() const noexcept {
+  return impl_->stats;
+}
+
+const DesyncEvidence* Session::desync_evidence() const noexcept {
+  return impl_->evidence ? &*impl_->evidence : nullptr;
+}
+
+}  // namespace detsim::net

@@ -1,0 +1,152 @@
+// Session internals shared by session.cpp (the frame loop: inputs, rollback, confirmed frames,
+// desync checks) and session_wire.cpp (the network: handshake, packets in and out, timers).
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include <detsim/net/session.hpp>
+#include <detsim/sim/rng.hpp>
+
+#include "input_queue.hpp"
+
+namespace detsim::net::detail {
+
+/// Frames of inputs each player's queue holds: enough for the prediction window, the input delay,
+/// the confirmed frames not yet emitted and the oldest input a peer's delta may refer to. A remote
+/// input further ahead than this is out of the window and dropped.
+inline constexpr std::size_t input_capacity = 256;
+/// Hash checks this side keeps for comparison, and accepts ahead from one peer.
+inline constexpr std::size_t max_pending_checks = 64;
+/// "No frame": a connected player's disconnect frame.
+inline constexpr std::uint64_t never = ~std::uint64_t{0};
+
+/// One confirmed-frame hash this machine computed, kept until every peer's hash was compared.
+struct LocalCheck {
+  std::uint64_t frame = 0;
+  std::uint64_t hash = 0;
+  std::vector<std::uint8_t> state;  ///< this machine's state at `frame` (desync evidence)
+};
+
+/// A remote player's connection.
+struct Peer {
+  std::uint32_t player = 0;
+  PeerId id = 0;
+  // Handshake: synchronized once the peer answered our challenge and we know its nonce.
+  std::uint32_t challenge = 0;
+  bool answered = false;     ///< the peer replied to our challenge
+  bool nonce_known = false;  ///< we received the peer's hello
+  std::uint32_t remote_nonce = 0;
+  bool synchronized = false;
+  std::uint64_t last_hello_us = 0;
+  bool hello_sent = false;
+  bool hello_rejected = false;  ///< reported once
+  // Inputs and checks the peer holds of ours.
+  std::uint64_t acked_inputs = 0;  ///< the peer holds our inputs before this frame
+  std::uint64_t acked_checks = 0;  ///< the peer holds our checks up to this frame
+  // Checks received from the peer.
+  std::uint64_t checks_through = 0;  ///< every check of the peer up to this frame received
+  std::deque<protocol::HashCheck> pending_checks;  ///< received, not yet compared
+  bool desynced = false;
+  // Liveness and statistics.
+  std::uint64_t last_receive_us = 0;
+  std::uint64_t last_send_us = 0;
+  std::uint64_t last_ping_us = 0;
+  bool interrupted = false;
+  bool disconnected = false;
+  bool needs_ack = false;  ///< received data since the last packet we sent
+  std::uint16_t send_sequence = 0;
+  std::optional<std::uint16_t> last_sequence;
+  std::uint64_t rtt_x16 = 0;     ///< smoothed round-trip time, times 16
+  std::uint64_t jitter_x16 = 0;  ///< smoothed |rtt - smoothed rtt|, times 16
+  std::uint64_t remote_frame = 0;
+  std::int64_t advantage_x16 = 0;  ///< smoothed frames we are ahead of the peer, times 16
+  std::int64_t remote_advantage_x16 = 0;
+  PeerStats stats;
+};
+
+struct State {
+  std::uint64_t frame = ~std::uint64_t{0};
+  std::uint64_t hash = 0;
+  std::vector<std::uint8_t> bytes;
+};
+
+}  // namespace detsim::net::detail
+
+namespace detsim::net {
+
+struct Session::Impl {
+  Impl(const SessionConfig& c, Game& g, Transport& t);
+
+  // session.cpp: the frame loop.
+  void add_local_input(std::span<const std::uint8_t> input);
+  void simulate(std::uint64_t frame, bool resimulating);
+  void rollback();
+  void emit_confirmed();
+  void add_local_check(std::uint64_t frame, std::uint64_t hash, const detail::State* state);
+  void compare_checks(detail::Peer& peer);
+  void retire_checks();
+  void receive_input(detail::Peer& peer, std::uint64_t frame, std::span<const std::uint8_t> input);
+  void disconnect(detail::Peer& peer);
+  [[nodiscard]] std::uint64_t confirmed_frame() const noexcept;
+  [[nodiscard]] std::uint64_t window_start() const noexcept;
+  [[nodiscard]] detail::State& state_slot(std::uint64_t frame) noexcept {
+    return states[static_cast<std::size_t>(frame % states.size())];
+  }
+  void raise(Event e) { events.push_back(e); }
+
+  // session_wire.cpp: the network.
+  void receive_all();
+  void handle(detail::Peer& peer, const protocol::Packet& packet);
+  void handle_hello(detail::Peer& peer, const protocol::Packet& packet);
+  void handle_input(detail::Peer& peer, const protocol::InputBody& body);
+  void send_due();
+  void send_inputs(detail::Peer& peer);
+  void send(detail::Peer& peer, protocol::Packet& packet);
+  void check_timeouts();
+  [[nodiscard]] detail::Peer* peer_by_id(PeerId id) noexcept;
+
+  SessionConfig config;
+  Game* game;
+  Transport* transport;
+  std::uint32_t max_prediction = 0;  ///< 0 in lockstep
+  Rng rng;
+  std::uint32_t nonce = 0;
+  std::uint64_t now_us = 0;
+  bool running = false;
+
+  std::vector<detail::InputQueue> queues;       ///< one per player
+  std::vector<std::uint64_t> disconnect_frame;  ///< per player; ~0: connected
+  std::vector<detail::Peer> peers;              ///< by ascending player
+  std::vector<detail::State> states;            ///< ring of saved states
+  std::uint64_t current = 0;
+  std::optional<std::uint64_t> first_incorrect;
+  std::uint64_t next_emit = 0;  ///< the next frame to hand to the confirmed listener
+
+  // Scratch for simulate(), sized once.
+  std::vector<std::uint8_t> frame_inputs;
+  std::vector<InputStatus> frame_status;
+  std::vector<std::uint8_t> scratch_input;
+
+  std::deque<detail::LocalCheck> local_checks;
+  std::optional<DesyncEvidence> evidence;
+  std::uint64_t agreed_frame = 0;
+  std::vector<std::uint8_t> agreed_state;
+
+  Predictor predictor;
+  std::function<void(const ConfirmedFrame&)> confirmed_listener;
+  std::vector<Event> events;
+  SessionStats stats;
+
+  // Scratch for the wire.
+  std::vector<Datagram> inbox;
+  std::vector<std::uint8_t> outbuf;
+  std::vector<std::uint8_t> scratch_deltas;
+  std::vector<std::uint8_t> scratch_inputs;
+  protocol::Packet packet;
+};
+
+}  // namespace detsim::net

@@ -1,0 +1,333 @@
+// The session's network side: the handshake, every received datagram's validation and handling,
+// what is sent when (inputs, acks, hash checks, pings, keepalives), and the silence timeouts.
+//
+// Reliability is by redundancy, as in GGPO: every input packet carries all of this machine's
+// inputs the peer has not acknowledged and all unacknowledged hash checks, so a lost packet costs
+// nothing once any later one arrives. Acknowledgements are cumulative (frame numbers).
+#include <algorithm>
+#include <limits>
+
+#include "session_impl.hpp"
+
+namespace detsim::net {
+namespace {
+
+// Smoothing by 1/8 per sample (TCP's SRTT gain), in integers scaled by 16.
+std::uint64_t smooth(std::uint64_t average_x16, std::uint64_t sample, bool first) {
+  const std::uint64_t target = sample * 16;
+  if (first) return target;
+  return target >= average_x16 ? average_x16 + (target - average_x16) / 8
+                               : average_x16 - (average_x16 - target) / 8;
+}
+
+std::int64_t smooth_signed(std::int64_t average_x16, std::int64_t sample) {
+  return average_x16 + (sample * 16 - average_x16) / 8;
+}
+
+std::uint32_t wire_frame(std::uint64_t frame) {
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(frame, 0xFFFF'FFFFU));
+}
+
+}  // namespace
+
+detail::Peer* Session::Impl::peer_by_id(PeerId id) noexcept {
+  for (detail::Peer& peer : peers)
+    if (peer.id == id) return &peer;
+  return nullptr;
+}
+
+void Session::Impl::receive_all() {
+  inbox.clear();
+  transport->receive(inbox);
+  for (const Datagram& d : inbox) {
+    detail::Peer* peer = peer_by_id(d.from);
+    if (peer == nullptr || peer->disconnected) {
+      ++stats.dropped_wrong_session;
+      continue;
+    }
+    const protocol::DecodeError error = protocol::decode(d.bytes, config.input_size, packet);
+    if (error != protocol::DecodeError::none) {
+      ++stats.dropped_malformed[static_cast<std::size_t>(error)];
+      continue;
+    }
+    peer->stats.bytes_received += d.bytes.size();
+    handle(*peer, packet);
+  }
+  inbox.clear();
+}
+
+void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
+  using protocol::PacketType;
+  if (p.header.type == PacketType::hello) {
+    handle_hello(peer, p);
+  } else if (p.header.type == PacketType::hello_reply) {
+    if (p.hello_reply.challenge != peer.challenge ||
+        (peer.nonce_known && p.header.nonce != peer.remote_nonce)) {
+      ++stats.dropped_wrong_session;
+      return;
+    }
+    peer.answered = true;
+  } else {
+    if (!peer.synchronized || p.header.nonce != peer.remote_nonce) {
+      ++stats.dropped_wrong_session;
+      return;
+    }
+    // Loss statistics from the sequence numbers (modulo 2^16; a late one fills a gap).
+    if (peer.last_sequence) {
+      const auto step = static_cast<std::uint16_t>(p.header.sequence - *peer.last_sequence);
+      if (step != 0 && step < 0x8000U) {
+        peer.stats.packets_lost += step - 1U;
+        peer.last_sequence = p.header.sequence;
+      } else if (step >= 0x8000U && peer.stats.packets_lost > 0) {
+        --peer.stats.packets_lost;
+      }
+    } else {
+      peer.last_sequence = p.header.sequence;
+    }
+    if (p.header.type == PacketType::ping) {
+      protocol::Packet pong;
+      pong.header.type = PacketType::pong;
+      pong.ping.time_us = p.ping.time_us;
+      send(peer, pong);
+    } else if (p.header.type == PacketType::pong) {
+      if (p.ping.time_us <= now_us) {
+        const std::uint64_t rtt = now_us - p.ping.time_us;
+        const bool first = peer.rtt_x16 == 0;
+        const std::uint64_t deviation =
+            rtt * 16 > peer.rtt_x16 ? rtt * 16 - peer.rtt_x16 : peer.rtt_x16 - rtt * 16;
+        peer.rtt_x16 = smooth(peer.rtt_x16, rtt, first);
+        peer.jitter_x16 = smooth(peer.jitter_x16, deviation / 16, first);
+      }
+    } else {
+      handle_input(peer, p.input);
+    }
+  }
+  ++peer.stats.packets_received;
+  peer.last_receive_us = now_us;
+  if (peer.interrupted) {
+    peer.interrupted = false;
+    raise(Event{EventType::resumed, peer.player, current, 0, 0, {}});
+  }
+  if (!peer.synchronized && peer.answered && peer.nonce_known) {
+    peer.synchronized = true;
+    peer.stats.synchronized = true;
+    raise(Event{EventType::synchronized, peer.player, current, 0, 0, {}});
+    if (std::all_of(peers.begin(), peers.end(),
+                    [](const detail::Peer& x) { return x.synchronized; })) {
+      running = true;
+      raise(Event{EventType::running, 0, current, 0, 0, {}});
+    }
+  }
+}
+
+void Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) {
+  const protocol::Hello& h = p.hello;
+  std::string_view reason;
+  if (h.fingerprint != config.fingerprint)
+    reason = "fingerprint";
+  else if (h.players != config.players)
+    reason = "player count";
+  else if (h.input_size != config.input_size)
+    reason = "input size";
+  else if (h.player != peer.player)
+    reason = "player index";
+  if (!reason.empty()) {
+    ++stats.dropped_wrong_session;
+    if (!peer.hello_rejected) {
+      peer.hello_rejected = true;
+      raise(Event{EventType::hello_rejected, peer.player, current, 0, 0, reason});
+    }
+    return;
+  }
+  if (peer.nonce_known && p.header.nonce != peer.remote_nonce) {
+    if (peer.synchronized) {  // a stale or foreign session on the same address
+      ++stats.dropped_wrong_session;
+      return;
+    }
+    peer.answered = false;  // the peer restarted before we finished: start over with it
+  }
+  peer.remote_nonce = p.header.nonce;
+  peer.nonce_known = true;
+  protocol::Packet reply;
+  reply.header.type = protocol::PacketType::hello_reply;
+  reply.hello_reply.challenge = h.challenge;
+  send(peer, reply);
+}
+
+void Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& b) {
+  const detail::InputQueue& mine = queues[config.local_player];
+  // Acknowledgements never move backwards, nor beyond what was sent.
+  if (b.ack_frame <= mine.next_confirmed())
+    peer.acked_inputs = std::max<std::uint64_t>(peer.acked_inputs, b.ack_frame);
+  const std::uint64_t last_check = local_checks.empty() ? agreed_frame : local_checks.back().frame;
+  if (b.check_ack <= std::max(last_check, peer.acked_checks))
+    peer.acked_checks = std::max<std::uint64_t>(peer.acked_checks, b.check_ack);
+  peer.remote_frame = b.current_frame;
+  peer.stats.remote_frame = b.current_frame;
+  peer.remote_advantage_x16 = smooth_signed(peer.remote_advantage_x16, b.advantage);
+  const std::uint64_t half_rtt_frames = peer.rtt_x16 / 32 / config.frame_us;
+  const auto ahead = static_cast<std::int64_t>(current) -
+                     static_cast<std::int64_t>(b.current_frame + half_rtt_frames);
+  peer.advantage_x16 = smooth_signed(peer.advantage_x16, ahead);
+
+  detail::InputQueue& q = queues[peer.player];
+  if (b.count > 0 && disconnect_frame[peer.player] == detail::never) {
+    const std::uint64_t start = b.start_frame;
+    const std::uint64_t end = start + b.count;
+    if (start > q.next_confirmed() || (start > 0 && !q.holds(start - 1)) ||
+        end > window_start() + detail::input_capacity) {
+      ++stats.dropped_out_of_window;
+    } else if (end > q.next_confirmed()) {
+      scratch_deltas.assign(b.deltas.begin(), b.deltas.end());
+      protocol::delta_decode(q.reference(start), scratch_deltas);
+      const std::size_t size = config.input_size;
+      for (std::uint64_t frame = q.next_confirmed(); frame < end; ++frame) {
+        const auto offset = static_cast<std::size_t>(frame - start) * size;
+        receive_input(peer, frame,
+                      std::span<const std::uint8_t>(scratch_deltas).subspan(offset, size));
+      }
+    }
+    peer.needs_ack = true;
+  }
+  if (!b.checks.empty()) peer.needs_ack = true;
+  for (const protocol::HashCheck& c : b.checks) {
+    if (config.check_interval == 0 || c.frame == 0 || c.frame % config.check_interval != 0) {
+      ++stats.dropped_out_of_window;
+      break;
+    }
+    if (c.frame == peer.checks_through + config.check_interval &&
+        peer.pending_checks.size() < detail::max_pending_checks) {
+      peer.pending_checks.push_back(c);
+      peer.checks_through = c.frame;
+    }
+  }
+  compare_checks(peer);
+  retire_checks();
+}
+
+void Session::Impl::send(detail::Peer& peer, protocol::Packet& p) {
+  p.header.nonce = nonce;
+  p.header.sequence = peer.send_sequence++;
+  if (!protocol::encode(p, config.input_size, outbuf)) return;
+  transport->send(peer.id, outbuf);
+  ++peer.stats.packets_sent;
+  peer.stats.bytes_sent += outbuf.size();
+  peer.last_send_us = now_us;
+}
+
+void Session::Impl::send_inputs(detail::Peer& peer) {
+  const detail::InputQueue& mine = queues[config.local_player];
+  protocol::Packet& p = packet;
+  p.header.type = protocol::PacketType::input;
+  protocol::InputBody& b = p.input;
+  b.ack_frame = wire_frame(queues[peer.player].next_confirmed());
+  b.check_ack = wire_frame(peer.checks_through);
+  b.current_frame = wire_frame(current);
+  b.advantage =
+      static_cast<std::int8_t>(std::clamp<std::int64_t>(peer.advantage_x16 / 16, -127, 127));
+  std::uint64_t start = std::min(peer.acked_inputs, mine.next_confirmed());
+  if (start > 0 && !mine.holds(start - 1)) start = mine.next_confirmed();  // too far behind
+  const std::size_t size = config.input_size;
+  const std::size_t most = std::min<std::size_t>(protocol::max_inputs_per_packet, 900 / (size + 1));
+  const auto count =
+      static_cast<std::size_t>(std::min<std::uint64_t>(mine.next_confirmed() - start, most));
+  b.start_frame = wire_frame(start);
+  b.count = static_cast<std::uint8_t>(count);
+  scratch_inputs.resize(count * size);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::span<const std::uint8_t> input = mine.confirmed(start + i);
+    std::copy(input.begin(), input.end(),
+              scratch_inputs.begin() + static_cast<std::ptrdiff_t>(i * size));
+  }
+  protocol::delta_encode(mine.reference(start), scratch_inputs, b.deltas);
+  b.checks.clear();
+  for (const detail::LocalCheck& c : local_checks) {
+    if (c.frame <= peer.acked_checks) continue;
+    if (b.checks.size() == protocol::max_checks_per_packet) break;
+    b.checks.push_back(protocol::HashCheck{wire_frame(c.frame), c.hash});
+  }
+  peer.needs_ack = false;
+  send(peer, p);
+}
+
+void Session::Impl::send_due() {
+  const detail::InputQueue& mine = queues[config.local_player];
+  for (detail::Peer& peer : peers) {
+    if (peer.disconnected) continue;
+    if (!peer.answered || !peer.nonce_known) {
+      if (!peer.hello_sent || now_us - peer.last_hello_us >= config.hello_interval_us) {
+        protocol::Packet hello;
+        hello.header.type = protocol::PacketType::hello;
+        hello.hello = protocol::Hello{config.fingerprint, static_cast<std::uint8_t>(config.players),
+                                      static_cast<std::uint8_t>(config.local_player),
+                                      static_cast<std::uint8_t>(config.input_size), peer.challenge};
+        send(peer, hello);
+        peer.hello_sent = true;
+        peer.last_hello_us = now_us;
+      }
+    }
+    if (!peer.synchronized) continue;
+    if (now_us - peer.last_ping_us >= config.ping_interval_us) {
+      protocol::Packet ping;
+      ping.header.type = protocol::PacketType::ping;
+      ping.ping.time_us = now_us;
+      send(peer, ping);
+      peer.last_ping_us = now_us;
+    }
+    const bool unacked = peer.acked_inputs < mine.next_confirmed() ||
+                         (!local_checks.empty() && local_checks.back().frame > peer.acked_checks);
+    const std::uint64_t quiet = now_us - peer.last_send_us;
+    if (((unacked || peer.needs_ack) && quiet >= config.frame_us) || quiet >= config.keepalive_us)
+      send_inputs(peer);
+  }
+}
+
+void Session::Impl::check_timeouts() {
+  for (detail::Peer& peer : peers) {
+    if (!peer.synchronized || peer.disconnected) continue;
+    const std::uint64_t silence = now_us - peer.last_receive_us;
+    if (silence >= config.disconnect_timeout_us) {
+      disconnect(peer);
+    } else if (silence >= config.disconnect_warning_us && !peer.interrupted) {
+      peer.interrupted = true;
+      raise(Event{EventType::interrupted, peer.player, current, 0, 0, {}});
+    }
+  }
+}
+
+void Session::poll(std::uint64_t now_us) {
+  Impl& s = *impl_;
+  s.now_us = std::max(s.now_us, now_us);
+  s.receive_all();
+  s.check_timeouts();
+  if (s.running) {
+    // As GGPO does while idle: a correction received here is applied now, so a game that stops
+    // advancing (at a match's end, or waiting) still gets its confirmed frames out.
+    if (s.first_incorrect) s.rollback();
+    s.emit_confirmed();
+  }
+  s.send_due();
+}
+
+std::uint32_t Session::recommended_wait_frames() const noexcept {
+  std::int64_t wait_x16 = 0;
+  for (const detail::Peer& peer : impl_->peers) {
+    if (!peer.synchronized || peer.disconnected) continue;
+    wait_x16 = std::max(wait_x16, (peer.advantage_x16 - peer.remote_advantage_x16) / 2);
+  }
+  return static_cast<std::uint32_t>(wait_x16 / 16);
+}
+
+std::optional<PeerStats> Session::peer_stats(std::uint32_t player) const {
+  for (const detail::Peer& peer : impl_->peers) {
+    if (peer.player != player) continue;
+    PeerStats stats = peer.stats;
+    stats.ping_us = peer.rtt_x16 / 16;
+    stats.jitter_us = peer.jitter_x16 / 16;
+    stats.frames_ahead = peer.advantage_x16 / 16;
+    return stats;
+  }
+  return std::nullopt;
+}
+
+}  // namespace detsim::net

@@ -1,0 +1,135 @@
+// Test support for net/: games a session can drive, and a match of N sessions over a SimNetwork
+// stepped in virtual time, recording every peer's confirmed frames for comparison.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <detsim/net/game.hpp>
+#include <detsim/net/scenario_game.hpp>
+#include <detsim/net/session.hpp>
+#include <detsim/net/sim_network.hpp>
+#include <detsim/sim/scenario.hpp>
+
+namespace detsim::test {
+
+/// A cheap deterministic game: its state is the frame and an accumulator that mixes in every
+/// input byte, so any difference in any input of any frame changes every later hash. `fault_frame`
+/// perturbs the state on this machine only (a stand-in for non-determinism).
+class CounterGame final : public net::Game {
+ public:
+  /// Called for each peer every tick before it advances (mid-match changes).
+  std::function<void(std::uint32_t peer, std::uint64_t tick, net::Session&)> on_tick;
+  std::optional<std::uint64_t> fault_frame;
+
+  static std::uint64_t mix(std::uint64_t x) {  // splitmix64's finaliser
+    x ^= x >> 30;
+    x *= 0xBF58476D1CE4E5B9ULL;
+    x ^= x >> 27;
+    x *= 0x94D049BB133111EBULL;
+    return x ^ (x >> 31);
+  }
+  std::uint64_t save(std::vector<std::uint8_t>& state) override {
+    state.resize(16);
+    for (int i = 0; i < 8; ++i) {
+      state[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(frame_ >> (8 * i));
+      state[static_cast<std::size_t>(8 + i)] = static_cast<std::uint8_t>(acc_ >> (8 * i));
+    }
+    return mix(acc_ ^ mix(frame_));
+  }
+  void load(std::span<const std::uint8_t> state) override {
+    frame_ = acc_ = 0;
+    for (int i = 0; i < 8; ++i) {
+      frame_ |= std::uint64_t{state[static_cast<std::size_t>(i)]} << (8 * i);
+      acc_ |= std::uint64_t{state[static_cast<std::size_t>(8 + i)]} << (8 * i);
+    }
+  }
+  void advance(const net::FrameInputs& inputs, bool resimulating) override {
+    for (std::size_t i = 0; i < inputs.bytes.size(); ++i)
+      acc_ = mix(acc_ + inputs.bytes[i] + i);
+    if (fault_frame && *fault_frame == frame_) acc_ += 1;
+    ++frame_;
+    ++(resimulating ? resimulated : simulated);
+  }
+  std::uint64_t simulated = 0;
+  std::uint64_t resimulated = 0;
+
+ private:
+  std::uint64_t frame_ = 0;
+  std::uint64_t acc_ = 0;
+};
+
+/// What one peer confirmed.
+struct PeerRecord {
+  std::vector<std::uint64_t> hashes;     ///< per confirmed frame
+  std::vector<std::uint8_t> inputs;      ///< every confirmed frame's inputs, concatenated
+  std::vector<net::InputStatus> status;  ///< per confirmed frame and player
+  std::vector<net::Event> events;
+  bool has(net::EventType type) const {
+    for (const net::Event& e : events)
+      if (e.type == type) return true;
+    return false;
+  }
+};
+
+struct MatchOptions {
+  std::uint32_t players = 2;
+  net::SessionMode mode = net::SessionMode::rollback;
+  net::LinkConditions link{};
+  std::uint64_t frames = 600;
+  std::uint64_t seed = 1;
+  std::uint32_t input_delay = 2;
+  std::uint32_t max_prediction = 8;
+  std::uint32_t check_interval = 30;
+  bool arena = false;             ///< the arena scenario through ScenarioGame; else CounterGame
+  std::uint32_t arena_count = 0;  ///< the arena's size (0: its default)
+  /// Called once with the network before the match (outages, per-link conditions).
+  std::function<void(net::SimNetwork&)> setup;
+  /// Called for each peer's config (per-peer tweaks).
+  std::function<void(std::uint32_t peer, net::SessionConfig&)> configure;
+  /// Whether peer p simulates (advances) at all: a peer that never advances still polls.
+  std::function<bool(std::uint32_t peer, std::uint64_t tick)> active;
+  /// Called for each peer every tick before it advances (mid-match changes).
+  std::function<void(std::uint32_t peer, std::uint64_t tick, net::Session&)> on_tick;
+  std::optional<std::uint64_t> fault_frame;  ///< CounterGame fault on peer fault_peer
+  std::uint32_t fault_peer = 0;
+  std::uint64_t max_ticks = 0;  ///< 0: frames * 4 + 2000
+};
+
+/// N peers, each with its own game and session, over one SimNetwork.
+class Match {
+ public:
+  explicit Match(const MatchOptions& options);
+
+  /// Ticks until every peer confirmed options.frames frames (or max_ticks); true if they did.
+  bool run();
+
+  std::uint32_t players() const { return options_.players; }
+  net::Session& session(std::uint32_t p) { return *sessions_[p]; }
+  net::SimNetwork& network() { return *network_; }
+  const PeerRecord& record(std::uint32_t p) const { return records_[p]; }
+  std::uint64_t ticks() const { return tick_; }
+  /// The hashes of an offline run of peer p's confirmed inputs, frame by frame.
+  std::vector<std::uint64_t> offline_hashes(std::uint32_t p) const;
+  /// An empty string when every peer confirmed the same inputs and hashes for every frame they all
+  /// confirmed, and that matches an offline replay; else what differs.
+  std::string compare() const;
+
+ private:
+  std::unique_ptr<net::Game> make_game(std::uint32_t p);
+
+  MatchOptions options_;
+  std::optional<net::SimNetwork> network_;
+  std::vector<std::unique_ptr<Scenario>> scenarios_;
+  std::vector<std::unique_ptr<net::Game>> games_;
+  std::vector<std::optional<net::Session>> sessions_;
+  std::vector<PeerRecord> records_;
+  std::uint64_t tick_ = 0;
+};
+
+}  // namespace detsim::test
