@@ -1,15 +1,19 @@
 // The Game adapter for detsim scenarios (scenario_game.hpp).
 #include <detsim/net/scenario_game.hpp>
 
-#include <xxhash.h>
-
 namespace detsim::net {
 
 std::uint64_t ScenarioGame::save(std::vector<std::uint8_t>& state) {
-  state = scenario_->world().save();
-  // The World's state hash is XXH3-64 of exactly these bytes (docs/STATE.md): hashing them here
-  // saves a second encoding of the state.
-  return XXH3_64bits(state.data(), state.size());
+  const World& world = scenario_->world();
+  const StateHashes hashes = world.save(state);  // one encoding gives the bytes and every hash
+  const std::uint64_t frame = world.frame();
+  remembered_[frame % remembered_hashes] = Remembered{frame, hashes};
+  if (keyframe_interval_ != 0 && frame % keyframe_interval_ == 0) {
+    Keyframe& k = keyframes_[(frame / keyframe_interval_) % keyframes_.size()];
+    k.frame = frame;
+    k.state.assign(state.begin(), state.end());
+  }
+  return hashes.total;
 }
 
 void ScenarioGame::load(std::span<const std::uint8_t> state) {
@@ -26,6 +30,18 @@ void ScenarioGame::advance(const FrameInputs& inputs, bool resimulating) {
   }
   scenario_->step(inputs_);
   ++(resimulating ? resimulated_ : simulated_);
+}
+
+std::optional<StateHashes> ScenarioGame::hashes_at(std::uint64_t frame) const noexcept {
+  const Remembered& r = remembered_[frame % remembered_hashes];
+  if (r.frame != frame) return std::nullopt;
+  return r.hashes;
+}
+
+const std::vector<std::uint8_t>* ScenarioGame::keyframe_at(std::uint64_t frame) const noexcept {
+  if (keyframe_interval_ == 0 || frame % keyframe_interval_ != 0) return nullptr;
+  const Keyframe& k = keyframes_[(frame / keyframe_interval_) % keyframes_.size()];
+  return k.frame == frame ? &k.state : nullptr;
 }
 
 }  // namespace detsim::net

@@ -369,6 +369,11 @@ Status World::restore(std::span<const std::uint8_t> bytes) {
 }
 
 StateHashes World::hashes() const {
+  std::vector<std::uint8_t> bytes;
+  return save(bytes);
+}
+
+StateHashes World::save(std::vector<std::uint8_t>& out) const {
   // One encoding: the total is the hash of save()'s bytes, each part the hash of its slice.
   sim_detail::Encoded e;
   sim_detail::encode(*s_, e);
@@ -382,6 +387,7 @@ StateHashes World::hashes() const {
   h.bodies = slice(e.bodies, e.contacts);
   h.contacts = slice(e.contacts, e.w.size());
   h.total = slice(0, e.w.size());
+  out = e.w.take();
   return h;
 }
 

@@ -4,6 +4,7 @@
 #include <detsim/net/game.hpp>
 #include <detsim/net/protocol.hpp>
 #include <detsim/net/scenario_game.hpp>
+#include <detsim/net/scenario_recorder.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/net/transport.hpp>

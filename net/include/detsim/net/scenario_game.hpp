@@ -1,14 +1,21 @@
 // detsim::net::ScenarioGame: the Game adapter that lets a session drive a detsim Scenario (and so
 // its World) directly: save and load are World::save / World::restore, the hash is the frame's
 // state hash, and each player's input is a PlayerInput in its 3-byte canonical encoding.
+//
+// It also remembers the per-part hashes of the states it saved recently, and the states at
+// keyframe frames, so that a ScenarioRecorder can write a replay of the confirmed frames without
+// simulating anything twice.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include <detsim/net/game.hpp>
 #include <detsim/sim/scenario.hpp>
+#include <detsim/sim/world.hpp>
 
 namespace detsim::net {
 
@@ -16,6 +23,8 @@ class ScenarioGame final : public Game {
  public:
   /// The input size of a scenario session: PlayerInput's canonical encoding.
   static constexpr std::uint32_t input_size = PlayerInput::encoded_size;
+  /// How many recent saves' hashes are remembered (more than any prediction window).
+  static constexpr std::size_t remembered_hashes = 64;
 
   /// Drives `scenario`, which must outlive this adapter.
   explicit ScenarioGame(Scenario& scenario) noexcept : scenario_(&scenario) {}
@@ -33,9 +42,29 @@ class ScenarioGame final : public Game {
   [[nodiscard]] std::uint64_t frames_simulated() const noexcept { return simulated_; }
   [[nodiscard]] std::uint64_t frames_resimulated() const noexcept { return resimulated_; }
 
+  /// The hashes of the state most recently saved at `frame`, if it is among the last
+  /// remembered_hashes saves' frames.
+  [[nodiscard]] std::optional<StateHashes> hashes_at(std::uint64_t frame) const noexcept;
+  /// Keep the state bytes of frames that are multiples of `interval` (0: none).
+  void keep_keyframes(std::uint32_t interval) noexcept { keyframe_interval_ = interval; }
+  /// The state most recently saved at keyframe frame `frame`, or nullptr.
+  [[nodiscard]] const std::vector<std::uint8_t>* keyframe_at(std::uint64_t frame) const noexcept;
+
  private:
+  struct Remembered {
+    std::uint64_t frame = ~std::uint64_t{0};
+    StateHashes hashes;
+  };
+  struct Keyframe {
+    std::uint64_t frame = ~std::uint64_t{0};
+    std::vector<std::uint8_t> state;
+  };
+
   Scenario* scenario_;
   std::vector<PlayerInput> inputs_;
+  std::array<Remembered, remembered_hashes> remembered_{};
+  std::array<Keyframe, 2> keyframes_{};
+  std::uint32_t keyframe_interval_ = 0;
   std::uint64_t failed_loads_ = 0;
   std::uint64_t simulated_ = 0;
   std::uint64_t resimulated_ = 0;

@@ -193,6 +193,8 @@ class World {
   Status restore(std::span<const std::uint8_t> bytes);
   /// The hashes of the current state (the per-frame state hash is `hashes().total`).
   [[nodiscard]] StateHashes hashes() const;
+  /// save() and hashes() from one encoding: the bytes go to `bytes` (replacing its contents).
+  StateHashes save(std::vector<std::uint8_t>& bytes) const;
   /// XXH3-64 of one body's canonical bytes, or an error for an unknown ID.
   [[nodiscard]] Expected<std::uint64_t> body_hash(BodyId id) const;
 

@@ -1,0 +1,50 @@
+// detsim::net::ScenarioRecorder: records a session's confirmed frames of a scenario match as a
+// replay (replay/FORMAT.md) that `detsim verify` re-simulates: the confirmed inputs of every
+// player, the state hashes after each frame, and a keyframe every keyframe_interval frames.
+//
+// It reads the hashes and keyframe states the ScenarioGame already computed when the session
+// saved them, so recording simulates nothing twice.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <detsim/net/scenario_game.hpp>
+#include <detsim/net/session.hpp>
+#include <detsim/replay/replay.hpp>
+#include <detsim/sim/status.hpp>
+
+namespace detsim::net {
+
+class ScenarioRecorder {
+ public:
+  /// Creates `path` for a match of `game`'s scenario, which must still be at frame 0 (the
+  /// fingerprint records its initial state). keyframe_interval: 16 .. 100000.
+  static Expected<ScenarioRecorder> create(
+      const std::string& path, ScenarioGame& game,
+      std::uint32_t keyframe_interval = replay::default_keyframe_interval);
+  ScenarioRecorder(ScenarioRecorder&&) noexcept;
+  ScenarioRecorder& operator=(ScenarioRecorder&&) noexcept;
+  ~ScenarioRecorder();
+
+  /// Records `session`'s confirmed frames from now on (it replaces the session's confirmed
+  /// listener; `listener`, if given, is still called for each frame). The recorder must outlive
+  /// the session's use of it: keep both alive together, or attach before a move only.
+  void attach(Session& session, std::function<void(const ConfirmedFrame&)> listener = {});
+
+  /// Frames recorded so far.
+  [[nodiscard]] std::uint64_t frames() const noexcept;
+  /// The first error (a write failed, or a hash the game no longer remembered); recording stops
+  /// at it. Success while all is well.
+  [[nodiscard]] Status status() const;
+  /// Writes the end marker and closes the file; returns status() or the write's error.
+  Status finish();
+
+ private:
+  struct Impl;
+  explicit ScenarioRecorder(std::unique_ptr<Impl> impl) noexcept;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace detsim::net

@@ -1,0 +1,83 @@
+// Replays of session matches (scenario_recorder.hpp).
+#include <detsim/net/scenario_recorder.hpp>
+
+#include <utility>
+
+namespace detsim::net {
+
+struct ScenarioRecorder::Impl {
+  replay::ReplayWriter writer;
+  ScenarioGame* game = nullptr;
+  std::uint32_t keyframe_interval = 0;
+  std::function<void(const ConfirmedFrame&)> listener;
+  Status error;
+
+  void record(const ConfirmedFrame& f) {
+    if (listener) listener(f);
+    if (!error.ok()) return;
+    const std::uint64_t frame = f.frame + 1;  // replay frames count states after each step
+    const std::optional<StateHashes> hashes = game->hashes_at(frame);
+    if (!hashes || hashes->total != f.hash) {
+      error = Status::error("recording: the game no longer holds the hashes of frame " +
+                            std::to_string(frame));
+      return;
+    }
+    if (Status s = writer.frame(f.inputs, *hashes); !s) {
+      error = s;
+      return;
+    }
+    if (frame % keyframe_interval == 0) {
+      const std::vector<std::uint8_t>* state = game->keyframe_at(frame);
+      if (state == nullptr) {
+        error = Status::error("recording: the game no longer holds the keyframe of frame " +
+                              std::to_string(frame));
+        return;
+      }
+      if (Status s = writer.keyframe(frame, *state); !s) error = s;
+    }
+  }
+};
+
+Expected<ScenarioRecorder> ScenarioRecorder::create(const std::string& path, ScenarioGame& game,
+                                                    std::uint32_t keyframe_interval) {
+  if (keyframe_interval < 16 || keyframe_interval > 100'000)
+    return Status::error("recording: keyframe interval must be 16 .. 100000, got " +
+                         std::to_string(keyframe_interval));
+  if (game.scenario().world().frame() != 0)
+    return Status::error("recording: the scenario must be at frame 0, it is at frame " +
+                         std::to_string(game.scenario().world().frame()));
+  auto writer = replay::ReplayWriter::create(
+      path, replay::fingerprint_of(game.scenario(), keyframe_interval));
+  if (!writer) return writer.status();
+  game.keep_keyframes(keyframe_interval);
+  auto impl = std::make_unique<Impl>(
+      Impl{std::move(writer.value()), &game, keyframe_interval, {}, Status::success()});
+  return ScenarioRecorder(std::move(impl));
+}
+
+ScenarioRecorder::ScenarioRecorder(std::unique_ptr<Impl> impl) noexcept : impl_(std::move(impl)) {}
+ScenarioRecorder::ScenarioRecorder(ScenarioRecorder&&) noexcept = default;
+ScenarioRecorder& ScenarioRecorder::operator=(ScenarioRecorder&&) noexcept = default;
+ScenarioRecorder::~ScenarioRecorder() = default;
+
+void ScenarioRecorder::attach(Session& session,
+                              std::function<void(const ConfirmedFrame&)> listener) {
+  impl_->listener = std::move(listener);
+  Impl* impl = impl_.get();  // stable across moves of the recorder
+  session.set_confirmed_listener([impl](const ConfirmedFrame& f) { impl->record(f); });
+}
+
+std::uint64_t ScenarioRecorder::frames() const noexcept {
+  return impl_->writer.frames();
+}
+
+Status ScenarioRecorder::status() const {
+  return impl_->error;
+}
+
+Status ScenarioRecorder::finish() {
+  if (!impl_->error.ok()) return impl_->error;
+  return impl_->writer.finish();
+}
+
+}  // namespace detsim::net
