@@ -25,7 +25,12 @@ Match::Match(const MatchOptions& options) : options_(options) {
     for (std::uint32_t q = 0; q < options.players; ++q)
       if (q != p) config.remotes.push_back(net::RemotePlayer{q, q});
     if (options.configure) options.configure(p, config);
-    auto session = net::Session::create(config, *games_[p], network_->endpoint(p));
+    net::Transport* transport = &network_->endpoint(p);
+    if (options.wrap) {
+      wrappers_.push_back(options.wrap(p, *transport));
+      if (wrappers_.back()) transport = wrappers_.back().get();
+    }
+    auto session = net::Session::create(config, *games_[p], *transport);
     sessions_.emplace_back(std::move(session.value()));
     PeerRecord& record = records_[p];
     sessions_[p]->set_confirmed_listener([&record](const net::ConfirmedFrame& f) {

@@ -96,6 +96,8 @@ struct MatchOptions {
   std::function<bool(std::uint32_t peer, std::uint64_t tick)> active;
   /// Called for each peer every tick before it advances (mid-match changes).
   std::function<void(std::uint32_t peer, std::uint64_t tick, net::Session&)> on_tick;
+  /// Wraps peer p's transport (hostile-datagram tests); nullptr keeps the network's endpoint.
+  std::function<std::unique_ptr<net::Transport>(std::uint32_t peer, net::Transport& inner)> wrap;
   std::optional<std::uint64_t> fault_frame;  ///< CounterGame fault on peer fault_peer
   std::uint32_t fault_peer = 0;
   std::uint64_t max_ticks = 0;  ///< 0: frames * 4 + 2000
@@ -127,6 +129,7 @@ class Match {
   std::optional<net::SimNetwork> network_;
   std::vector<std::unique_ptr<Scenario>> scenarios_;
   std::vector<std::unique_ptr<net::Game>> games_;
+  std::vector<std::unique_ptr<net::Transport>> wrappers_;
   std::vector<std::optional<net::Session>> sessions_;
   std::vector<PeerRecord> records_;
   std::uint64_t tick_ = 0;
