@@ -54,6 +54,11 @@ std::uint32_t checksum(std::span<const std::uint8_t> bytes) noexcept {
 
 // Run-length tokens over the XOR deltas: t < 128 -> t + 1 literals follow; t >= 128 -> t - 127
 // zero bytes. Inputs are small and mostly unchanged between frames, so zero runs dominate.
+//
+// A lone zero between non-zero bytes stays inside the literal run: a token of its own would cost
+// as much as the byte and the literal after it another token (x 0 x 0 ... would take 1.5 bytes a
+// byte). So a zero token is only written for a zero run that saves bytes, and n bytes never take
+// more than n + ceil(n / 128): what the session's packet budget (count * (input_size + 1)) assumes.
 void run_length_encode(std::span<const std::uint8_t> bytes, std::vector<std::uint8_t>& out) {
   std::size_t i = 0;
   while (i < bytes.size()) {
@@ -65,7 +70,8 @@ void run_length_encode(std::span<const std::uint8_t> bytes, std::vector<std::uin
       i += run;
     } else {
       std::size_t run = 1;
-      while (i + run < bytes.size() && bytes[i + run] != 0 && run < 128)
+      while (i + run < bytes.size() && run < 128 &&
+             (bytes[i + run] != 0 || (i + run + 1 < bytes.size() && bytes[i + run + 1] != 0)))
         ++run;
       out.push_back(static_cast<std::uint8_t>(run - 1));
       out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(i),
@@ -133,7 +139,7 @@ std::string_view to_string(DecodeError error) noexcept {
 
 bool encode(const Packet& packet, std::size_t input_size, std::vector<std::uint8_t>& out) {
   out.clear();
-  if (input_size == 0 || input_size > max_input_size || !body_ok(packet, input_size)) return false;
+  if (input_size == 0 || input_size > max_unit_size || !body_ok(packet, input_size)) return false;
   out.push_back(magic0);
   out.push_back(magic1);
   out.push_back(version);
@@ -194,7 +200,7 @@ DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, 
   const std::span<const std::uint8_t> signed_part = bytes.first(bytes.size() - trailer_size);
   Reader trailer(bytes.last(trailer_size));
   if (trailer.u32() != checksum(signed_part)) return DecodeError::bad_checksum;
-  if (input_size == 0 || input_size > max_input_size) return DecodeError::bad_field;
+  if (input_size == 0 || input_size > max_unit_size) return DecodeError::bad_field;
 
   Reader in(signed_part);
   in.get(4);  // magic, version, type: checked above
@@ -221,7 +227,7 @@ DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, 
       b.start_frame = in.u32();
       b.count = in.u8();
       if (!in.ok()) return DecodeError::bad_length;
-      // count <= 255 and input_size <= 64 bound the allocation to 16 KiB whatever the bytes say.
+      // count <= 255 and input_size <= 513 bound the allocation to 128 KiB whatever the bytes say.
       if (!run_length_decode(in, std::size_t{b.count} * input_size, b.deltas))
         return in.ok() ? DecodeError::bad_field : DecodeError::bad_length;
       const std::uint8_t checks = in.u8();

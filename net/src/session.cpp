@@ -51,9 +51,12 @@ Status validate(const SessionConfig& c) {
     seen[r.player] = true;
     ids.push_back(r.peer);
   }
+  if (c.spectators.size() > 16)
+    return bad("at most 16 spectators, got " + std::to_string(c.spectators.size()));
+  ids.insert(ids.end(), c.spectators.begin(), c.spectators.end());
   std::sort(ids.begin(), ids.end());
   if (std::adjacent_find(ids.begin(), ids.end()) != ids.end())
-    return bad("remotes: two players share one peer id");
+    return bad("remotes and spectators: two share one peer id");
   return Status::success();
 }
 
@@ -80,6 +83,16 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
     peer.stats.player = r.player;
     peers.push_back(std::move(peer));
   }
+  for (std::size_t k = 0; k < c.spectators.size(); ++k) {
+    detail::Peer spectator;
+    spectator.player = c.players + static_cast<std::uint32_t>(k);
+    spectator.spectator = true;
+    spectator.id = c.spectators[k];
+    spectator.challenge = static_cast<std::uint32_t>(rng.next_u64());
+    spectator.stats.player = spectator.player;
+    spectators.push_back(std::move(spectator));
+  }
+  unit_size = 1 + std::size_t{c.players} * c.input_size;
   states.resize(max_prediction + 3U);
   frame_inputs.resize(std::size_t{c.players} * c.input_size);
   frame_status.resize(c.players);
@@ -185,6 +198,14 @@ void Session::Impl::emit_confirmed() {
     const std::uint64_t hash = held ? after.hash : 0;
     if (confirmed_listener)
       confirmed_listener(ConfirmedFrame{frame, frame_inputs, frame_status, hash});
+    if (!spectators.empty()) {
+      std::uint8_t gone = 0;
+      for (std::uint32_t p = 0; p < config.players; ++p)
+        if (frame_status[p] == InputStatus::disconnected)
+          gone = static_cast<std::uint8_t>(gone | (1U << p));
+      frame_log.push_back(gone);
+      frame_log.insert(frame_log.end(), frame_inputs.begin(), frame_inputs.end());
+    }
     if (config.check_interval != 0 && (frame + 1) % config.check_interval == 0 && held)
       add_local_check(frame + 1, hash, &after);
   }

@@ -33,7 +33,8 @@ struct LocalCheck {
 
 /// A remote player's connection.
 struct Peer {
-  std::uint32_t player = 0;
+  std::uint32_t player = 0;  ///< a spectator's is players + its index
+  bool spectator = false;
   PeerId id = 0;
   // Handshake: synchronized once the peer answered our challenge and we know its nonce.
   std::uint32_t challenge = 0;
@@ -105,6 +106,8 @@ struct Session::Impl {
   void handle_input(detail::Peer& peer, const protocol::InputBody& body);
   void send_due();
   void send_inputs(detail::Peer& peer);
+  void send_frames(detail::Peer& spectator);
+  void send_hello(detail::Peer& peer);
   void send(detail::Peer& peer, protocol::Packet& packet);
   void check_timeouts();
   [[nodiscard]] detail::Peer* peer_by_id(PeerId id) noexcept;
@@ -121,7 +124,13 @@ struct Session::Impl {
   std::vector<detail::InputQueue> queues;       ///< one per player
   std::vector<std::uint64_t> disconnect_frame;  ///< per player; ~0: connected
   std::vector<detail::Peer> peers;              ///< by ascending player
-  std::vector<detail::State> states;            ///< ring of saved states
+  std::vector<detail::Peer> spectators;         ///< in configuration order
+  /// Spectators only: every confirmed frame as a spectator receives it (unit_size bytes each:
+  /// a mask of disconnected players, then every input). Grows with the match: 1 + players *
+  /// input_size bytes per frame.
+  std::vector<std::uint8_t> frame_log;
+  std::size_t unit_size = 0;
+  std::vector<detail::State> states;  ///< ring of saved states
   std::uint64_t current = 0;
   std::optional<std::uint64_t> first_incorrect;
   std::uint64_t next_emit = 0;  ///< the next frame to hand to the confirmed listener

@@ -33,6 +33,8 @@ std::uint32_t wire_frame(std::uint64_t frame) {
 detail::Peer* Session::Impl::peer_by_id(PeerId id) noexcept {
   for (detail::Peer& peer : peers)
     if (peer.id == id) return &peer;
+  for (detail::Peer& spectator : spectators)
+    if (spectator.id == id) return &spectator;
   return nullptr;
 }
 
@@ -112,8 +114,8 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
     peer.synchronized = true;
     peer.stats.synchronized = true;
     raise(Event{EventType::synchronized, peer.player, current, 0, 0, {}});
-    if (std::all_of(peers.begin(), peers.end(),
-                    [](const detail::Peer& x) { return x.synchronized; })) {
+    if (!peer.spectator && std::all_of(peers.begin(), peers.end(),
+                                       [](const detail::Peer& x) { return x.synchronized; })) {
       running = true;
       raise(Event{EventType::running, 0, current, 0, 0, {}});
     }
@@ -129,8 +131,8 @@ void Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) 
     reason = "player count";
   else if (h.input_size != config.input_size)
     reason = "input size";
-  else if (h.player != peer.player)
-    reason = "player index";
+  else if (peer.spectator ? h.player != protocol::spectator_player : h.player != peer.player)
+    reason = peer.spectator ? "not a spectator" : "player index";
   if (!reason.empty()) {
     ++stats.dropped_wrong_session;
     if (!peer.hello_rejected) {
@@ -155,6 +157,14 @@ void Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) 
 }
 
 void Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& b) {
+  if (peer.spectator) {  // a spectator only acknowledges frames
+    const std::uint64_t logged = frame_log.size() / unit_size;
+    if (b.ack_frame <= logged)
+      peer.acked_inputs = std::max<std::uint64_t>(peer.acked_inputs, b.ack_frame);
+    peer.remote_frame = b.current_frame;
+    peer.stats.remote_frame = b.current_frame;
+    return;
+  }
   const detail::InputQueue& mine = queues[config.local_player];
   // Acknowledgements never move backwards, nor beyond what was sent.
   if (b.ack_frame <= mine.next_confirmed())
@@ -208,7 +218,10 @@ void Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& 
 void Session::Impl::send(detail::Peer& peer, protocol::Packet& p) {
   p.header.nonce = nonce;
   p.header.sequence = peer.send_sequence++;
-  if (!protocol::encode(p, config.input_size, outbuf)) return;
+  const std::size_t unit = peer.spectator && p.header.type == protocol::PacketType::input
+                               ? unit_size
+                               : config.input_size;
+  if (!protocol::encode(p, unit, outbuf)) return;
   transport->send(peer.id, outbuf);
   ++peer.stats.packets_sent;
   peer.stats.bytes_sent += outbuf.size();
@@ -250,47 +263,92 @@ void Session::Impl::send_inputs(detail::Peer& peer) {
   send(peer, p);
 }
 
+void Session::Impl::send_hello(detail::Peer& peer) {
+  protocol::Packet hello;
+  hello.header.type = protocol::PacketType::hello;
+  hello.hello = protocol::Hello{config.fingerprint, static_cast<std::uint8_t>(config.players),
+                                static_cast<std::uint8_t>(config.local_player),
+                                static_cast<std::uint8_t>(config.input_size), peer.challenge};
+  send(peer, hello);
+  peer.hello_sent = true;
+  peer.last_hello_us = now_us;
+}
+
+void Session::Impl::send_frames(detail::Peer& spectator) {
+  // Every confirmed frame the spectator lacks, as whole-frame units delta-coded against the
+  // frame before: a spectator that fell behind gets up to a packet of frames per send.
+  const std::uint64_t logged = frame_log.size() / unit_size;
+  const std::uint64_t start = std::min(spectator.acked_inputs, logged);
+  const std::size_t most =
+      std::min<std::size_t>(protocol::max_inputs_per_packet, 900 / (unit_size + 1));
+  const auto count = static_cast<std::size_t>(std::min<std::uint64_t>(logged - start, most));
+  protocol::Packet& p = packet;
+  p.header.type = protocol::PacketType::input;
+  protocol::InputBody& b = p.input;
+  b = protocol::InputBody{};
+  b.current_frame = wire_frame(current);
+  b.start_frame = wire_frame(start);
+  b.count = static_cast<std::uint8_t>(count);
+  const auto at = [&](std::uint64_t frame) {
+    return frame_log.begin() + static_cast<std::ptrdiff_t>(frame * unit_size);
+  };
+  scratch_inputs.assign(at(start), at(start + count));
+  scratch_deltas.assign(unit_size, 0);
+  if (start > 0) scratch_deltas.assign(at(start - 1), at(start));
+  protocol::delta_encode(scratch_deltas, scratch_inputs, b.deltas);
+  spectator.needs_ack = false;
+  send(spectator, p);
+}
+
 void Session::Impl::send_due() {
   const detail::InputQueue& mine = queues[config.local_player];
-  for (detail::Peer& peer : peers) {
-    if (peer.disconnected) continue;
-    if (!peer.answered || !peer.nonce_known) {
-      if (!peer.hello_sent || now_us - peer.last_hello_us >= config.hello_interval_us) {
-        protocol::Packet hello;
-        hello.header.type = protocol::PacketType::hello;
-        hello.hello = protocol::Hello{config.fingerprint, static_cast<std::uint8_t>(config.players),
-                                      static_cast<std::uint8_t>(config.local_player),
-                                      static_cast<std::uint8_t>(config.input_size), peer.challenge};
-        send(peer, hello);
-        peer.hello_sent = true;
-        peer.last_hello_us = now_us;
+  const std::uint64_t logged = unit_size ? frame_log.size() / unit_size : 0;
+  for (std::vector<detail::Peer>* group : {&peers, &spectators}) {
+    for (detail::Peer& peer : *group) {
+      if (peer.disconnected) continue;
+      if ((!peer.answered || !peer.nonce_known) &&
+          (!peer.hello_sent || now_us - peer.last_hello_us >= config.hello_interval_us))
+        send_hello(peer);
+      if (!peer.synchronized) continue;
+      if (now_us - peer.last_ping_us >= config.ping_interval_us) {
+        protocol::Packet ping;
+        ping.header.type = protocol::PacketType::ping;
+        ping.ping.time_us = now_us;
+        send(peer, ping);
+        peer.last_ping_us = now_us;
       }
+      const std::uint64_t quiet = now_us - peer.last_send_us;
+      if (peer.spectator) {
+        if ((peer.acked_inputs < logged && quiet >= config.frame_us) ||
+            quiet >= config.keepalive_us)
+          send_frames(peer);
+        continue;
+      }
+      const bool unacked = peer.acked_inputs < mine.next_confirmed() ||
+                           (!local_checks.empty() && local_checks.back().frame > peer.acked_checks);
+      if (((unacked || peer.needs_ack) && quiet >= config.frame_us) || quiet >= config.keepalive_us)
+        send_inputs(peer);
     }
-    if (!peer.synchronized) continue;
-    if (now_us - peer.last_ping_us >= config.ping_interval_us) {
-      protocol::Packet ping;
-      ping.header.type = protocol::PacketType::ping;
-      ping.ping.time_us = now_us;
-      send(peer, ping);
-      peer.last_ping_us = now_us;
-    }
-    const bool unacked = peer.acked_inputs < mine.next_confirmed() ||
-                         (!local_checks.empty() && local_checks.back().frame > peer.acked_checks);
-    const std::uint64_t quiet = now_us - peer.last_send_us;
-    if (((unacked || peer.needs_ack) && quiet >= config.frame_us) || quiet >= config.keepalive_us)
-      send_inputs(peer);
   }
 }
 
 void Session::Impl::check_timeouts() {
-  for (detail::Peer& peer : peers) {
-    if (!peer.synchronized || peer.disconnected) continue;
-    const std::uint64_t silence = now_us - peer.last_receive_us;
-    if (silence >= config.disconnect_timeout_us) {
-      disconnect(peer);
-    } else if (silence >= config.disconnect_warning_us && !peer.interrupted) {
-      peer.interrupted = true;
-      raise(Event{EventType::interrupted, peer.player, current, 0, 0, {}});
+  for (std::vector<detail::Peer>* group : {&peers, &spectators}) {
+    for (detail::Peer& peer : *group) {
+      if (!peer.synchronized || peer.disconnected) continue;
+      const std::uint64_t silence = now_us - peer.last_receive_us;
+      if (silence >= config.disconnect_timeout_us) {
+        if (peer.spectator) {
+          peer.disconnected = true;
+          peer.stats.disconnected = true;
+          raise(Event{EventType::disconnected, peer.player, current, 0, 0, {}});
+        } else {
+          disconnect(peer);
+        }
+      } else if (silence >= config.disconnect_warning_us && !peer.interrupted) {
+        peer.interrupted = true;
+        raise(Event{EventType::interrupted, peer.player, current, 0, 0, {}});
+      }
     }
   }
 }
@@ -319,7 +377,8 @@ std::uint32_t Session::recommended_wait_frames() const noexcept {
 }
 
 std::optional<PeerStats> Session::peer_stats(std::uint32_t player) const {
-  for (const detail::Peer& peer : impl_->peers) {
+  const bool spectator = player >= impl_->config.players;
+  for (const detail::Peer& peer : spectator ? impl_->spectators : impl_->peers) {
     if (peer.player != player) continue;
     PeerStats stats = peer.stats;
     stats.ping_us = peer.rtt_x16 / 16;

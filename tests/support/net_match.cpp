@@ -6,7 +6,8 @@
 namespace detsim::test {
 
 Match::Match(const MatchOptions& options) : options_(options) {
-  auto network = net::SimNetwork::create(options.players, options.seed * 7919 + 13, options.link);
+  auto network = net::SimNetwork::create(options.players + options.spectators,
+                                         options.seed * 7919 + 13, options.link);
   network_.emplace(std::move(network.value()));  // the test's own settings: always valid
   if (options.setup) options.setup(*network_);
   records_.resize(options.players);
@@ -24,6 +25,9 @@ Match::Match(const MatchOptions& options) : options_(options) {
     config.random_seed = options.seed * 1000 + p;
     for (std::uint32_t q = 0; q < options.players; ++q)
       if (q != p) config.remotes.push_back(net::RemotePlayer{q, q});
+    if (p == 0)
+      for (std::uint32_t k = 0; k < options.spectators; ++k)
+        config.spectators.push_back(options.players + k);
     if (options.configure) options.configure(p, config);
     net::Transport* transport = &network_->endpoint(p);
     if (options.wrap) {
@@ -56,7 +60,31 @@ std::unique_ptr<net::Game> Match::make_game(std::uint32_t p) {
   return game;
 }
 
+void Match::add_spectators() {
+  spectator_records_.resize(options_.spectators);
+  for (std::uint32_t k = 0; k < options_.spectators; ++k) {
+    spectator_games_.push_back(make_game(options_.players + k));
+    net::SpectatorConfig config;
+    config.players = options_.players;
+    config.input_size = sessions_[0]->config().input_size;
+    config.fingerprint = sessions_[0]->config().fingerprint;
+    config.random_seed = options_.seed * 1000 + 100 + k;
+    config.host = 0;
+    if (options_.configure_spectator) options_.configure_spectator(k, config);
+    auto s = net::SpectatorSession::create(config, *spectator_games_.back(),
+                                           network_->endpoint(options_.players + k));
+    spectator_sessions_.emplace_back(std::move(s.value()));
+    PeerRecord& record = spectator_records_[k];
+    spectator_sessions_[k]->set_confirmed_listener([&record](const net::ConfirmedFrame& f) {
+      record.hashes.push_back(f.hash);
+      record.inputs.insert(record.inputs.end(), f.inputs.begin(), f.inputs.end());
+      record.status.insert(record.status.end(), f.status.begin(), f.status.end());
+    });
+  }
+}
+
 bool Match::run() {
+  if (spectator_sessions_.size() < options_.spectators) add_spectators();
   const std::uint64_t frame_us = 16'667;
   const std::uint64_t limit = options_.max_ticks ? options_.max_ticks : options_.frames * 4 + 2000;
   std::vector<std::uint8_t> input(sessions_[0]->config().input_size);
@@ -88,6 +116,18 @@ bool Match::run() {
         records_[p].events.push_back(e);
       const bool gone = !active;
       if (!gone && records_[p].hashes.size() < options_.frames) done = false;
+    }
+    for (std::uint32_t k = 0; k < options_.spectators; ++k) {
+      if (tick_ < options_.spectator_join_tick) {
+        done = false;
+        continue;
+      }
+      net::SpectatorSession& s = *spectator_sessions_[k];
+      s.poll(now);
+      s.advance();
+      for (const net::Event& e : s.take_events())
+        spectator_records_[k].events.push_back(e);
+      if (spectator_records_[k].hashes.size() < options_.frames) done = false;
     }
     if (done) return true;
   }

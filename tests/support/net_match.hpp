@@ -14,6 +14,7 @@
 #include <detsim/net/scenario_game.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
+#include <detsim/net/spectator.hpp>
 #include <detsim/sim/scenario.hpp>
 
 namespace detsim::test {
@@ -101,6 +102,11 @@ struct MatchOptions {
   std::optional<std::uint64_t> fault_frame;  ///< CounterGame fault on peer fault_peer
   std::uint32_t fault_peer = 0;
   std::uint64_t max_ticks = 0;  ///< 0: frames * 4 + 2000
+  /// Spectators served by player 0 (network nodes players .. players + spectators - 1), each
+  /// joining (first polling) at spectator_join_tick.
+  std::uint32_t spectators = 0;
+  std::uint64_t spectator_join_tick = 0;
+  std::function<void(std::uint32_t spectator, net::SpectatorConfig&)> configure_spectator;
 };
 
 /// N peers, each with its own game and session, over one SimNetwork.
@@ -115,6 +121,8 @@ class Match {
   net::Session& session(std::uint32_t p) { return *sessions_[p]; }
   net::SimNetwork& network() { return *network_; }
   const PeerRecord& record(std::uint32_t p) const { return records_[p]; }
+  const PeerRecord& spectator_record(std::uint32_t k) const { return spectator_records_[k]; }
+  net::SpectatorSession& spectator(std::uint32_t k) { return *spectator_sessions_[k]; }
   std::uint64_t ticks() const { return tick_; }
   /// The hashes of an offline run of peer p's confirmed inputs, frame by frame.
   std::vector<std::uint64_t> offline_hashes(std::uint32_t p) const;
@@ -124,6 +132,7 @@ class Match {
 
  private:
   std::unique_ptr<net::Game> make_game(std::uint32_t p);
+  void add_spectators();
 
   MatchOptions options_;
   std::optional<net::SimNetwork> network_;
@@ -132,6 +141,9 @@ class Match {
   std::vector<std::unique_ptr<net::Transport>> wrappers_;
   std::vector<std::optional<net::Session>> sessions_;
   std::vector<PeerRecord> records_;
+  std::vector<std::unique_ptr<net::Game>> spectator_games_;
+  std::vector<std::optional<net::SpectatorSession>> spectator_sessions_;
+  std::vector<PeerRecord> spectator_records_;
   std::uint64_t tick_ = 0;
 };
 

@@ -7,5 +7,6 @@
 #include <detsim/net/scenario_recorder.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
+#include <detsim/net/spectator.hpp>
 #include <detsim/net/transport.hpp>
 #include <detsim/net/udp.hpp>

@@ -43,8 +43,11 @@ inline constexpr std::uint8_t magic0 = 'D';
 inline constexpr std::uint8_t magic1 = 'N';
 inline constexpr std::size_t header_size = 10;
 inline constexpr std::size_t trailer_size = 4;
-/// The largest input a session exchanges, in bytes.
+/// The largest input a player sends, in bytes.
 inline constexpr std::size_t max_input_size = 64;
+/// The largest unit an input packet carries: players send their input; a host sends spectators
+/// whole frames (a byte of disconnected players, then every player's input: 1 + 8 * 64 bytes).
+inline constexpr std::size_t max_unit_size = 1 + 8 * max_input_size;
 /// The most inputs and hash checks one datagram carries.
 inline constexpr std::size_t max_inputs_per_packet = 255;
 inline constexpr std::size_t max_checks_per_packet = 8;
@@ -121,7 +124,7 @@ inline constexpr std::size_t decode_error_count = 9;
 /// A short name for logs and statistics ("bad_checksum").
 [[nodiscard]] std::string_view to_string(DecodeError error) noexcept;
 
-/// Decodes `bytes`, whose inputs (if any) are `input_size` bytes each (1 .. max_input_size).
+/// Decodes `bytes`, whose inputs (if any) are `input_size` bytes each (1 .. max_unit_size).
 /// On success fills `out` and returns DecodeError::none; otherwise `out` is unspecified.
 [[nodiscard]] DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size,
                                  Packet& out);

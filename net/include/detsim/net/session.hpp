@@ -70,6 +70,10 @@ struct SessionConfig {
   std::uint64_t disconnect_warning_us = 500'000;    ///< silence before Event::interrupted
   std::uint64_t disconnect_timeout_us = 5'000'000;  ///< silence before Event::disconnected
   std::vector<RemotePlayer> remotes;                ///< every other player, each exactly once
+  /// Spectators this machine serves (at most 16; ids distinct from the remotes'): each receives
+  /// every confirmed frame's inputs from here (SpectatorSession). Events about spectator k use
+  /// player = players + k.
+  std::vector<PeerId> spectators;
 };
 
 /// What advance_frame() did.
@@ -196,7 +200,8 @@ class Session {
   /// Frames the game should skip (not advance) to let slower peers catch up: 0 when in time.
   [[nodiscard]] std::uint32_t recommended_wait_frames() const noexcept;
   [[nodiscard]] const SessionStats& stats() const noexcept;
-  /// The statistics of the peer playing `player`; nothing for the local player or an unknown one.
+  /// The statistics of the peer playing `player` (spectator k: players + k); nothing for the
+  /// local player or an unknown one.
   [[nodiscard]] std::optional<PeerStats> peer_stats(std::uint32_t player) const;
   /// This machine's side of the first desync, once one was detected.
   [[nodiscard]] const DesyncEvidence* desync_evidence() const noexcept;

@@ -37,6 +37,8 @@ class [[nodiscard]] Expected {
   /// The value; only valid when ok().
   [[nodiscard]] const T& value() const& { return std::get<0>(v_); }
   [[nodiscard]] T& value() & { return std::get<0>(v_); }
+  /// The value moved out of a temporary (`auto world = World::create(def).value();`).
+  [[nodiscard]] T&& value() && { return std::get<0>(std::move(v_)); }
   [[nodiscard]] const T& operator*() const& { return value(); }
   [[nodiscard]] const T* operator->() const { return &value(); }
   /// The error message; empty when ok().
