@@ -324,9 +324,13 @@ void Session::Impl::send_due() {
           send_frames(peer);
         continue;
       }
+      // advance_frame() sends each new local input at once; here only what it did not cover: a
+      // stall (waiting at the limit adds no input), acknowledgements, resends and keepalives.
+      // Waiting a frame and a half first keeps the normal flow at one datagram per frame.
       const bool unacked = peer.acked_inputs < mine.next_confirmed() ||
                            (!local_checks.empty() && local_checks.back().frame > peer.acked_checks);
-      if (((unacked || peer.needs_ack) && quiet >= config.frame_us) || quiet >= config.keepalive_us)
+      const std::uint64_t resend_us = config.frame_us + config.frame_us / 2;
+      if (((unacked || peer.needs_ack) && quiet >= resend_us) || quiet >= config.keepalive_us)
         send_inputs(peer);
     }
   }

@@ -64,9 +64,9 @@ struct SessionConfig {
   /// (from the operating system) in a real game; a fixed value in tests.
   std::uint64_t random_seed = 0;
   std::uint32_t frame_us = 16'667;  ///< the nominal frame duration (time sync): 1000 .. 1'000'000
-  std::uint64_t hello_interval_us = 200'000;  ///< handshake resend interval
-  std::uint64_t keepalive_us = 100'000;       ///< the longest silence towards a peer
-  std::uint64_t ping_interval_us = 250'000;
+  std::uint64_t hello_interval_us = 200'000;        ///< handshake resend interval
+  std::uint64_t keepalive_us = 100'000;             ///< the longest silence towards a peer
+  std::uint64_t ping_interval_us = 1'000'000;       ///< round-trip measurement
   std::uint64_t disconnect_warning_us = 500'000;    ///< silence before Event::interrupted
   std::uint64_t disconnect_timeout_us = 5'000'000;  ///< silence before Event::disconnected
   std::vector<RemotePlayer> remotes;                ///< every other player, each exactly once
