@@ -7,9 +7,13 @@
 // tenth of the frames (DETSIM_TEST_SCALE).
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <detsim/net/scenario_game.hpp>
+#include <detsim/net/scenario_recorder.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
+#include <detsim/replay/scenario_replay.hpp>
 
 #include "support/net_match.hpp"
 #include "support/scale.hpp"
@@ -242,6 +246,31 @@ TEST(NetConditions, ANudgedBodyIsDetectedWithinOneCheckInterval) {
     World check;
     ASSERT_TRUE(check.restore(evidence->divergent_state).ok());
     EXPECT_EQ(check.hashes().total, evidence->local_hash);
+  }
+  // The desync reports of a healthy peer and of the nudged one: they agree on every body at the
+  // agreed frame and disagree at the divergent one, starting with the nudged player's body.
+  const replay::Fingerprint fingerprint = replay::fingerprint_of(*scenarios[0]);
+  std::vector<replay::DesyncReport> reports;
+  for (std::uint32_t p : {0U, 3U}) {
+    auto report = net::desync_report(fingerprint, p, *sessions[p].desync_evidence());
+    ASSERT_TRUE(report.ok()) << report.message();
+    std::string path = DETSIM_BINARY_DIR;
+    path.append("/tests/net_desync_").append(std::to_string(p)).append(".dsd");
+    ASSERT_TRUE(replay::write_desync_report(path, report.value()).ok());
+    auto back = replay::read_desync_report(path);
+    ASSERT_TRUE(back.ok()) << back.message();
+    EXPECT_EQ(back.value(), report.value());
+    EXPECT_EQ(back->confirmed_frames.size(), expected * (1 + players * 3U));
+    reports.push_back(std::move(back).value());
+    std::remove(path.c_str());
+  }
+  EXPECT_EQ(reports[0].agreed_bodies, reports[1].agreed_bodies);
+  EXPECT_EQ(reports[0].confirmed_frames, reports[1].confirmed_frames);
+  ASSERT_EQ(reports[0].divergent_bodies.size(), reports[1].divergent_bodies.size());
+  const BodyId nudged = scenarios[0]->player_body(0);
+  for (std::size_t i = 0; i < reports[0].divergent_bodies.size(); ++i) {
+    if (reports[0].divergent_bodies[i].id != nudged.value) continue;
+    EXPECT_NE(reports[0].divergent_bodies[i].hash, reports[1].divergent_bodies[i].hash);
   }
 }
 

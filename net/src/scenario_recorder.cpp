@@ -80,4 +80,28 @@ Status ScenarioRecorder::finish() {
   return impl_->writer.finish();
 }
 
+Expected<replay::DesyncReport> desync_report(const replay::Fingerprint& fingerprint,
+                                             std::uint32_t reporter,
+                                             const DesyncEvidence& evidence) {
+  replay::DesyncReport r;
+  r.fingerprint = fingerprint;
+  r.reporter = reporter;
+  r.other = evidence.player;
+  r.agreed_frame = evidence.agreed_frame;
+  r.divergent_frame = evidence.divergent_frame;
+  r.local_hash = evidence.local_hash;
+  r.remote_hash = evidence.remote_hash;
+  r.confirmed_frames = evidence.confirmed_frames;
+  r.agreed_state = evidence.agreed_state;
+  r.divergent_state = evidence.divergent_state;
+  auto agreed = replay::body_hashes(r.agreed_state);
+  if (!agreed) return Status::error("desync report: the agreed state: " + agreed.message());
+  auto divergent = replay::body_hashes(r.divergent_state);
+  if (!divergent)
+    return Status::error("desync report: the divergent state: " + divergent.message());
+  r.agreed_bodies = std::move(agreed).value();
+  r.divergent_bodies = std::move(divergent).value();
+  return r;
+}
+
 }  // namespace detsim::net

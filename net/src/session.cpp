@@ -101,6 +101,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
   detail::State& zero = state_slot(0);
   zero.frame = 0;
   zero.hash = game->save(zero.bytes);
+  agreed_state = zero.bytes;  // every peer starts from the same state (the fingerprint says so)
 }
 
 std::uint64_t Session::Impl::confirmed_frame() const noexcept {
@@ -198,7 +199,7 @@ void Session::Impl::emit_confirmed() {
     const std::uint64_t hash = held ? after.hash : 0;
     if (confirmed_listener)
       confirmed_listener(ConfirmedFrame{frame, frame_inputs, frame_status, hash});
-    if (!spectators.empty()) {
+    {  // the log spectators are served from and desync evidence carries
       std::uint8_t gone = 0;
       for (std::uint32_t p = 0; p < config.players; ++p)
         if (frame_status[p] == InputStatus::disconnected)
@@ -234,7 +235,10 @@ void Session::Impl::compare_checks(detail::Peer& peer) {
     raise(Event{EventType::desync, peer.player, remote.frame, local->hash, remote.hash, {}});
     if (!evidence) {
       evidence = DesyncEvidence{peer.player,  agreed_frame, agreed_state, remote.frame,
-                                local->state, local->hash,  remote.hash};
+                                local->state, local->hash,  remote.hash,  {}};
+      const std::size_t logged = std::min<std::size_t>(frame_log.size() / unit_size, remote.frame);
+      evidence->confirmed_frames.assign(
+          frame_log.begin(), frame_log.begin() + static_cast<std::ptrdiff_t>(logged * unit_size));
     }
   }
 }

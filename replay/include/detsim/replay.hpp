@@ -1,5 +1,6 @@
 // The replay layer: replay files, and recording, verifying and seeking scenario replays.
 #pragma once
 
+#include <detsim/replay/desync_report.hpp>
 #include <detsim/replay/replay.hpp>
 #include <detsim/replay/scenario_replay.hpp>

@@ -12,6 +12,7 @@
 
 #include <detsim/net/scenario_game.hpp>
 #include <detsim/net/session.hpp>
+#include <detsim/replay/desync_report.hpp>
 #include <detsim/replay/replay.hpp>
 #include <detsim/sim/status.hpp>
 
@@ -46,5 +47,13 @@ class ScenarioRecorder {
   explicit ScenarioRecorder(std::unique_ptr<Impl> impl) noexcept;
   std::unique_ptr<Impl> impl_;
 };
+
+/// The desync report of this machine's side (`evidence` from Session::desync_evidence()) in a
+/// scenario match with `fingerprint` (replay::fingerprint_of the scenario at frame 0), written by
+/// player `reporter`: adds the per-body hashes of both states. Write it with
+/// replay::write_desync_report().
+Expected<replay::DesyncReport> desync_report(const replay::Fingerprint& fingerprint,
+                                             std::uint32_t reporter,
+                                             const DesyncEvidence& evidence);
 
 }  // namespace detsim::net

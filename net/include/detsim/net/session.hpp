@@ -116,11 +116,14 @@ struct ConfirmedFrame {
 struct DesyncEvidence {
   std::uint32_t player = 0;        ///< the peer that disagreed
   std::uint64_t agreed_frame = 0;  ///< the last state frame every peer agreed on (0: the start)
-  std::vector<std::uint8_t> agreed_state;  ///< empty when agreed_frame is 0 and none was kept
+  std::vector<std::uint8_t> agreed_state;  ///< this machine's state at agreed_frame
   std::uint64_t divergent_frame = 0;
   std::vector<std::uint8_t> divergent_state;
   std::uint64_t local_hash = 0;
   std::uint64_t remote_hash = 0;
+  /// Every confirmed frame before divergent_frame, in order, each 1 + players * input_size
+  /// bytes: a byte whose bit p says player p was disconnected, then every player's input.
+  std::vector<std::uint8_t> confirmed_frames;
 };
 
 struct PeerStats {
