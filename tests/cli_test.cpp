@@ -1,8 +1,6 @@
 // The detsim command as a user meets it: exit codes (0 ok, 1 a check failed, 2 bad usage or
 // input), exactly one JSON object with --json, errors on stderr naming what is wrong, no progress
 // output when stderr is not a terminal, and the golden check against the checked-in golden/.
-#include <sys/wait.h>
-
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -12,65 +10,21 @@
 #include <gtest/gtest.h>
 #include <detsim/replay.hpp>
 
+#include "support/cli.hpp"
 #include "support/replay_files.hpp"
 
 namespace detsim {
 namespace {
 
+using test::detsim_cli;
+using test::expect_one_json_object;
+using test::has;
+using test::json_value;
 using test::read_bytes;
+using test::read_text;
 using test::TempFile;
 using test::write_bytes;
-
-struct Result {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string read_text(const std::string& path) {
-  const auto bytes = read_bytes(path);
-  return {bytes.begin(), bytes.end()};
-}
-
-/// Runs `detsim <args>` with stdin from /dev/null, capturing stdout and stderr.
-Result detsim_cli(const std::string& args) {
-  TempFile out("out.txt");
-  TempFile err("err.txt");
-  const std::string command = std::string(DETSIM_BINARY_DIR) + "/tools/detsim " + args +
-                              " </dev/null >" + out.path() + " 2>" + err.path();
-  const int status = std::system(command.c_str());
-  Result r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = read_text(out.path());
-  r.err = read_text(err.path());
-  return r;
-}
-
-bool has(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
-/// One JSON object on one line, and nothing else.
-void expect_one_json_object(const std::string& out) {
-  ASSERT_FALSE(out.empty());
-  EXPECT_EQ(out.front(), '{') << out;
-  EXPECT_EQ(out.substr(out.size() - 2), "}\n") << out;
-  EXPECT_EQ(out.find('\n'), out.size() - 1) << out;
-}
-
-/// The value of "key": in a flat JSON object (a string without quotes, or a literal).
-std::string json_value(const std::string& json, const std::string& key) {
-  const std::string k = "\"" + key + "\":";
-  const auto at = json.find(k);
-  if (at == std::string::npos) return "<missing>";
-  std::size_t from = at + k.size();
-  if (json[from] == '"') {
-    const auto end = json.find('"', from + 1);
-    return json.substr(from + 1, end - from - 1);
-  }
-  const auto end = json.find_first_of(",}", from);
-  return json.substr(from, end - from);
-}
+using Result = test::CliResult;
 
 std::string hex16(std::uint64_t v) {
   char text[17];

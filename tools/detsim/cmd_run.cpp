@@ -1,9 +1,10 @@
-// detsim scenarios, detsim run, and the main job (detsim demo): run a scenario, record, verify.
+// detsim scenarios and detsim run: list the scenarios; run one headless, optionally recording it.
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <string>
-#include <system_error>
+#include <vector>
+
+#include <xxhash.h>
 
 #include <detsim/replay.hpp>
 
@@ -45,6 +46,45 @@ std::string describe(const Scenario& scenario) {
   if (scenario.info().default_count != 0)
     out += ", " + std::to_string(p.count) + " " + std::string(scenario.info().count_unit);
   return out + ")";
+}
+
+// ---- The session fingerprint (netplay, demo) -------------------------------------------------
+
+namespace {
+
+void put_u64(std::vector<std::uint8_t>& out, std::uint64_t v) {
+  for (int i = 0; i < 8; ++i)
+    out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+}
+
+void put_text(std::vector<std::uint8_t>& out, std::string_view text) {
+  put_u64(out, text.size());
+  out.insert(out.end(), text.begin(), text.end());
+}
+
+}  // namespace
+
+std::uint64_t session_fingerprint(const Scenario& scenario, net::SessionMode mode,
+                                  std::uint64_t frames) {
+  const replay::Fingerprint f = replay::fingerprint_of(scenario);
+  std::vector<std::uint8_t> bytes;
+  put_text(bytes, "detsim netplay 1");
+  put_text(bytes, f.detsim_version);
+  put_u64(bytes, f.fixed_fraction_bits);
+  put_u64(bytes, f.state_version);
+  put_text(bytes, f.scenario);
+  put_u64(bytes, f.params.seed);
+  put_u64(bytes, f.params.players);
+  put_u64(bytes, f.params.count);
+  put_u64(bytes, static_cast<std::uint64_t>(f.dt.raw()));
+  put_u64(bytes, f.substeps);
+  put_u64(bytes, f.iterations);
+  put_u64(bytes, f.players);
+  put_u64(bytes, f.input_size);
+  put_u64(bytes, f.initial_hash);
+  put_u64(bytes, static_cast<std::uint64_t>(mode));
+  put_u64(bytes, frames);
+  return XXH3_64bits(bytes.data(), bytes.size());
 }
 
 // ---- detsim scenarios ---------------------------------------------------------------------------
@@ -128,78 +168,6 @@ int run_command(const RunArgs& args) {
               static_cast<unsigned long long>(result->frames), hex(result->final_hash).c_str());
   if (!args.record.empty()) std::printf("recorded %s\n", args.record.c_str());
   return exit_ok;
-}
-
-// ---- detsim demo (the main job) -----------------------------------------------------------------
-
-int demo_command(const DemoArgs& args) {
-  auto chosen = choose_scenario(args.scene);
-  if (!chosen) return usage_error("demo", chosen.message());
-  Scenario& scenario = chosen.value().scenario;
-  std::string path = args.record;
-  if (path.empty()) {
-    std::error_code ec;
-    path = (std::filesystem::temp_directory_path(ec) / "detsim-demo.dsr").string();
-  }
-  replay::RecordOptions options;
-  options.frames = static_cast<std::uint32_t>(chosen.value().frames);
-  Progress run_progress("run");
-  options.progress = [&run_progress](std::uint64_t done, std::uint64_t total) {
-    run_progress.update(done, total);
-    return true;
-  };
-  auto start = std::chrono::steady_clock::now();
-  auto recorded = replay::record(scenario, path, options);
-  const double run_seconds = seconds_since(start);
-  run_progress.done();
-  if (!recorded) return usage_error("demo", recorded.message());
-
-  auto reader = replay::ReplayReader::open(path);
-  if (!reader) return usage_error("demo", reader.message());
-  Progress verify_progress("verify");
-  start = std::chrono::steady_clock::now();
-  auto verified = replay::verify(reader.value(), [&](std::uint64_t done, std::uint64_t total) {
-    verify_progress.update(done, total);
-    return true;
-  });
-  const double verify_seconds = seconds_since(start);
-  verify_progress.done();
-  if (!verified) return usage_error("demo", verified.message());
-  const bool ok = verified->ok;
-  const double fps =
-      verify_seconds > 0 ? static_cast<double>(verified->frames) / verify_seconds : 0;
-  const double realtime = fps * scenario.world().def().dt.to_double();
-  if (args.json) {
-    Json()
-        .str("scenario", scenario.info().name)
-        .num("frames", recorded->frames)
-        .hash("final_hash", recorded->final_hash)
-        .str("replay", path)
-        .num("replay_bytes", reader->file_size())
-        .boolean("verified", ok)
-        .frame("first_mismatch", verified->first_mismatch)
-        .real("run_seconds", run_seconds)
-        .real("verify_seconds", verify_seconds)
-        .real("verify_frames_per_second", fps)
-        .print();
-    return ok ? exit_ok : exit_check_failed;
-  }
-  std::printf("scenario     %s\n", describe(scenario).c_str());
-  std::printf("frames       %llu (%.2f s of simulated time)\n",
-              static_cast<unsigned long long>(recorded->frames),
-              static_cast<double>(recorded->frames) * scenario.world().def().dt.to_double());
-  std::printf("final hash   %s\n", hex(recorded->final_hash).c_str());
-  std::printf("replay       %s (%llu bytes, %zu keyframes)\n", path.c_str(),
-              static_cast<unsigned long long>(reader->file_size()), reader->keyframes().size());
-  if (ok) {
-    std::printf("verify       ok: every frame's hash reproduced\n");
-  } else {
-    std::printf("verify       MISMATCH at frame %llu\n",
-                static_cast<unsigned long long>(verified->first_mismatch.value_or(0)));
-  }
-  std::printf("time         run %.2f s, verify %.2f s (%.0f frames/s, %.0fx real time)\n",
-              run_seconds, verify_seconds, fps, realtime);
-  return ok ? exit_ok : exit_check_failed;
 }
 
 }  // namespace detsim::cli

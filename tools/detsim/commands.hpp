@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace detsim::cli {
 
@@ -55,12 +56,33 @@ struct GoldenArgs {
 };
 int golden_command(const GoldenArgs& args);
 
-/// The main job of scripts/run.sh: run a scenario, record it, verify the replay, summarise.
+/// The main job of scripts/run.sh: a 4-player arena match of bots over a simulated bad network
+/// (rollback sessions in virtual time), player 0 recorded, the replay verified, a summary.
 struct DemoArgs {
-  ScenarioArgs scene;
-  std::string record;  ///< empty: a temporary file
+  std::uint64_t frames = 1200;
+  std::uint64_t seed = 1;
+  std::string record;  ///< empty: a temporary file, removed afterwards
   bool json = false;
 };
 int demo_command(const DemoArgs& args);
+
+/// One player of an arena match over UDP against the listed peers.
+struct NetplayArgs {
+  std::uint32_t players = 2;
+  std::uint32_t me = 0;
+  std::string bind;                ///< IP:PORT
+  std::vector<std::string> peers;  ///< "J=IP:PORT", every player but `me` once
+  std::string mode = "rollback";   ///< or "lockstep"
+  std::uint32_t input_delay = 2;
+  std::uint64_t frames = 3600;
+  std::uint64_t seed = 1;  ///< the scenario's seed
+  bool bot = false;        ///< drive this player with scripted_input(bot_seed, ...)
+  std::uint64_t bot_seed = 0;
+  std::uint32_t fps = 60;  ///< 0: as fast as possible
+  double timeout_seconds = 10;
+  std::string record;  ///< replay file, or empty
+  bool json = false;
+};
+int netplay_command(const NetplayArgs& args);
 
 }  // namespace detsim::cli

@@ -1,0 +1,292 @@
+// detsim netplay between two real processes over UDP on 127.0.0.1 (the same final hash, the same
+// replay bytes, a replay that verifies), its usage errors, and detsim demo (four sessions over a
+// simulated network).
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "support/cli.hpp"
+#include "support/replay_files.hpp"
+
+extern char** environ;  // POSIX: the environment passed on to the spawned processes
+
+namespace detsim {
+namespace {
+
+using test::detsim_cli;
+using test::expect_one_json_object;
+using test::has;
+using test::json_value;
+using test::read_bytes;
+using test::read_text;
+using test::TempFile;
+
+/// A detsim process started in the background, its stdout and stderr going to files.
+class Process {
+ public:
+  Process(const std::vector<std::string>& args, const std::string& name)
+      : out_(name + ".out"), err_(name + ".err") {
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 1, out_.path().c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err_.path().c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+    const std::string binary = test::detsim_binary();
+    std::vector<std::string> all = {binary};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : all)
+      argv.push_back(a.data());
+    argv.push_back(nullptr);
+    if (posix_spawn(&pid_, binary.c_str(), &actions, nullptr, argv.data(), environ) != 0) pid_ = -1;
+    posix_spawn_file_actions_destroy(&actions);
+  }
+  ~Process() { kill(); }
+  Process(const Process&) = delete;
+  Process& operator=(const Process&) = delete;
+
+  /// True once the process has exited (its exit code is then exit_code()).
+  bool poll() {
+    if (pid_ < 0) return true;
+    int status = 0;
+    if (waitpid(pid_, &status, WNOHANG) != pid_) return false;
+    exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    pid_ = -1;
+    return true;
+  }
+  /// Kills the process (this one, by its id) if it still runs.
+  void kill() {
+    if (pid_ < 0) return;
+    ::kill(pid_, SIGKILL);
+    int status = 0;
+    waitpid(pid_, &status, 0);
+    pid_ = -1;
+  }
+  [[nodiscard]] int exit_code() const { return exit_code_; }
+  [[nodiscard]] std::string out() const { return read_text(out_.path()); }
+  [[nodiscard]] std::string err() const { return read_text(err_.path()); }
+
+ private:
+  TempFile out_;
+  TempFile err_;
+  pid_t pid_ = -1;
+  int exit_code_ = -1;  ///< -1: killed, killed by a signal, or not started
+};
+
+/// Ports for this test process: even numbers in 20000 .. 59998 derived from the pid, so that
+/// concurrent test runs rarely collide; attempt k moves on to other ports.
+std::uint16_t port_for(int attempt) {
+  const auto pid = static_cast<std::uint32_t>(getpid());
+  const std::uint32_t slot =
+      (pid * 2'654'435'761U + static_cast<std::uint32_t>(attempt) * 7919U) % 20'000U;
+  return static_cast<std::uint16_t>(20'000U + slot * 2U);
+}
+
+std::string endpoint(std::uint16_t port) {
+  return "127.0.0.1:" + std::to_string(port);
+}
+
+bool bind_failed(const Process& p) {
+  return p.exit_code() == 2 && has(p.err(), "bind 127.0.0.1:");
+}
+
+/// Two netplay processes, players 0 and 1, each with its own extra arguments, on fresh ports.
+/// Retries on other ports when a bind fails; kills both after `limit`.
+struct Pair {
+  std::unique_ptr<Process> a;
+  std::unique_ptr<Process> b;
+  bool timed_out = false;
+};
+
+Pair run_pair(const std::vector<std::string>& extra_a, const std::vector<std::string>& extra_b,
+              std::chrono::seconds limit) {
+  Pair pair;
+  for (int attempt = 0; attempt < 6; ++attempt) {
+    const std::uint16_t port_a = port_for(attempt);
+    const auto port_b = static_cast<std::uint16_t>(port_a + 1);
+    std::vector<std::string> args_a = {"netplay",        "--players", "2",
+                                       "--me",           "0",         "--bind",
+                                       endpoint(port_a), "--peer",    "1=" + endpoint(port_b)};
+    std::vector<std::string> args_b = {"netplay",        "--players", "2",
+                                       "--me",           "1",         "--bind",
+                                       endpoint(port_b), "--peer",    "0=" + endpoint(port_a)};
+    args_a.insert(args_a.end(), extra_a.begin(), extra_a.end());
+    args_b.insert(args_b.end(), extra_b.begin(), extra_b.end());
+    pair.a = std::make_unique<Process>(args_a, "netplay_a");
+    pair.b = std::make_unique<Process>(args_b, "netplay_b");
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    bool retry = false;
+    for (;;) {
+      const bool a_done = pair.a->poll();
+      const bool b_done = pair.b->poll();
+      if ((a_done && bind_failed(*pair.a)) || (b_done && bind_failed(*pair.b))) {
+        retry = true;  // a port in use: stop the other one and try other ports
+        break;
+      }
+      if (a_done && b_done) break;
+      if (std::chrono::steady_clock::now() > deadline) {
+        pair.timed_out = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    pair.a->kill();
+    pair.b->kill();
+    if (!retry) return pair;
+  }
+  return pair;
+}
+
+TEST(CliNetplay, TwoProcessesPlayTheSameMatchAndRecordTheSameReplay) {
+  TempFile replay_a("netplay_a.dsr");
+  TempFile replay_b("netplay_b.dsr");
+  const std::vector<std::string> common = {"--frames", "3000", "--fps", "1000", "--json"};
+  std::vector<std::string> a = {"--bot", "11", "--record", replay_a.path()};
+  std::vector<std::string> b = {"--bot", "12", "--record", replay_b.path()};
+  a.insert(a.end(), common.begin(), common.end());
+  b.insert(b.end(), common.begin(), common.end());
+  const Pair pair = run_pair(a, b, std::chrono::seconds(120));
+  ASSERT_FALSE(pair.timed_out) << "killed after 120 s\nA: " << pair.a->err()
+                               << "\nB: " << pair.b->err();
+  const std::string out_a = pair.a->out();
+  const std::string out_b = pair.b->out();
+  ASSERT_EQ(pair.a->exit_code(), 0) << out_a << pair.a->err();
+  ASSERT_EQ(pair.b->exit_code(), 0) << out_b << pair.b->err();
+  expect_one_json_object(out_a);
+  expect_one_json_object(out_b);
+  for (const std::string* out : {&out_a, &out_b}) {
+    EXPECT_EQ(json_value(*out, "frames"), "3000") << *out;
+    EXPECT_EQ(json_value(*out, "desyncs"), "0") << *out;
+    EXPECT_EQ(json_value(*out, "final_hash").size(), 16U) << *out;
+    EXPECT_NE(json_value(*out, "rollbacks"), "<missing>") << *out;
+    EXPECT_NE(json_value(*out, "resimulated_frames"), "<missing>") << *out;
+  }
+  EXPECT_EQ(json_value(out_a, "player"), "0");
+  EXPECT_EQ(json_value(out_b, "player"), "1");
+  EXPECT_EQ(json_value(out_a, "final_hash"), json_value(out_b, "final_hash"));
+
+  const auto bytes_a = read_bytes(replay_a.path());
+  ASSERT_FALSE(bytes_a.empty());
+  EXPECT_TRUE(bytes_a == read_bytes(replay_b.path())) << "the two peers' replays differ";
+  const test::CliResult verify = detsim_cli("verify " + replay_a.path() + " --json");
+  EXPECT_EQ(verify.exit_code, 0) << verify.out << verify.err;
+  EXPECT_EQ(json_value(verify.out, "ok"), "true");
+  EXPECT_EQ(json_value(verify.out, "frames"), "3000");
+  EXPECT_EQ(json_value(verify.out, "final_hash"), json_value(out_a, "final_hash"));
+}
+
+TEST(CliNetplay, PeersWithOtherSettingsRefuseEachOther) {
+  // Another scenario seed: the session fingerprints differ, the handshake never completes.
+  const Pair pair =
+      run_pair({"--timeout", "1"}, {"--timeout", "1", "--seed", "2"}, std::chrono::seconds(60));
+  ASSERT_FALSE(pair.timed_out);
+  for (const Process* p : {pair.a.get(), pair.b.get()}) {
+    EXPECT_EQ(p->exit_code(), 2) << p->err();
+    EXPECT_TRUE(has(p->err(), "handshake timed out waiting for player")) << p->err();
+    EXPECT_TRUE(has(p->err(), "settings differ: fingerprint")) << p->err();
+  }
+}
+
+TEST(CliNetplay, HandshakeTimeoutNamesThePlayerAndAddress) {
+  // Port 0: the OS picks a free port, so this never collides; nobody answers at port 9.
+  const test::CliResult r = detsim_cli(
+      "netplay --players 3 --me 1 --bind 127.0.0.1:0 --peer 0=127.0.0.1:9 --peer 2=127.0.0.1:11 "
+      "--timeout 0.3 --json");
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "handshake timed out waiting for player 0 at 127.0.0.1:9")) << r.err;
+  EXPECT_EQ(r.out, "");
+}
+
+TEST(CliNetplay, BadUsageExitsWithTwoAndNamesTheProblem) {
+  struct Case {
+    std::string args;
+    std::string message;  ///< on stderr
+  };
+  const std::string bind = " --bind 127.0.0.1:0";
+  const std::vector<Case> cases = {
+      {"netplay --players 2 --me 0" + bind, "missing --peer for player 1"},
+      {"netplay --players 3 --me 0" + bind + " --peer 1=127.0.0.1:7001",
+       "missing --peer for player 2"},
+      {"netplay --players 3" + bind + " --peer 1=127.0.0.1:7001 --peer 1=127.0.0.1:7002",
+       "--peer 1 is given twice"},
+      {"netplay" + bind + " --peer 0=127.0.0.1:7001", "player 0 is this machine (--me 0)"},
+      {"netplay" + bind + " --peer 2=127.0.0.1:7001", "player \"2\" is not a player of this match"},
+      {"netplay" + bind + " --peer 127.0.0.1:7001", "expected J=IP:PORT"},
+      {"netplay" + bind + " --peer 1=localhost:7001", "host names are not resolved"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:70000", "port 70000 is out of range"},
+      {"netplay --bind 127.0.0.1 --peer 1=127.0.0.1:7001", "--bind: endpoint \"127.0.0.1\""},
+      {"netplay --bind 127.0.0.1:65536 --peer 1=127.0.0.1:7001", "port 65536 is out of range"},
+      {"netplay --players 2 --me 2" + bind + " --peer 0=127.0.0.1:7001",
+       "--me 2 must be below --players 2"},
+      {"netplay --players 9" + bind, "--players must be 2 .. 8"},
+      {"netplay --players 1" + bind, "--players must be 2 .. 8"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --mode turbo",
+       "--mode must be rollback or lockstep"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --frames 0", "--frames must be 1 .."},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --timeout 0", "--timeout must be"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --fps 5000", "--fps"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --input-delay 17", "--input-delay"},
+      {"netplay --bind [::1]:0 --peer 1=127.0.0.1:7001", "one address family"},
+      {"netplay --peer 1=127.0.0.1:7001", "--bind is required"},
+  };
+  for (const Case& c : cases) {
+    const test::CliResult r = detsim_cli(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.err;
+    EXPECT_TRUE(has(r.err, c.message)) << c.args << "\nstderr: " << r.err;
+    EXPECT_EQ(r.out, "") << c.args;
+  }
+}
+
+TEST(CliNetplay, HelpDescribesEveryOption) {
+  const test::CliResult top = detsim_cli("--help");
+  EXPECT_TRUE(has(top.out, "  netplay")) << top.out;
+  const test::CliResult help = detsim_cli("netplay --help");
+  EXPECT_EQ(help.exit_code, 0);
+  for (const char* option :
+       {"--players", "--me", "--bind", "--peer", "--seed", "--mode", "--input-delay", "--frames",
+        "--bot", "--fps", "--timeout", "--record", "--json", "Exit status: 0"}) {
+    EXPECT_TRUE(has(help.out, option)) << option;
+  }
+  EXPECT_FALSE(has(help.out, "--spectate"));
+}
+
+TEST(CliDemo, FourPeersOverABadNetworkAgreeAndTheReplayVerifies) {
+  const test::CliResult r = detsim_cli("demo --json --frames 300");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  expect_one_json_object(r.out);
+  EXPECT_EQ(json_value(r.out, "frames"), "300");
+  EXPECT_EQ(json_value(r.out, "players"), "4");
+  EXPECT_EQ(json_value(r.out, "final_hash").size(), 16U) << r.out;
+  EXPECT_EQ(json_value(r.out, "peers_agree"), "true");
+  EXPECT_EQ(json_value(r.out, "desyncs"), "0");
+  EXPECT_EQ(json_value(r.out, "verified"), "true");
+  EXPECT_EQ(json_value(r.out, "first_mismatch"), "null");
+  for (const char* key : {"rollbacks", "resimulated_frames", "peers", "bytes_per_second",
+                          "virtual_seconds", "match_seconds", "replay"}) {
+    EXPECT_NE(json_value(r.out, key), "<missing>") << key;
+  }
+  // The temporary replay is removed afterwards; --record keeps it, and it verifies on its own.
+  EXPECT_FALSE(std::filesystem::exists(json_value(r.out, "replay")));
+  TempFile kept("demo.dsr");
+  const test::CliResult recorded = detsim_cli("demo --frames 120 --record " + kept.path());
+  EXPECT_EQ(recorded.exit_code, 0) << recorded.out << recorded.err;
+  EXPECT_TRUE(has(recorded.out, "peers agree  yes")) << recorded.out;
+  EXPECT_EQ(detsim_cli("verify " + kept.path()).exit_code, 0);
+}
+
+}  // namespace
+}  // namespace detsim
