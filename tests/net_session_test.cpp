@@ -140,6 +140,9 @@ TEST(NetSession, LatencyCausesRollbacksThatEndIdentical) {
   EXPECT_GT(peer->ping_us, 100'000U);  // 120 ms round trip, measured
   EXPECT_LT(peer->ping_us, 160'000U);
   EXPECT_FALSE(m.session(0).peer_stats(0).has_value());  // the local player is no peer
+  // Once the last acknowledgements arrived, peer 1 holds every input peer 0 sent.
+  m.idle(30);
+  EXPECT_GE(m.session(0).peer_stats(1)->acknowledged_frame, o.frames);
 }
 
 TEST(NetSession, FourAndEightPlayersOnABadNetworkAgree) {

@@ -388,6 +388,7 @@ std::optional<PeerStats> Session::peer_stats(std::uint32_t player) const {
     stats.ping_us = peer.rtt_x16 / 16;
     stats.jitter_us = peer.jitter_x16 / 16;
     stats.frames_ahead = peer.advantage_x16 / 16;
+    stats.acknowledged_frame = peer.acked_inputs;
     return stats;
   }
   return std::nullopt;

@@ -134,6 +134,18 @@ bool Match::run() {
   return false;
 }
 
+void Match::idle(std::uint64_t ticks) {
+  for (const std::uint64_t end = tick_ + ticks; tick_ < end; ++tick_) {
+    const std::uint64_t now = tick_ * 16'667;
+    network_->advance_to(now);
+    for (std::uint32_t p = 0; p < options_.players; ++p) {
+      sessions_[p]->poll(now);
+      for (const net::Event& e : sessions_[p]->take_events())
+        records_[p].events.push_back(e);
+    }
+  }
+}
+
 std::vector<std::uint64_t> Match::offline_hashes(std::uint32_t p) const {
   const PeerRecord& r = records_[p];
   const std::size_t size = sessions_[p]->config().input_size;

@@ -117,6 +117,9 @@ class Match {
   /// Ticks until every peer confirmed options.frames frames (or max_ticks); true if they did.
   bool run();
 
+  /// Polls every peer for `ticks` more ticks without advancing (acknowledgements settle).
+  void idle(std::uint64_t ticks);
+
   std::uint32_t players() const { return options_.players; }
   net::Session& session(std::uint32_t p) { return *sessions_[p]; }
   net::SimNetwork& network() { return *network_; }

@@ -101,7 +101,7 @@ struct Event {
   std::uint64_t frame = 0;
   std::uint64_t local_hash = 0;   ///< desync: this machine's hash of `frame`
   std::uint64_t remote_hash = 0;  ///< desync: the peer's
-  std::string_view reason;        ///< hello_rejected: what differed
+  std::string_view reason;  ///< hello_rejected: what differed (a string literal: never dangles)
 };
 
 /// A frame whose inputs are all final, in frame order, each once: what a replay records.
@@ -109,7 +109,7 @@ struct ConfirmedFrame {
   std::uint64_t frame = 0;  ///< the step (0 is the first); the state after it is frame + 1
   std::span<const std::uint8_t> inputs;  ///< players * input_size
   std::span<const InputStatus> status;
-  std::uint64_t hash = 0;  ///< of the state after the step
+  std::uint64_t hash = 0;  ///< of the state after the step (0 only if a bug lost that state)
 };
 
 /// This machine's side of the first desync: what a desync report needs.
@@ -134,6 +134,8 @@ struct PeerStats {
   std::uint64_t jitter_us = 0;     ///< smoothed deviation of the round-trip time
   std::int64_t frames_ahead = 0;   ///< how many frames this machine is ahead of the peer (estimate)
   std::uint64_t remote_frame = 0;  ///< the peer's frame as last reported
+  /// The peer holds every local input before this frame (spectators: every confirmed frame).
+  std::uint64_t acknowledged_frame = 0;
   std::uint64_t packets_sent = 0;
   std::uint64_t packets_received = 0;
   std::uint64_t packets_lost = 0;  ///< gaps in the peer's sequence numbers
@@ -201,6 +203,8 @@ class Session {
   /// confirmed).
   [[nodiscard]] std::uint64_t confirmed_frame() const noexcept;
   /// Frames the game should skip (not advance) to let slower peers catch up: 0 when in time.
+  /// A policy that works: while it is above 0, skip advance_frame() on one tick in three (a
+  /// skipped tick still polls), so the correction is spread out and never visible as a stall.
   [[nodiscard]] std::uint32_t recommended_wait_frames() const noexcept;
   [[nodiscard]] const SessionStats& stats() const noexcept;
   /// The statistics of the peer playing `player` (spectator k: players + k); nothing for the
