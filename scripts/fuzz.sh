@@ -1,20 +1,29 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer target for the replay reader (clang, ASan + UBSan) and runs it.
-# Usage: scripts/fuzz.sh [SECONDS]   (default 600)
-# The corpus lives in build-fuzz/corpus (seeded with short replays); findings go to
-# build-fuzz/findings. Exit status: 0 no finding, non-zero a crash, leak, timeout or OOM was found
-# (libFuzzer prints the reproducer's path).
+# Builds a libFuzzer target (clang, ASan + UBSan) and runs it.
+# Usage: scripts/fuzz.sh [SECONDS] [TARGET]   (default 600 s, target replay)
+#   replay  fuzz/replay_reader_fuzz.cpp, the replay reader: corpus build-fuzz/corpus (seeded with
+#           short replays), findings build-fuzz/findings
+#   packet  fuzz/net_packet_fuzz.cpp, the session wire protocol decoder: corpus
+#           build-fuzz/corpus-packet (seeded with valid datagrams), findings build-fuzz/findings-packet
+# DETSIM_FUZZ_BUILD names another build directory than build-fuzz. Exit status: 0 no finding,
+# non-zero a crash, leak, timeout or OOM was found (libFuzzer prints the reproducer's path).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-600}"
-build=build-fuzz
+target="${2:-replay}"
+build="${DETSIM_FUZZ_BUILD:-build-fuzz}"
+case "$target" in
+  replay) fuzzer=replay_reader_fuzz seeds=make_seeds suffix="" max_len=65536 ;;
+  packet) fuzzer=net_packet_fuzz seeds=make_packet_seeds suffix=-packet max_len=1300 ;;
+  *) echo "usage: scripts/fuzz.sh [SECONDS] [replay|packet]" >&2; exit 2 ;;
+esac
 flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
 cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" -DCMAKE_CXX_FLAGS="$flags" \
   -DDETSIM_BUILD_FUZZ=ON -DDETSIM_BUILD_TESTS=OFF -DDETSIM_BUILD_TOOLS=OFF >/dev/null
-cmake --build "$build" --target replay_reader_fuzz make_seeds -j "$(nproc)"
-mkdir -p "$build/corpus" "$build/findings"
-"$build/fuzz/make_seeds" "$build/corpus"
-cd "$build/findings"
-exec ../fuzz/replay_reader_fuzz ../corpus -max_total_time="$seconds" -max_len=65536 \
+cmake --build "$build" --target "$fuzzer" "$seeds" -j "$(nproc)"
+mkdir -p "$build/corpus$suffix" "$build/findings$suffix"
+"$build/fuzz/$seeds" "$build/corpus$suffix"
+cd "$build/findings$suffix"
+exec "../fuzz/$fuzzer" "../corpus$suffix" -max_total_time="$seconds" -max_len="$max_len" \
   -rss_limit_mb=2048 -timeout=20 -print_final_stats=1
