@@ -7,9 +7,9 @@ std::uint64_t ScenarioGame::save(std::vector<std::uint8_t>& state) {
   const World& world = scenario_->world();
   const StateHashes hashes = world.save(state);  // one encoding gives the bytes and every hash
   const std::uint64_t frame = world.frame();
-  remembered_[frame % remembered_hashes] = Remembered{frame, hashes};
+  remembered_[static_cast<std::size_t>(frame % remembered_hashes)] = Remembered{frame, hashes};
   if (keyframe_interval_ != 0 && frame % keyframe_interval_ == 0) {
-    Keyframe& k = keyframes_[(frame / keyframe_interval_) % keyframes_.size()];
+    Keyframe& k = keyframes_[static_cast<std::size_t>((frame / keyframe_interval_) % 2)];
     k.frame = frame;
     k.state.assign(state.begin(), state.end());
   }
@@ -33,14 +33,14 @@ void ScenarioGame::advance(const FrameInputs& inputs, bool resimulating) {
 }
 
 std::optional<StateHashes> ScenarioGame::hashes_at(std::uint64_t frame) const noexcept {
-  const Remembered& r = remembered_[frame % remembered_hashes];
+  const Remembered& r = remembered_[static_cast<std::size_t>(frame % remembered_hashes)];
   if (r.frame != frame) return std::nullopt;
   return r.hashes;
 }
 
 const std::vector<std::uint8_t>* ScenarioGame::keyframe_at(std::uint64_t frame) const noexcept {
   if (keyframe_interval_ == 0 || frame % keyframe_interval_ != 0) return nullptr;
-  const Keyframe& k = keyframes_[(frame / keyframe_interval_) % keyframes_.size()];
+  const Keyframe& k = keyframes_[static_cast<std::size_t>((frame / keyframe_interval_) % 2)];
   return k.frame == frame ? &k.state : nullptr;
 }
 

@@ -128,7 +128,9 @@ Expected<DesyncReport> parse_desync_report(std::span<const std::uint8_t> bytes,
     return fail(12, "payload size " + std::to_string(size) + ", but the file holds " +
                         std::to_string(bytes.size() - kHeaderSize - kTrailerSize) +
                         " payload bytes (truncated or extended)");
-  const std::span<const std::uint8_t> payload = bytes.subspan(kHeaderSize, size);
+  // size equals what the file holds (checked above), so it fits size_t on every target.
+  const std::span<const std::uint8_t> payload =
+      bytes.subspan(kHeaderSize, static_cast<std::size_t>(size));
   ByteReader trailer(bytes.last(kTrailerSize));
   if (trailer.u64("checksum") != XXH3_64bits(payload.data(), payload.size()))
     return fail(bytes.size() - kTrailerSize,

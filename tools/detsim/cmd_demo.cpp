@@ -70,7 +70,8 @@ std::optional<std::uint64_t> first_disagreement(const std::vector<Peer>& peers,
                                                 std::uint64_t frames) {
   for (std::uint64_t f = 0; f < frames; ++f) {
     for (const Peer& p : peers) {
-      if (p.hashes.size() <= f || p.hashes[f] != peers[0].hashes[f]) return f + 1;
+      const auto i = static_cast<std::size_t>(f);  // f < hashes.size() before indexing
+      if (p.hashes.size() <= f || p.hashes[i] != peers[0].hashes[i]) return f + 1;
     }
   }
   return std::nullopt;
@@ -228,7 +229,7 @@ int Demo::report(const MatchResult& match, const replay::VerifyResult& verified,
   const bool verified_ok = verified.ok && verified.frames == frames;
   const std::vector<std::uint64_t>& hashes0 = peers_[0].hashes;
   const bool have_final = hashes0.size() >= frames;
-  const std::uint64_t final_hash = have_final ? hashes0[frames - 1] : 0;
+  const std::uint64_t final_hash = have_final ? hashes0[static_cast<std::size_t>(frames - 1)] : 0;
   const double virtual_seconds = static_cast<double>(match.virtual_us) / 1e6;
   const auto per_second = [&](std::uint64_t bytes) {
     return virtual_seconds > 0 ? static_cast<double>(bytes) / virtual_seconds : 0.0;

@@ -1,12 +1,16 @@
-// detsim synctest: GGPO's sync test on a scenario. Every frame f >= K, restore the state saved at
-// frame f - K, re-simulate the K frames with the same inputs, and compare each frame's hashes with
-// those of the first pass; the run then goes on from the re-simulated state. Any state that save()
-// misses, or any hidden dependence on history, shows up as a mismatch at a named frame.
+// detsim synctest: GGPO's sync test on a scenario, run by net::SyncTestSession. Every frame f >= K,
+// the state of frame f - K is loaded and the K frames re-simulated with the same inputs, and each
+// frame's hash compared with the first pass; the run then goes on from the re-simulated state. Any
+// state that save() misses, or any hidden dependence on history, shows up as a mismatch at a named
+// frame, and both states are kept for a diff.
 #include <chrono>
 #include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <detsim/net/scenario_game.hpp>
+#include <detsim/net/synctest.hpp>
 
 #include "commands.hpp"
 #include "output.hpp"
@@ -19,65 +23,73 @@ namespace {
 struct SyncResult {
   std::uint64_t frames = 0;
   std::uint64_t resimulated = 0;
-  std::optional<std::uint64_t> first_mismatch;
-  StateHashes expected;  ///< first pass, at first_mismatch
-  StateHashes actual;    ///< re-simulation, at first_mismatch
+  std::optional<net::SyncTestMismatch> mismatch;
   std::uint64_t final_hash = 0;
   std::string error;
 };
 
-void inputs_at(const Scenario& s, std::uint64_t frame, std::vector<PlayerInput>& out) {
-  out.resize(s.params().players);
-  for (std::uint32_t p = 0; p < out.size(); ++p)
-    out[p] = scripted_input(s.params().seed, frame, p);
-}
-
 SyncResult run_synctest(Scenario& s, std::uint64_t frames, std::uint32_t distance,
                         Progress& progress) {
   SyncResult r;
-  // Saved states of the last distance + 1 frames, and every frame's first-pass hashes.
-  std::vector<std::vector<std::uint8_t>> saved(distance + 1);
-  std::vector<StateHashes> first_pass(distance + 1);
-  std::vector<PlayerInput> inputs;
-  // The ring slot of frame f (distance + 1 slots; the remainder fits size_t on every target).
-  const auto slot_of = [&](std::uint64_t f) {
-    return static_cast<std::size_t>(f % (std::uint64_t{distance} + 1));
-  };
-  saved[0] = s.world().save();
-  first_pass[0] = s.world().hashes();
+  net::ScenarioGame game(s);
+  const std::uint32_t players = std::max<std::uint32_t>(s.params().players, 1);
+  auto created = net::SyncTestSession::create(
+      net::SyncTestConfig{players, net::ScenarioGame::input_size, distance}, game);
+  if (!created) {
+    r.error = created.message();
+    return r;
+  }
+  net::SyncTestSession session = std::move(created).value();
+  std::vector<std::uint8_t> inputs(std::size_t{players} * net::ScenarioGame::input_size);
   for (std::uint64_t f = 1; f <= frames; ++f) {
-    inputs_at(s, f, inputs);
-    s.step(inputs);
-    const std::size_t slot = slot_of(f);
-    first_pass[slot] = s.world().hashes();
-    if (f >= distance && distance > 0) {
-      const Status restored = s.world().restore(saved[slot_of(f - distance)]);
-      if (!restored) {
-        r.error = "frame " + std::to_string(f) + ": restoring frame " +
-                  std::to_string(f - distance) + " failed: " + restored.message();
-        return r;
-      }
-      for (std::uint64_t g = f - distance + 1; g <= f; ++g) {
-        inputs_at(s, g, inputs);
-        s.step(inputs);
-        ++r.resimulated;
-        const StateHashes again = s.world().hashes();
-        const StateHashes& want = first_pass[slot_of(g)];
-        if (again != want) {
-          r.frames = f;
-          r.first_mismatch = g;
-          r.expected = want;
-          r.actual = again;
-          return r;
-        }
-      }
+    // The step to state f takes the scripted inputs of frame f (as `detsim run` does).
+    for (std::uint32_t p = 0; p < players; ++p) {
+      encode_input(scripted_input(s.params().seed, f, p),
+                   std::span<std::uint8_t, PlayerInput::encoded_size>(
+                       inputs.data() + std::size_t{p} * net::ScenarioGame::input_size, 3));
     }
-    saved[slot] = s.world().save();
+    auto ok = session.advance_frame(inputs);
+    if (!ok) {
+      r.error = ok.message();
+      return r;
+    }
     r.frames = f;
-    r.final_hash = first_pass[slot].total;
+    r.resimulated = session.resimulated_frames();
+    if (!ok.value()) {
+      r.mismatch = *session.mismatch();
+      return r;
+    }
+    r.final_hash = session.current_hash();
     progress.update(f, frames);
   }
   return r;
+}
+
+/// Which parts of the state differ between the two states of a mismatch.
+std::string differing_parts(const net::SyncTestMismatch& m) {
+  World expected;
+  World actual;
+  if (!expected.restore(m.expected_state) || !actual.restore(m.actual_state)) return "unknown";
+  const StateHashes a = expected.hashes();
+  const StateHashes b = actual.hashes();
+  std::string parts;
+  const auto add = [&](const char* name, bool differs) {
+    if (!differs) return;
+    if (!parts.empty()) parts += ", ";
+    parts += name;
+  };
+  add("globals", a.globals != b.globals);
+  add("rng", a.rng != b.rng);
+  add("bodies", a.bodies != b.bodies);
+  add("contacts", a.contacts != b.contacts);
+  return parts.empty() ? "none" : parts;
+}
+
+bool write_file(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (f == nullptr) return false;
+  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  return std::fclose(f) == 0 && ok;
 }
 
 }  // namespace
@@ -95,7 +107,18 @@ int synctest_command(const SynctestArgs& args) {
   const double seconds = seconds_since(start);
   progress.done();
   if (!r.error.empty()) return usage_error("synctest", r.error);
-  const bool ok = !r.first_mismatch.has_value();
+  const bool ok = !r.mismatch.has_value();
+  std::string dumped;
+  if (!ok && !args.dump.empty()) {
+    const std::string expected = args.dump + ".expected";
+    const std::string actual = args.dump + ".actual";
+    if (!write_file(expected, r.mismatch->expected_state) ||
+        !write_file(actual, r.mismatch->actual_state))
+      return usage_error("synctest", "cannot write the states to " + expected + " and " + actual);
+    dumped = expected + " and " + actual;
+  }
+  const std::optional<std::uint64_t> first_mismatch =
+      ok ? std::nullopt : std::optional<std::uint64_t>(r.mismatch->frame);
   if (args.json) {
     Json j;
     j.boolean("ok", ok)
@@ -103,11 +126,14 @@ int synctest_command(const SynctestArgs& args) {
         .num("frames", r.frames)
         .num("check_distance", args.check_distance)
         .num("resimulated_frames", r.resimulated)
-        .frame("first_mismatch", r.first_mismatch);
+        .frame("first_mismatch", first_mismatch);
     if (ok) {
       j.hash("final_hash", r.final_hash);
     } else {
-      j.hash("expected_hash", r.expected.total).hash("actual_hash", r.actual.total);
+      j.hash("expected_hash", r.mismatch->expected_hash)
+          .hash("actual_hash", r.mismatch->actual_hash)
+          .str("differing_parts", differing_parts(*r.mismatch));
+      if (!dumped.empty()) j.str("dumped", dumped);
     }
     j.real("seconds", seconds).print();
     return ok ? exit_ok : exit_check_failed;
@@ -121,11 +147,13 @@ int synctest_command(const SynctestArgs& args) {
     return exit_ok;
   }
   std::printf("%s: MISMATCH at frame %llu (rolling back from frame %llu to frame %llu)\n",
-              describe(scenario).c_str(), static_cast<unsigned long long>(*r.first_mismatch),
+              describe(scenario).c_str(), static_cast<unsigned long long>(r.mismatch->frame),
               static_cast<unsigned long long>(r.frames),
               static_cast<unsigned long long>(r.frames - args.check_distance));
-  std::printf("  first pass %s, re-simulation %s\n", hex(r.expected.total).c_str(),
-              hex(r.actual.total).c_str());
+  std::printf("  first pass %s, re-simulation %s; differing: %s\n",
+              hex(r.mismatch->expected_hash).c_str(), hex(r.mismatch->actual_hash).c_str(),
+              differing_parts(*r.mismatch).c_str());
+  if (!dumped.empty()) std::printf("  states written to %s\n", dumped.c_str());
   return exit_check_failed;
 }
 

@@ -45,6 +45,7 @@ int info_command(const InfoArgs& args);
 struct SynctestArgs {
   ScenarioArgs scene;
   std::uint32_t check_distance = 8;
+  std::string dump;  ///< on a mismatch, write both states to DUMP.expected / DUMP.actual
   bool json = false;
 };
 int synctest_command(const SynctestArgs& args);

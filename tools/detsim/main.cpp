@@ -327,6 +327,10 @@ without its end marker (a recording that stopped early) verifies up to its last 
   c->add_option("--check-distance", synctest.check_distance,
                 "Frames to roll back every frame (default 8, at most 600)")
       ->type_name("K");
+  c->add_option("--dump", synctest.dump,
+                "On a mismatch, write both states of the frame (World::save bytes) to "
+                "PREFIX.expected and PREFIX.actual")
+      ->type_name("PREFIX");
   c->add_flag("--json", synctest.json,
               "Print one JSON object: ok, frames, first_mismatch (null or a frame), ...");
   c->footer(std::string(R"(

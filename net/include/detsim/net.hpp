@@ -8,5 +8,6 @@
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/net/spectator.hpp>
+#include <detsim/net/synctest.hpp>
 #include <detsim/net/transport.hpp>
 #include <detsim/net/udp.hpp>
