@@ -8,9 +8,10 @@
 //   mutations reach the body decoder (fields, run-length tokens, checks).
 // The datagram is decoded with input sizes 1, 3, 4 and 64 (players' inputs) and max_unit_size
 // (spectator frames). Whenever it decodes, the packet must re-encode, that encoding must decode to
-// the same packet, be no longer than the datagram (the encoder's tokens are the shortest), equal it
-// byte for byte for every type but input (whose tokens the decoder accepts in any split), and
-// encode again to itself. A violation traps; the sanitizers and libFuzzer's limits catch the rest.
+// the same packet, be no longer than the datagram (the encoder's tokens are the shortest, and the
+// decoder accepts frame varints only in their shortest form), equal it byte for byte for every
+// type but input (whose tokens the decoder accepts in any split), and encode again to itself. A
+// violation traps; the sanitizers and libFuzzer's limits catch the rest.
 #include <xxhash.h>
 
 #include <cstddef>

@@ -37,11 +37,56 @@ class Reader {
   std::uint32_t u32() noexcept { return static_cast<std::uint32_t>(get(4)); }
   std::uint64_t u64() noexcept { return get(8); }
 
+  /// An unsigned LEB128 varint of at most 5 bytes (35 bits) in its shortest form; anything else
+  /// sets `bad`, a datagram that ends inside one fails like any short read.
+  std::uint64_t varint(bool& bad) noexcept {
+    std::uint64_t v = 0;
+    for (int i = 0; i < 5; ++i) {
+      const std::uint8_t b = u8();
+      if (!ok_) return 0;
+      v |= std::uint64_t{b & 0x7FU} << (7 * i);
+      if ((b & 0x80U) == 0) {
+        if (b == 0 && i > 0) bad = true;  // a redundant trailing zero byte
+        return v;
+      }
+    }
+    bad = true;  // longer than any u32 frame distance needs
+    return 0;
+  }
+  /// A frame written by put_frame against `ack`; `bad` when it falls outside u32.
+  std::uint32_t frame(std::uint32_t ack, bool& bad) noexcept {
+    const std::uint64_t z = varint(bad);
+    const std::int64_t d = (z & 1U) != 0 ? -static_cast<std::int64_t>(z >> 1) - 1
+                                         : static_cast<std::int64_t>(z >> 1);
+    const std::int64_t frame = std::int64_t{ack} + d;
+    if (frame < 0 || frame > 0xFFFF'FFFFLL) {
+      bad = true;
+      return 0;
+    }
+    return static_cast<std::uint32_t>(frame);
+  }
+
  private:
   std::span<const std::uint8_t> bytes_;
   std::size_t at_ = 0;
   bool ok_ = true;
 };
+
+// LEB128: 7 bits per byte, low first; the top bit says another byte follows.
+void put_varint(std::vector<std::uint8_t>& out, std::uint64_t v) {
+  while (v >= 0x80) {
+    out.push_back(static_cast<std::uint8_t>(v | 0x80U));
+    v >>= 7;
+  }
+  out.push_back(static_cast<std::uint8_t>(v));
+}
+
+// A frame relative to ack_frame, zigzag-coded: small distances either way are small numbers.
+void put_frame(std::vector<std::uint8_t>& out, std::uint32_t frame, std::uint32_t ack) {
+  const std::int64_t d = std::int64_t{frame} - std::int64_t{ack};
+  put_varint(out, d >= 0 ? static_cast<std::uint64_t>(d) << 1
+                         : (static_cast<std::uint64_t>(-(d + 1)) << 1) | 1U);
+}
 
 void put(std::vector<std::uint8_t>& out, std::uint64_t v, std::size_t n) {
   for (std::size_t i = 0; i < n; ++i)
@@ -159,16 +204,16 @@ bool encode(const Packet& packet, std::size_t input_size, std::vector<std::uint8
       break;
     case PacketType::input: {
       const InputBody& b = packet.input;
-      put(out, b.ack_frame, 4);
-      put(out, b.check_ack, 4);
-      put(out, b.current_frame, 4);
+      put_varint(out, b.ack_frame);
+      put_frame(out, b.check_ack, b.ack_frame);
+      put_frame(out, b.current_frame, b.ack_frame);
       out.push_back(static_cast<std::uint8_t>(b.advantage));
-      put(out, b.start_frame, 4);
+      put_frame(out, b.start_frame, b.ack_frame);
       out.push_back(b.count);
       run_length_encode(b.deltas, out);
       out.push_back(static_cast<std::uint8_t>(b.checks.size()));
       for (const HashCheck& c : b.checks) {
-        put(out, c.frame, 4);
+        put_frame(out, c.frame, b.ack_frame);
         put(out, c.hash, 8);
       }
       break;
@@ -220,25 +265,30 @@ DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, 
       break;
     case PacketType::input: {
       InputBody& b = out.input;
-      b.ack_frame = in.u32();
-      b.check_ack = in.u32();
-      b.current_frame = in.u32();
+      bool bad = false;
+      const std::uint64_t ack = in.varint(bad);
+      if (ack > 0xFFFF'FFFFU) bad = true;
+      b.ack_frame = static_cast<std::uint32_t>(ack);
+      b.check_ack = in.frame(b.ack_frame, bad);
+      b.current_frame = in.frame(b.ack_frame, bad);
       b.advantage = static_cast<std::int8_t>(in.u8());
-      b.start_frame = in.u32();
+      b.start_frame = in.frame(b.ack_frame, bad);
       b.count = in.u8();
       if (!in.ok()) return DecodeError::bad_length;
+      if (bad) return DecodeError::bad_field;
       // count <= 255 and input_size <= 513 bound the allocation to 128 KiB whatever the bytes say.
       if (!run_length_decode(in, std::size_t{b.count} * input_size, b.deltas))
         return in.ok() ? DecodeError::bad_field : DecodeError::bad_length;
       const std::uint8_t checks = in.u8();
       if (!in.ok()) return DecodeError::bad_length;
       if (checks > max_checks_per_packet) return DecodeError::bad_field;
-      if (in.remaining() != std::size_t{checks} * 12U) return DecodeError::bad_length;
       b.checks.resize(checks);
       for (HashCheck& c : b.checks) {
-        c.frame = in.u32();
+        c.frame = in.frame(b.ack_frame, bad);
         c.hash = in.u64();
       }
+      if (!in.ok()) return DecodeError::bad_length;
+      if (bad) return DecodeError::bad_field;
       break;
     }
     case PacketType::ping:

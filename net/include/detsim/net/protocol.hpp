@@ -15,10 +15,16 @@
 //
 //     hello        fingerprint u64 | players u8 | player u8 | input_size u8 | challenge u32
 //     hello_reply  challenge u32
-//     input        ack_frame u32 | check_ack u32 | current_frame u32 | advantage i8 |
-//                  start_frame u32 | count u8 | deltas: run-length coded bytes (below) |
-//                  checks u8 | checks x (frame u32, hash u64)
+//     input        ack_frame v | check_ack z | current_frame z | advantage i8 | start_frame z |
+//                  count u8 | deltas: run-length coded bytes (below) |
+//                  checks u8 | checks x (frame z, hash u64)
 //     ping, pong   time u64 (microseconds of the pinging side's clock)
+//
+// Frame numbers are u32 values. `v` is an unsigned LEB128 varint (7 bits per byte, low first, at
+// most 5 bytes, no redundant trailing zero byte); `z` is the frame minus ack_frame, zigzag-coded
+// (0, -1, 1, -2, ... as 0, 1, 2, 3, ...) as such a varint: the frames of one packet lie close
+// together, so each costs one byte instead of four. A value outside u32, an over-long or
+// redundant varint is a bad field.
 //
 // Input deltas: the count inputs, each XORed with the one before it (the first with the input the
 // receiver already holds for start_frame - 1), so a held button costs nothing; then the
@@ -38,7 +44,7 @@ namespace detsim::net::protocol {
 
 /// Changes whenever the layout above changes; peers of different versions drop each other's
 /// datagrams (counted as bad_version) and never synchronise.
-inline constexpr std::uint8_t version = 1;
+inline constexpr std::uint8_t version = 2;
 inline constexpr std::uint8_t magic0 = 'D';
 inline constexpr std::uint8_t magic1 = 'N';
 inline constexpr std::size_t header_size = 10;
