@@ -203,6 +203,27 @@ TEST(NetSession, InputDelayChangesMidMatchStayConsistent) {
   EXPECT_EQ(m.session(1).stats().dropped_inputs, 2U);
 }
 
+TEST(NetSession, TimeSyncKeepsAFastPeerFromRunningIntoThePredictionLimit) {
+  // Peer 1 is a slower machine: it misses every eighth tick. Without time sync peer 0 runs ahead
+  // until the prediction window stops it, again and again; following recommended_wait_frames()
+  // it slows down early and rarely reaches the limit.
+  const auto run = [](bool time_sync) {
+    MatchOptions o;
+    o.frames = 1800;
+    o.link.latency_us = 30'000;
+    o.time_sync = time_sync;
+    o.active = [](std::uint32_t p, std::uint64_t tick) { return p != 1 || tick % 8 != 0; };
+    Match m(o);
+    EXPECT_TRUE(m.run()) << m.compare();
+    EXPECT_EQ(m.compare(), "");
+    return m.session(0).stats().prediction_limit_waits;
+  };
+  const std::uint64_t without = run(false);
+  const std::uint64_t with = run(true);
+  EXPECT_GT(without, 100U);
+  EXPECT_LT(with * 4, without) << "with time sync " << with << ", without " << without;
+}
+
 // ---- lockstep ----
 
 TEST(NetSession, LockstepNeverPredictsAndEndsIdentical) {

@@ -99,7 +99,7 @@ bool Match::run() {
       const bool active = !options_.active || options_.active(p, tick_);
       if (active && s.current_frame() < options_.frames) {
         // Time sync: a peer that is ahead skips a tick, as a game would.
-        if (s.recommended_wait_frames() == 0 || tick_ % 4 != 0) {
+        if (!options_.time_sync || s.recommended_wait_frames() == 0 || tick_ % 4 != 0) {
           const PlayerInput bot = scripted_input(options_.seed, tick_, p);
           if (options_.arena) {
             encode_input(bot, std::span<std::uint8_t, PlayerInput::encoded_size>(input.data(), 3));

@@ -102,6 +102,8 @@ struct MatchOptions {
   std::optional<std::uint64_t> fault_frame;  ///< CounterGame fault on peer fault_peer
   std::uint32_t fault_peer = 0;
   std::uint64_t max_ticks = 0;  ///< 0: frames * 4 + 2000
+  /// Peers follow recommended_wait_frames() (skip one tick in four while it is above 0).
+  bool time_sync = true;
   /// Spectators served by player 0 (network nodes players .. players + spectators - 1), each
   /// joining (first polling) at spectator_join_tick.
   std::uint32_t spectators = 0;
