@@ -32,7 +32,7 @@ TEST(NetReplay, EveryPeerRecordsTheSameReplayAndItVerifies) {
   link.latency_us = 50'000;
   link.jitter_us = 20'000;
   link.loss_ppm = 50'000;
-  auto created = net::SimNetwork::create(players, 5, link);
+  auto created = net::SimNetwork::create(players + 1, 5, link);  // node 3: a spectator
   ASSERT_TRUE(created.ok());
   net::SimNetwork network = std::move(created.value());
   std::vector<std::unique_ptr<Scenario>> scenarios;
@@ -55,12 +55,28 @@ TEST(NetReplay, EveryPeerRecordsTheSameReplayAndItVerifies) {
     c.random_seed = 40 + p;
     for (std::uint32_t q = 0; q < players; ++q)
       if (q != p) c.remotes.push_back({q, q});
+    if (p == 0) c.spectators = {players};
     auto s = net::Session::create(c, *games.back(), network.endpoint(p));
     ASSERT_TRUE(s.ok()) << s.message();
     sessions.push_back(std::move(s.value()));
   }
   for (std::uint32_t p = 0; p < players; ++p)
     recorders[p].attach(sessions[p]);
+  // The spectator records too: the same file, from the confirmed frames it is sent.
+  ScenarioParams watched;
+  watched.players = players;
+  watched.seed = 9;
+  Scenario spectator_scenario = Scenario::create("arena", watched).value();
+  net::ScenarioGame spectator_game(spectator_scenario);
+  auto spectator_recorder =
+      net::ScenarioRecorder::create(temp_path("spectator"), spectator_game).value();
+  net::SpectatorConfig sc;
+  sc.players = players;
+  sc.input_size = net::ScenarioGame::input_size;
+  sc.host = 0;
+  auto spectator =
+      net::SpectatorSession::create(sc, spectator_game, network.endpoint(players)).value();
+  spectator_recorder.attach(spectator);
   std::array<std::uint8_t, 3> input{};
   for (std::uint64_t tick = 0; tick < frames * 3; ++tick) {
     network.advance_to(tick * 16'667);
@@ -73,6 +89,9 @@ TEST(NetReplay, EveryPeerRecordsTheSameReplayAndItVerifies) {
       }
       if (recorders[p].frames() < frames) done = false;
     }
+    spectator.poll(tick * 16'667);
+    spectator.advance();
+    if (spectator_recorder.frames() < frames) done = false;
     if (done) break;
   }
   for (std::uint32_t p = 0; p < players; ++p) {
@@ -85,6 +104,10 @@ TEST(NetReplay, EveryPeerRecordsTheSameReplayAndItVerifies) {
   ASSERT_FALSE(first.empty());
   for (std::uint32_t p = 1; p < players; ++p)
     EXPECT_EQ(file_bytes(temp_path(std::to_string(p))), first) << "peer " << p;
+  ASSERT_TRUE(spectator_recorder.finish().ok());
+  EXPECT_EQ(spectator_recorder.frames(), frames);
+  EXPECT_EQ(file_bytes(temp_path("spectator")), first) << "the spectator's replay";
+  std::remove(temp_path("spectator").c_str());
   auto reader = replay::ReplayReader::open(temp_path("0"));
   ASSERT_TRUE(reader.ok()) << reader.message();
   EXPECT_EQ(reader->keyframes().size(), 2U);

@@ -67,6 +67,13 @@ void ScenarioRecorder::attach(Session& session,
   session.set_confirmed_listener([impl](const ConfirmedFrame& f) { impl->record(f); });
 }
 
+void ScenarioRecorder::attach(SpectatorSession& spectator,
+                              std::function<void(const ConfirmedFrame&)> listener) {
+  impl_->listener = std::move(listener);
+  Impl* impl = impl_.get();
+  spectator.set_confirmed_listener([impl](const ConfirmedFrame& f) { impl->record(f); });
+}
+
 std::uint64_t ScenarioRecorder::frames() const noexcept {
   return impl_->writer.frames();
 }

@@ -12,6 +12,7 @@
 
 #include <detsim/net/scenario_game.hpp>
 #include <detsim/net/session.hpp>
+#include <detsim/net/spectator.hpp>
 #include <detsim/replay/desync_report.hpp>
 #include <detsim/replay/replay.hpp>
 #include <detsim/sim/status.hpp>
@@ -33,6 +34,9 @@ class ScenarioRecorder {
   /// listener; `listener`, if given, is still called for each frame). The recorder must outlive
   /// the session's use of it: keep both alive together, or attach before a move only.
   void attach(Session& session, std::function<void(const ConfirmedFrame&)> listener = {});
+  /// The same for a spectator: it records exactly the file the players record.
+  void attach(SpectatorSession& spectator,
+              std::function<void(const ConfirmedFrame&)> listener = {});
 
   /// Frames recorded so far.
   [[nodiscard]] std::uint64_t frames() const noexcept;
