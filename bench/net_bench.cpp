@@ -46,16 +46,6 @@ class NullGame final : public net::Game {
   std::uint64_t acc_ = 0;
 };
 
-net::LinkConditions internet() {
-  net::LinkConditions link;
-  link.latency_us = 50'000;
-  link.jitter_us = 20'000;
-  link.loss_ppm = 50'000;
-  link.duplicate_ppm = 10'000;
-  link.reorder_ppm = 10'000;
-  return link;
-}
-
 /// P sessions over one SimNetwork, ticked in virtual time.
 struct Match {
   std::optional<net::SimNetwork> network;
@@ -110,7 +100,7 @@ void session_frame_perfect(benchmark::State& state) {
   session_frame(state, {});
 }
 void session_frame_internet(benchmark::State& state) {
-  session_frame(state, internet());
+  session_frame(state, net::internet_link());
 }
 BENCHMARK(session_frame_perfect)->Name("session_frame")->Arg(2)->Arg(4)->Arg(8);
 BENCHMARK(session_frame_internet)->Name("session_frame_internet")->Arg(2)->Arg(4)->Arg(8);
@@ -158,7 +148,7 @@ BENCHMARK(rollback_8)->Unit(benchmark::kMillisecond);
 
 void bandwidth(benchmark::State& state) {
   for (auto _ : state) {
-    Match m(4, internet());
+    Match m(4, net::internet_link());
     for (int i = 0; i < 60 * 60; ++i)
       m.step();
     std::uint64_t bytes = 0;

@@ -25,16 +25,6 @@ using net::EventType;
 using test::Match;
 using test::MatchOptions;
 
-net::LinkConditions internet(std::uint32_t loss_ppm = 50'000) {
-  net::LinkConditions link;
-  link.latency_us = 50'000;  // 100 ms round trip
-  link.jitter_us = 20'000;
-  link.loss_ppm = loss_ppm;
-  link.duplicate_ppm = 10'000;
-  link.reorder_ppm = 10'000;
-  return link;
-}
-
 const std::uint64_t full_match = test::scaled(10'000);
 
 void expect_clean(const Match& m, const std::string& what) {
@@ -50,7 +40,7 @@ TEST_P(ArenaOnTheInternet, EveryPeerAgreesAtEveryConfirmedFrame) {
   o.players = GetParam();
   o.frames = full_match;
   o.arena = true;
-  o.link = internet();
+  o.link = net::internet_link();
   o.seed = 100 + o.players;
   Match m(o);
   ASSERT_TRUE(m.run()) << m.compare();
@@ -75,7 +65,7 @@ TEST_P(CounterOnBadNetworks, EveryPeerAgreesAtEveryConfirmedFrame) {
   MatchOptions o;
   o.players = players;
   o.frames = 10'000;
-  o.link = internet(network.loss_ppm);
+  o.link = net::internet_link(network.loss_ppm);
   o.seed = 200 + players;
   if (network.outage) {
     // Peer 1 is cut off for 2 s, from 30 s in: a warning, then recovery.
@@ -112,7 +102,7 @@ TEST(NetConditions, ArenaAtTwentyPercentLossAndThroughAnOutage) {
     o.players = 4;
     o.frames = full_match;
     o.arena = true;
-    o.link = internet(outage ? 50'000 : 200'000);
+    o.link = net::internet_link(outage ? 50'000 : 200'000);
     o.seed = outage ? 301 : 302;
     if (outage)
       o.setup = [](net::SimNetwork& n) {
@@ -135,7 +125,7 @@ TEST(NetConditions, LockstepArenaOnTheInternetEndsIdentical) {
   o.mode = net::SessionMode::lockstep;
   o.frames = test::scaled(3000);
   o.arena = true;
-  o.link = internet();
+  o.link = net::internet_link();
   o.max_ticks = o.frames * 20;
   Match m(o);
   ASSERT_TRUE(m.run()) << m.compare();
@@ -153,7 +143,7 @@ TEST(NetConditions, ArenaHeldAtThePredictionLimitNeverDesyncs) {
   o.input_delay = 0;
   o.max_ticks = o.frames * 30;
   o.setup = [](net::SimNetwork& n) {
-    net::LinkConditions slow = internet();
+    net::LinkConditions slow = net::internet_link();
     slow.latency_us = 350'000;
     ASSERT_TRUE(n.set_link(1, 0, slow).ok());
   };
@@ -191,7 +181,7 @@ TEST(NetConditions, ANudgedBodyIsDetectedWithinOneCheckInterval) {
   constexpr std::uint32_t players = 4;
   constexpr std::uint32_t interval = 30;
   const std::uint64_t nudge = 500 + std::uint64_t{scripted_input(7, 0, 0).buttons} * 37 % 300;
-  auto created = net::SimNetwork::create(players, 77, internet());
+  auto created = net::SimNetwork::create(players, 77, net::internet_link());
   ASSERT_TRUE(created.ok()) << created.message();
   net::SimNetwork network = std::move(created.value());
   std::vector<std::unique_ptr<Scenario>> scenarios;

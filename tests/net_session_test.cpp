@@ -22,16 +22,6 @@ T take(Expected<T> e) {
 using test::Match;
 using test::MatchOptions;
 
-net::LinkConditions internet() {
-  net::LinkConditions link;
-  link.latency_us = 50'000;  // 100 ms round trip
-  link.jitter_us = 20'000;
-  link.loss_ppm = 50'000;
-  link.duplicate_ppm = 10'000;
-  link.reorder_ppm = 10'000;
-  return link;
-}
-
 // ---- configuration ----
 
 TEST(NetSession, RejectsInvalidConfigsNamingTheField) {
@@ -150,7 +140,7 @@ TEST(NetSession, FourAndEightPlayersOnABadNetworkAgree) {
     MatchOptions o;
     o.players = players;
     o.frames = 1500;
-    o.link = internet();
+    o.link = net::internet_link();
     o.seed = players;
     Match m(o);
     ASSERT_TRUE(m.run()) << players << " players: " << m.compare();
@@ -231,7 +221,7 @@ TEST(NetSession, LockstepNeverPredictsAndEndsIdentical) {
   o.players = 4;
   o.mode = net::SessionMode::lockstep;
   o.frames = 600;
-  o.link = internet();
+  o.link = net::internet_link();
   o.max_ticks = 30'000;
   Match m(o);
   ASSERT_TRUE(m.run()) << m.compare();
@@ -249,7 +239,7 @@ TEST(NetSession, InjectedNonDeterminismIsDetectedWithinOneCheckInterval) {
   MatchOptions o;
   o.players = 3;
   o.frames = 600;
-  o.link = internet();
+  o.link = net::internet_link();
   o.fault_frame = 200;  // peer 2's state differs from frame 201 on
   o.fault_peer = 2;
   Match m(o);
@@ -287,7 +277,7 @@ TEST(NetSession, NoFalseDesyncFromPredictedFrames) {
   o.frames = 900;
   o.input_delay = 0;
   o.check_interval = 1;
-  o.link = internet();
+  o.link = net::internet_link();
   o.link.latency_us = 80'000;
   Match m(o);
   ASSERT_TRUE(m.run()) << m.compare();
@@ -318,7 +308,7 @@ TEST(NetSession, AnOutageWarnsThenRecoversWithoutDesync) {
   MatchOptions o;
   o.players = 3;
   o.frames = 900;
-  o.link = internet();
+  o.link = net::internet_link();
   o.setup = [](net::SimNetwork& n) { ASSERT_TRUE(n.add_outage(1, 5'000'000, 7'000'000).ok()); };
   Match m(o);
   ASSERT_TRUE(m.run()) << m.compare();

@@ -12,16 +12,6 @@ namespace {
 using test::Match;
 using test::MatchOptions;
 
-net::LinkConditions internet() {
-  net::LinkConditions link;
-  link.latency_us = 50'000;
-  link.jitter_us = 20'000;
-  link.loss_ppm = 50'000;
-  link.duplicate_ppm = 10'000;
-  link.reorder_ppm = 10'000;
-  return link;
-}
-
 void expect_same_frames(const test::PeerRecord& player, const test::PeerRecord& spectator,
                         std::size_t frames, const std::string& who) {
   ASSERT_GE(spectator.hashes.size(), frames) << who;
@@ -39,7 +29,7 @@ TEST(NetSpectator, SpectatorsReproduceEveryConfirmedFrameAndALateOneCatchesUp) {
   MatchOptions o;
   o.players = 3;
   o.frames = 2400;
-  o.link = internet();
+  o.link = net::internet_link();
   o.spectators = 2;
   Match m(o);
   ASSERT_TRUE(m.run()) << m.compare();
@@ -55,7 +45,7 @@ TEST(NetSpectator, ALateSpectatorCatchesUpFasterThanRealTime) {
   // than one frame per tick to finish within the time the players take plus a little.
   MatchOptions o;
   o.frames = 2400;
-  o.link = internet();
+  o.link = net::internet_link();
   o.spectators = 1;
   o.spectator_join_tick = 1200;
   Match m(o);

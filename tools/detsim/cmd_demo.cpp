@@ -35,18 +35,6 @@ constexpr std::uint32_t demo_input_delay = 2;
 /// are exchanged and compared (half a second of virtual time).
 constexpr std::uint64_t demo_linger_ticks = 30;
 
-/// Every direction of every link: 100 ms round trip, 20 ms jitter, 5% loss, 1% duplication and
-/// 1% reordering.
-net::LinkConditions demo_link() {
-  net::LinkConditions link;
-  link.latency_us = 50'000;
-  link.jitter_us = 20'000;
-  link.loss_ppm = 50'000;
-  link.duplicate_ppm = 10'000;
-  link.reorder_ppm = 10'000;
-  return link;
-}
-
 /// One player's machine: its own scenario, game adapter and session, and what it confirmed.
 struct Peer {
   std::unique_ptr<Scenario> scenario;
@@ -103,7 +91,8 @@ class Demo {
 };
 
 Status Demo::set_up(const std::string& replay_path) {
-  auto network = net::SimNetwork::create(demo_players, args_.seed * 7919 + 13, demo_link());
+  auto network =
+      net::SimNetwork::create(demo_players, args_.seed * 7919 + 13, net::internet_link());
   if (!network) return network.status();
   network_.emplace(std::move(network.value()));
   peers_.resize(demo_players);  // never resized again: sessions and listeners point into it

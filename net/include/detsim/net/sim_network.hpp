@@ -83,6 +83,19 @@ struct LinkConditions {
 /// delivered/delivered_bytes by the receiver. Over the whole network,
 ///   sum(sent + duplicated) == sum(delivered + lost + dropped_invalid + dropped_outage +
 ///                                 dropped_queue + dropped_capacity) + in_flight().
+/// An ordinary bad internet link, one direction: 50 ms (100 ms round trip) +- 20 ms jitter, 1%
+/// duplication and reordering, and `loss_ppm` loss (default 5%). What detsim's network tests, the
+/// benchmarks and `detsim demo` play over.
+constexpr LinkConditions internet_link(std::uint32_t loss_ppm = 50'000) noexcept {
+  LinkConditions link;
+  link.latency_us = 50'000;
+  link.jitter_us = 20'000;
+  link.loss_ppm = loss_ppm;
+  link.duplicate_ppm = 10'000;
+  link.reorder_ppm = 10'000;
+  return link;
+}
+
 struct NodeStats {
   std::uint64_t sent = 0;        ///< send() calls, valid or not
   std::uint64_t sent_bytes = 0;  ///< their payload bytes
