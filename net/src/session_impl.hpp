@@ -102,7 +102,8 @@ struct Session::Impl {
   // session_wire.cpp: the network.
   void receive_all();
   void handle(detail::Peer& peer, const protocol::Packet& packet);
-  void handle_hello(detail::Peer& peer, const protocol::Packet& packet);
+  /// False when the hello was rejected (counted, maybe reported).
+  bool handle_hello(detail::Peer& peer, const protocol::Packet& packet);
   void handle_input(detail::Peer& peer, const protocol::InputBody& body);
   void send_due();
   void send_inputs(detail::Peer& peer);

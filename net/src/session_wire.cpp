@@ -61,7 +61,7 @@ void Session::Impl::receive_all() {
 void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
   using protocol::PacketType;
   if (p.header.type == PacketType::hello) {
-    handle_hello(peer, p);
+    if (!handle_hello(peer, p)) return;  // a rejected hello says nothing about the peer's liveness
   } else if (p.header.type == PacketType::hello_reply) {
     if (p.hello_reply.challenge != peer.challenge ||
         (peer.nonce_known && p.header.nonce != peer.remote_nonce)) {
@@ -122,7 +122,7 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
   }
 }
 
-void Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) {
+bool Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) {
   const protocol::Hello& h = p.hello;
   std::string_view reason;
   if (h.fingerprint != config.fingerprint)
@@ -139,12 +139,12 @@ void Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) 
       peer.hello_rejected = true;
       raise(Event{EventType::hello_rejected, peer.player, current, 0, 0, reason});
     }
-    return;
+    return false;
   }
   if (peer.nonce_known && p.header.nonce != peer.remote_nonce) {
     if (peer.synchronized) {  // a stale or foreign session on the same address
       ++stats.dropped_wrong_session;
-      return;
+      return false;
     }
     peer.answered = false;  // the peer restarted before we finished: start over with it
   }
@@ -154,6 +154,7 @@ void Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) 
   reply.header.type = protocol::PacketType::hello_reply;
   reply.hello_reply.challenge = h.challenge;
   send(peer, reply);
+  return true;
 }
 
 void Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& b) {
