@@ -29,6 +29,7 @@ const std::uint64_t full_match = test::scaled(10'000);
 
 void expect_clean(const Match& m, const std::string& what) {
   EXPECT_EQ(m.compare(), "") << what;
+  EXPECT_EQ(m.checks_complete(), "") << what;
   for (std::uint32_t p = 0; p < m.players(); ++p)
     EXPECT_FALSE(m.record(p).has(EventType::disconnected)) << what << ", peer " << p;
 }

@@ -122,6 +122,7 @@ TEST(NetSession, LatencyCausesRollbacksThatEndIdentical) {
   Match m(o);
   ASSERT_TRUE(m.run()) << m.compare();
   EXPECT_EQ(m.compare(), "");
+  EXPECT_EQ(m.checks_complete(), "");
   const net::SessionStats& s = m.session(0).stats();
   EXPECT_GT(s.rollbacks, 10U);
   EXPECT_GT(s.resimulated_frames, s.rollbacks);
@@ -145,6 +146,7 @@ TEST(NetSession, FourAndEightPlayersOnABadNetworkAgree) {
     Match m(o);
     ASSERT_TRUE(m.run()) << players << " players: " << m.compare();
     EXPECT_EQ(m.compare(), "") << players << " players";
+    EXPECT_EQ(m.checks_complete(), "") << players << " players";
     EXPECT_GT(m.session(0).stats().rollbacks, 0U);
   }
 }

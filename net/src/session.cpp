@@ -230,7 +230,12 @@ void Session::Impl::compare_checks(detail::Peer& peer) {
         std::find_if(local_checks.begin(), local_checks.end(),
                      [&](const detail::LocalCheck& c) { return c.frame == remote.frame; });
     peer.pending_checks.pop_front();
-    if (local == local_checks.end() || local->hash == remote.hash || peer.desynced) continue;
+    if (local == local_checks.end()) {
+      ++stats.checks_skipped;  // ours was dropped (more than max_pending_checks outstanding)
+      continue;
+    }
+    ++stats.checks_compared;
+    if (local->hash == remote.hash || peer.desynced) continue;
     peer.desynced = true;
     raise(Event{EventType::desync, peer.player, remote.frame, local->hash, remote.hash, {}});
     if (!evidence) {
@@ -249,10 +254,13 @@ void Session::Impl::retire_checks() {
     bool everyone = true;
     for (const detail::Peer& peer : peers) {
       if (peer.disconnected) continue;
+      // Kept until the peer's hash was compared with it here AND the peer acknowledged ours:
+      // retiring it earlier would leave a slower peer without our hash for the frame (its
+      // checks arrive in order, so it would then never compare another).
       const bool compared =
           peer.checks_through >= frame &&
           (peer.pending_checks.empty() || peer.pending_checks.front().frame > frame);
-      if (!compared || peer.desynced) everyone = false;
+      if (!compared || peer.acked_checks < frame || peer.desynced) everyone = false;
     }
     if (!everyone) return;
     agreed_frame = frame;

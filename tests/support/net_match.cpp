@@ -175,6 +175,20 @@ std::vector<std::uint64_t> Match::offline_hashes(std::uint32_t p) const {
   return hashes;
 }
 
+std::string Match::checks_complete() const {
+  std::ostringstream out;
+  if (options_.check_interval == 0) return "";
+  const std::uint64_t per_peer = options_.frames / options_.check_interval;
+  const std::uint64_t expected = (per_peer > 2 ? per_peer - 2 : 0) * (options_.players - 1);
+  for (std::uint32_t p = 0; p < options_.players; ++p) {
+    const net::SessionStats& s = sessions_[p]->stats();
+    if (s.checks_compared < expected || s.checks_skipped != 0)
+      out << "peer " << p << " compared " << s.checks_compared << " checks (expected at least "
+          << expected << ") and skipped " << s.checks_skipped << "; ";
+  }
+  return out.str();
+}
+
 std::string Match::compare() const {
   std::ostringstream out;
   std::size_t common = records_[0].hashes.size();

@@ -134,6 +134,11 @@ class Match {
   /// An empty string when every peer confirmed the same inputs and hashes for every frame they all
   /// confirmed, and that matches an offline replay; else what differs.
   std::string compare() const;
+  /// An empty string when every peer compared (nearly) every confirmed-frame hash check of every
+  /// other peer — frames / interval each, but for the last two, which may still be in flight — and
+  /// skipped none; else which peer did not. Desync detection that silently stops comparing would
+  /// pass compare() but not this.
+  std::string checks_complete() const;
 
  private:
   std::unique_ptr<net::Game> make_game(std::uint32_t p);

@@ -149,6 +149,10 @@ struct SessionStats {
   std::uint64_t resimulated_frames = 0;
   std::uint64_t prediction_limit_waits = 0;  ///< advance_frame() calls that hit the limit
   std::uint64_t dropped_inputs = 0;          ///< local inputs dropped when the input delay shrank
+  /// Peers' confirmed-frame hashes compared with this machine's (desync detection at work), and
+  /// those that could not be (this machine's hash was no longer kept).
+  std::uint64_t checks_compared = 0;
+  std::uint64_t checks_skipped = 0;
   /// Received datagrams dropped by the decoder, by protocol::DecodeError.
   std::array<std::uint64_t, protocol::decode_error_count> dropped_malformed{};
   std::uint64_t dropped_wrong_session = 0;  ///< a nonce or peer this session does not know
