@@ -1,6 +1,6 @@
 // detsim netplay between two real processes over UDP on 127.0.0.1 (the same final hash, the same
-// replay bytes, a replay that verifies), its usage errors, and detsim demo (four sessions over a
-// simulated network).
+// replay bytes, a replay that verifies), with a third watching as a spectator, its usage errors,
+// and detsim demo (four sessions over a simulated network).
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -104,8 +105,47 @@ bool bind_failed(const Process& p) {
   return p.exit_code() == 2 && has(p.err(), "bind 127.0.0.1:");
 }
 
+/// Netplay processes started together: `commands(base)` gives each one's arguments for ports
+/// base, base + 1, ... Retries on other ports when a bind fails; kills all after `limit`.
+struct Group {
+  std::vector<std::unique_ptr<Process>> processes;
+  bool timed_out = false;
+};
+
+using Commands = std::function<std::vector<std::vector<std::string>>(std::uint16_t base)>;
+
+Group run_group(const Commands& commands, std::chrono::seconds limit) {
+  Group group;
+  for (int attempt = 0; attempt < 6; ++attempt) {
+    const std::vector<std::vector<std::string>> args = commands(port_for(attempt));
+    group.processes.clear();
+    group.timed_out = false;
+    for (std::size_t i = 0; i < args.size(); ++i)
+      group.processes.push_back(std::make_unique<Process>(args[i], "netplay_" + std::to_string(i)));
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    bool retry = false;
+    for (;;) {
+      bool all_done = true;
+      for (const auto& p : group.processes) {
+        const bool done = p->poll();
+        all_done = all_done && done;
+        if (done && bind_failed(*p)) retry = true;  // a port in use: try other ports
+      }
+      if (retry || all_done) break;
+      if (std::chrono::steady_clock::now() > deadline) {
+        group.timed_out = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    for (const auto& p : group.processes)
+      p->kill();
+    if (!retry) return group;
+  }
+  return group;
+}
+
 /// Two netplay processes, players 0 and 1, each with its own extra arguments, on fresh ports.
-/// Retries on other ports when a bind fails; kills both after `limit`.
 struct Pair {
   std::unique_ptr<Process> a;
   std::unique_ptr<Process> b;
@@ -114,9 +154,7 @@ struct Pair {
 
 Pair run_pair(const std::vector<std::string>& extra_a, const std::vector<std::string>& extra_b,
               std::chrono::seconds limit) {
-  Pair pair;
-  for (int attempt = 0; attempt < 6; ++attempt) {
-    const std::uint16_t port_a = port_for(attempt);
+  const auto commands = [&](std::uint16_t port_a) {
     const auto port_b = static_cast<std::uint16_t>(port_a + 1);
     std::vector<std::string> args_a = {"netplay",        "--players", "2",
                                        "--me",           "0",         "--bind",
@@ -126,29 +164,10 @@ Pair run_pair(const std::vector<std::string>& extra_a, const std::vector<std::st
                                        endpoint(port_b), "--peer",    "0=" + endpoint(port_a)};
     args_a.insert(args_a.end(), extra_a.begin(), extra_a.end());
     args_b.insert(args_b.end(), extra_b.begin(), extra_b.end());
-    pair.a = std::make_unique<Process>(args_a, "netplay_a");
-    pair.b = std::make_unique<Process>(args_b, "netplay_b");
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    bool retry = false;
-    for (;;) {
-      const bool a_done = pair.a->poll();
-      const bool b_done = pair.b->poll();
-      if ((a_done && bind_failed(*pair.a)) || (b_done && bind_failed(*pair.b))) {
-        retry = true;  // a port in use: stop the other one and try other ports
-        break;
-      }
-      if (a_done && b_done) break;
-      if (std::chrono::steady_clock::now() > deadline) {
-        pair.timed_out = true;
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    pair.a->kill();
-    pair.b->kill();
-    if (!retry) return pair;
-  }
-  return pair;
+    return std::vector<std::vector<std::string>>{args_a, args_b};
+  };
+  Group group = run_group(commands, limit);
+  return Pair{std::move(group.processes[0]), std::move(group.processes[1]), group.timed_out};
 }
 
 TEST(CliNetplay, TwoProcessesPlayTheSameMatchAndRecordTheSameReplay) {
@@ -189,6 +208,100 @@ TEST(CliNetplay, TwoProcessesPlayTheSameMatchAndRecordTheSameReplay) {
   EXPECT_EQ(json_value(verify.out, "final_hash"), json_value(out_a, "final_hash"));
 }
 
+TEST(CliNetplay, ASpectatorReachesThePlayersHashAndRecordsTheSameReplay) {
+  TempFile replay_a("netplay_a.dsr");
+  TempFile replay_b("netplay_b.dsr");
+  TempFile replay_s("netplay_spectator.dsr");
+  TempFile report_a("netplay_a.desync");
+  TempFile report_b("netplay_b.desync");
+  const auto commands = [&](std::uint16_t base) {
+    const std::string a = endpoint(base);
+    const std::string b = endpoint(static_cast<std::uint16_t>(base + 1));
+    const std::string s = endpoint(static_cast<std::uint16_t>(base + 2));
+    std::vector<std::vector<std::string>> args = {
+        {"netplay", "--me", "0", "--bind", a, "--peer", "1=" + b, "--spectator", s, "--bot", "11",
+         "--record", replay_a.path(), "--desync-report", report_a.path()},
+        {"netplay", "--me", "1", "--bind", b, "--peer", "0=" + a, "--bot", "12", "--record",
+         replay_b.path(), "--desync-report", report_b.path()},
+        {"netplay", "--spectate", "--bind", s, "--peer", "0=" + a, "--record", replay_s.path()}};
+    for (std::vector<std::string>& one : args)
+      one.insert(one.end(), {"--frames", "2000", "--fps", "1000", "--json"});
+    return args;
+  };
+  const Group group = run_group(commands, std::chrono::seconds(120));
+  ASSERT_EQ(group.processes.size(), 3U);
+  const Process& a = *group.processes[0];
+  const Process& b = *group.processes[1];
+  const Process& spectator = *group.processes[2];
+  ASSERT_FALSE(group.timed_out) << "killed after 120 s\nA: " << a.err() << "\nB: " << b.err()
+                                << "\nspectator: " << spectator.err();
+  const std::string out_a = a.out();
+  const std::string out_s = spectator.out();
+  ASSERT_EQ(a.exit_code(), 0) << out_a << a.err();
+  ASSERT_EQ(b.exit_code(), 0) << b.out() << b.err();
+  ASSERT_EQ(spectator.exit_code(), 0) << out_s << spectator.err();
+  expect_one_json_object(out_s);
+  EXPECT_EQ(json_value(out_s, "spectator"), "true") << out_s;
+  EXPECT_EQ(json_value(out_s, "player"), "null") << out_s;
+  EXPECT_EQ(json_value(out_s, "host"), "0") << out_s;
+  EXPECT_EQ(json_value(out_s, "frames"), "2000") << out_s;
+  for (const char* zero : {"rollbacks", "resimulated_frames", "desyncs"})
+    EXPECT_EQ(json_value(out_s, zero), "0") << zero << "\n" << out_s;
+  EXPECT_EQ(json_value(out_s, "final_hash").size(), 16U) << out_s;
+  EXPECT_EQ(json_value(out_s, "final_hash"), json_value(out_a, "final_hash"));
+  EXPECT_EQ(json_value(b.out(), "final_hash"), json_value(out_a, "final_hash"));
+  // Player 0 served the spectator every frame before it left.
+  EXPECT_EQ(json_value(out_a, "spectator"), "false") << out_a;
+  EXPECT_EQ(json_value(out_a, "acknowledged_frames"), "2000") << out_a;
+
+  const auto bytes_a = read_bytes(replay_a.path());
+  ASSERT_FALSE(bytes_a.empty());
+  EXPECT_TRUE(bytes_a == read_bytes(replay_b.path())) << "the two players' replays differ";
+  EXPECT_TRUE(bytes_a == read_bytes(replay_s.path())) << "the spectator's replay differs";
+  const test::CliResult verify = detsim_cli("verify " + replay_s.path() + " --json");
+  EXPECT_EQ(verify.exit_code, 0) << verify.out << verify.err;
+  EXPECT_EQ(json_value(verify.out, "final_hash"), json_value(out_s, "final_hash"));
+
+  // --desync-report is accepted, and writes nothing when the peers agree.
+  EXPECT_EQ(json_value(out_a, "desync_report"), "null");
+  EXPECT_FALSE(std::filesystem::exists(report_a.path()));
+  EXPECT_FALSE(std::filesystem::exists(report_b.path()));
+}
+
+TEST(CliNetplay, ASpectatorOfAnotherMatchIsRefused) {
+  // Player 0 serves the spectator but its match has seed 1; the spectator's has seed 2. Nobody
+  // plays player 1: player 0 times out too, after naming the refused spectator.
+  const auto commands = [](std::uint16_t base) {
+    const std::string a = endpoint(base);
+    const std::string s = endpoint(static_cast<std::uint16_t>(base + 2));
+    return std::vector<std::vector<std::string>>{
+        {"netplay", "--me", "0", "--bind", a, "--peer", "1=127.0.0.1:9", "--spectator", s,
+         "--timeout", "1"},
+        {"netplay", "--spectate", "--bind", s, "--peer", "0=" + a, "--seed", "2", "--timeout",
+         "1"}};
+  };
+  const Group group = run_group(commands, std::chrono::seconds(60));
+  ASSERT_FALSE(group.timed_out);
+  const Process& a = *group.processes[0];
+  const Process& spectator = *group.processes[1];
+  EXPECT_EQ(a.exit_code(), 2) << a.err();
+  EXPECT_TRUE(has(a.err(), "watches with other settings (fingerprint)")) << a.err();
+  EXPECT_EQ(spectator.exit_code(), 2) << spectator.err();
+  EXPECT_TRUE(has(spectator.err(), "handshake timed out waiting for player 0 at 127.0.0.1:"))
+      << spectator.err();
+  EXPECT_TRUE(has(spectator.err(), "check --players, --seed, --mode, --frames")) << spectator.err();
+}
+
+TEST(CliNetplay, SpectatorHandshakeTimeoutNamesTheHost) {
+  const test::CliResult r = detsim_cli(
+      "netplay --spectate --players 3 --bind 127.0.0.1:0 --peer 2=127.0.0.1:9 --timeout 0.3 "
+      "--json");
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "handshake timed out waiting for player 2 at 127.0.0.1:9")) << r.err;
+  EXPECT_TRUE(has(r.err, "with --spectator")) << r.err;
+  EXPECT_EQ(r.out, "");
+}
+
 TEST(CliNetplay, PeersWithOtherSettingsRefuseEachOther) {
   // Another scenario seed: the session fingerprints differ, the handshake never completes.
   const Pair pair =
@@ -217,6 +330,9 @@ TEST(CliNetplay, BadUsageExitsWithTwoAndNamesTheProblem) {
     std::string message;  ///< on stderr
   };
   const std::string bind = " --bind 127.0.0.1:0";
+  std::string seventeen_spectators;
+  for (int k = 0; k < 17; ++k)
+    seventeen_spectators += " --spectator 127.0.0.1:" + std::to_string(7100 + k);
   const std::vector<Case> cases = {
       {"netplay --players 2 --me 0" + bind, "missing --peer for player 1"},
       {"netplay --players 3 --me 0" + bind + " --peer 1=127.0.0.1:7001",
@@ -242,6 +358,37 @@ TEST(CliNetplay, BadUsageExitsWithTwoAndNamesTheProblem) {
       {"netplay" + bind + " --peer 1=127.0.0.1:7001 --input-delay 17", "--input-delay"},
       {"netplay --bind [::1]:0 --peer 1=127.0.0.1:7001", "one address family"},
       {"netplay --peer 1=127.0.0.1:7001", "--bind is required"},
+      // Spectators: served by a player (--spectator), or watching (--spectate).
+      {"netplay --spectate --me 0" + bind + " --peer 0=127.0.0.1:7000",
+       "--me cannot be combined with --spectate"},
+      {"netplay --spectate" + bind, "--spectate needs exactly one --peer J=IP:PORT"},
+      {"netplay --spectate" + bind + " --peer 0=127.0.0.1:7000 --peer 1=127.0.0.1:7001",
+       "--spectate needs exactly one --peer J=IP:PORT"},
+      {"netplay --spectate" + bind + " --peer 0=127.0.0.1:7000 --spectator 127.0.0.1:7002",
+       "--spectator cannot be combined with --spectate"},
+      {"netplay --spectate" + bind + " --peer 0=127.0.0.1:7000 --bot 1",
+       "--bot cannot be combined with --spectate"},
+      {"netplay --spectate" + bind + " --peer 0=127.0.0.1:7000 --desync-report r.bin",
+       "--desync-report cannot be combined with --spectate"},
+      {"netplay --spectate" + bind + " --peer 2=127.0.0.1:7000",
+       "player \"2\" is not a player of this match"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --spectator 127.0.0.1",
+       "--spectator \"127.0.0.1\": endpoint"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --spectator localhost:7002",
+       "host names are not resolved"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --spectator 127.0.0.1:0",
+       "port 0 cannot be sent to"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --spectator 0.0.0.0:7002",
+       "the unspecified address cannot be sent to"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --spectator [::1]:7002",
+       "not the address family of --bind"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --spectator 127.0.0.1:7001",
+       "that is player 1's address"},
+      {"netplay" + bind +
+           " --peer 1=127.0.0.1:7001 --spectator 127.0.0.1:7002 --spectator 127.0.0.1:7002",
+       "--spectator \"127.0.0.1:7002\" is given twice"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001" + seventeen_spectators,
+       "at most 16 --spectator addresses, got 17"},
   };
   for (const Case& c : cases) {
     const test::CliResult r = detsim_cli(c.args);
@@ -258,10 +405,10 @@ TEST(CliNetplay, HelpDescribesEveryOption) {
   EXPECT_EQ(help.exit_code, 0);
   for (const char* option :
        {"--players", "--me", "--bind", "--peer", "--seed", "--mode", "--input-delay", "--frames",
-        "--bot", "--fps", "--timeout", "--record", "--json", "Exit status: 0"}) {
+        "--bot", "--fps", "--timeout", "--record", "--json", "--spectator", "--spectate",
+        "--desync-report", "detsim netplay --spectate", "Exit status: 0"}) {
     EXPECT_TRUE(has(help.out, option)) << option;
   }
-  EXPECT_FALSE(has(help.out, "--spectate"));
 }
 
 TEST(CliDemo, FourPeersOverABadNetworkAgreeAndTheReplayVerifies) {

@@ -1,18 +1,19 @@
 // detsim netplay: this machine plays one player of an `arena` match against peers over UDP, with a
 // net::Session in rollback or lockstep mode, optionally recording the confirmed frames as a replay
-// that every peer writes byte for byte alike.
+// that every peer writes byte for byte alike, and serving spectators (--spectator). With
+// --spectate it watches instead (cmd_spectate.cpp); netplay_plan.cpp checks the command line.
 //
 // The loop: every iteration polls the session (network in and out, timers); every 1/fps seconds
 // it advances one frame with the bot's input (or a neutral one), skipping an advance now and then
 // while the session recommends waiting for slower peers. After the last frame it keeps polling
-// until every frame is confirmed here and every peer has reached the last frame, then a short
-// linger so that the peers receive our last inputs and acknowledgements.
+// until every frame is confirmed here, every peer has reached the last frame and every connected
+// spectator has every frame, then a short linger so that the peers receive our last inputs and
+// acknowledgements.
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
 #include <optional>
-#include <random>
 #include <string>
 #include <thread>
 #include <vector>
@@ -21,8 +22,11 @@
 #include <detsim/net/scenario_recorder.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/udp.hpp>
+#include <detsim/replay/desync_report.hpp>
+#include <detsim/replay/replay.hpp>
 
 #include "commands.hpp"
+#include "netplay_plan.hpp"
 #include "output.hpp"
 #include "scenario_args.hpp"
 
@@ -30,97 +34,10 @@ namespace detsim::cli {
 
 namespace {
 
-constexpr std::string_view netplay_name = "netplay";
-/// Polling after the last frame once everything is confirmed, so that peers get our last
-/// inputs and acknowledgements (they are resent every frame until acknowledged).
-constexpr std::uint64_t linger_us = 500'000;
-/// The pause between polls while there is nothing to advance.
-constexpr std::uint64_t idle_sleep_us = 1'000;
-
-/// The netplay_name line, checked: where to bind, and every peer's player and address.
-struct Plan {
-  net::Endpoint bind;
-  std::vector<net::UdpPeer> peers;  ///< ascending player; PeerId = player index
-  net::SessionMode mode = net::SessionMode::rollback;
-};
-
-Expected<net::UdpPeer> parse_peer(const std::string& text, const NetplayArgs& a) {
-  const auto eq = text.find('=');
-  if (eq == std::string::npos)
-    return Status::error("--peer \"" + text + "\": expected J=IP:PORT, e.g. 1=127.0.0.1:7001");
-  const std::string index = text.substr(0, eq);
-  std::uint32_t player = 0;
-  const bool digits =
-      !index.empty() && index.size() <= 3 &&
-      std::all_of(index.begin(), index.end(), [](char c) { return c >= '0' && c <= '9'; });
-  if (digits) player = static_cast<std::uint32_t>(std::stoul(index));
-  if (!digits || player >= a.players)
-    return Status::error("--peer \"" + text + "\": player \"" + index +
-                         "\" is not a player of this match (0 .. " + std::to_string(a.players - 1) +
-                         ")");
-  if (player == a.me)
-    return Status::error("--peer \"" + text + "\": player " + index + " is this machine (--me " +
-                         std::to_string(a.me) + ")");
-  auto endpoint = net::parse_endpoint(std::string_view(text).substr(eq + 1));
-  if (!endpoint) return Status::error("--peer " + index + ": " + endpoint.message());
-  return net::UdpPeer{player, endpoint.value()};
-}
-
-Expected<Plan> plan_of(const NetplayArgs& a) {
-  if (a.players < 2 || a.players > 8)
-    return Status::error("--players must be 2 .. 8 (the arena scenario's range), got " +
-                         std::to_string(a.players));
-  if (a.me >= a.players)
-    return Status::error("--me " + std::to_string(a.me) + " must be below --players " +
-                         std::to_string(a.players) + " (players are numbered 0 .. " +
-                         std::to_string(a.players - 1) + ")");
-  Plan plan;
-  if (a.mode == "rollback") {
-    plan.mode = net::SessionMode::rollback;
-  } else if (a.mode == "lockstep") {
-    plan.mode = net::SessionMode::lockstep;
-  } else {
-    return Status::error("--mode must be rollback or lockstep, got \"" + a.mode + "\"");
-  }
-  auto bind = net::parse_endpoint(a.bind);
-  if (!bind) return Status::error("--bind: " + bind.message());
-  plan.bind = bind.value();
-  std::vector<std::optional<net::UdpPeer>> by_player(a.players);
-  for (const std::string& text : a.peers) {
-    auto peer = parse_peer(text, a);
-    if (!peer) return peer.status();
-    std::optional<net::UdpPeer>& slot = by_player[peer->id];
-    if (slot)
-      return Status::error("--peer " + std::to_string(peer->id) + " is given twice (" +
-                           slot->endpoint.to_string() + " and " + peer->endpoint.to_string() + ")");
-    slot = peer.value();
-  }
-  for (std::uint32_t p = 0; p < a.players; ++p) {
-    if (p == a.me) continue;
-    if (!by_player[p])
-      return Status::error("missing --peer for player " + std::to_string(p) +
-                           ": every player but --me " + std::to_string(a.me) +
-                           " needs one, e.g. --peer " + std::to_string(p) + "=127.0.0.1:7001");
-    plan.peers.push_back(*by_player[p]);
-  }
-  return plan;
-}
-
-std::uint64_t random_seed() {
-  std::random_device device;
-  return (std::uint64_t{device()} << 32) ^ device();
-}
-
-std::string milliseconds(std::uint64_t us) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f ms", static_cast<double>(us) / 1000.0);
-  return text;
-}
-
 /// One match: the scenario, the session over UDP, the optional recorder, and what happened.
 class Netplay {
  public:
-  Netplay(const NetplayArgs& args, Plan plan) : args_(args), plan_(std::move(plan)) {}
+  Netplay(const NetplayArgs& args, NetplayPlan plan) : args_(args), plan_(std::move(plan)) {}
   int run();
 
  private:
@@ -131,27 +48,44 @@ class Netplay {
     return static_cast<std::uint64_t>(
         std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - start_).count());
   }
-  [[nodiscard]] std::string address(std::uint32_t player) const;
+  /// "player 1 at 127.0.0.1:7001" or "spectator 0 at 127.0.0.1:7100", by event player number.
+  [[nodiscard]] std::string who(std::uint32_t player) const;
   void say(const std::string& line) const {
     if (!args_.json) std::printf("%s\n", line.c_str());
     std::fflush(stdout);
   }
-  /// Handles the session's events; false (with failure_ set) when a peer disconnected.
+  /// Handles the session's events; false (with failure_ set) when a player disconnected.
   bool handle_events();
+  void write_desync_report();
   void advance();
   [[nodiscard]] bool peers_at_end() const;
   [[nodiscard]] std::string unconfirmed_players() const;
+  /// Spectator `player` (players + k) acknowledged every frame of the match.
+  [[nodiscard]] bool has_every_frame(std::uint32_t player) const {
+    const auto stats = session_->peer_stats(player);
+    return stats && stats->acknowledged_frame >= args_.frames;
+  }
+  /// The connected spectators that lack frames ("" when none does).
+  [[nodiscard]] std::string spectators_behind() const;
   int report(double handshake_seconds, double match_seconds);
+  void print_text_report(double handshake_seconds, double match_seconds) const;
 
   const NetplayArgs& args_;
-  Plan plan_;
+  NetplayPlan plan_;
   Clock::time_point start_ = Clock::now();
   std::optional<Scenario> scenario_;
   std::optional<net::ScenarioGame> game_;
   std::optional<net::UdpTransport> transport_;
   std::optional<net::ScenarioRecorder> recorder_;
   std::optional<net::Session> session_;
-  std::vector<std::string> rejected_;  ///< per player: why its hello was rejected, if it was
+  /// The scenario's fingerprint at frame 0, kept for a desync report (--desync-report).
+  std::optional<replay::Fingerprint> initial_fingerprint_;
+  bool report_written_ = false;
+  /// Every frame confirmed here and every player at the end (this machine may still be serving
+  /// its spectators).
+  bool match_complete_ = false;
+  /// Per player, then per spectator: why its hello was rejected, if it was.
+  std::vector<std::string> rejected_;
   std::vector<net::Event> desyncs_;
   std::string failure_;
   std::uint64_t confirmed_ = 0;
@@ -162,10 +96,16 @@ class Netplay {
                                ///< (lockstep) waiting for inputs
 };
 
-std::string Netplay::address(std::uint32_t player) const {
+std::string Netplay::who(std::uint32_t player) const {
+  if (player >= args_.players) {
+    const std::size_t k = player - args_.players;
+    const std::string address =
+        k < plan_.spectators.size() ? plan_.spectators[k].endpoint.to_string() : "?";
+    return "spectator " + std::to_string(k) + " at " + address;
+  }
   for (const net::UdpPeer& p : plan_.peers)
-    if (p.id == player) return p.endpoint.to_string();
-  return "?";
+    if (p.id == player) return "player " + std::to_string(player) + " at " + p.endpoint.to_string();
+  return "player " + std::to_string(player);
 }
 
 Status Netplay::start() {
@@ -176,9 +116,15 @@ Status Netplay::start() {
   if (!scenario) return scenario.status();
   scenario_.emplace(std::move(scenario.value()));
   game_.emplace(*scenario_);
+  // A desync report names the run by the fingerprint of the scenario at frame 0.
+  if (!args_.desync_report.empty()) initial_fingerprint_ = replay::fingerprint_of(*scenario_);
   auto transport = net::UdpTransport::open(plan_.bind, plan_.peers);
   if (!transport) return transport.status();
   transport_.emplace(std::move(transport.value()));
+  for (const net::UdpPeer& s : plan_.spectators) {
+    if (Status added = transport_->add_peer(s); !added)
+      return Status::error("--spectator " + s.endpoint.to_string() + ": " + added.message());
+  }
   // The recorder must see the scenario at frame 0, before the session saves and steps it.
   if (!args_.record.empty()) {
     auto recorder = net::ScenarioRecorder::create(args_.record, *game_);
@@ -192,11 +138,13 @@ Status Netplay::start() {
   config.input_size = net::ScenarioGame::input_size;
   config.input_delay = args_.input_delay;
   config.fingerprint = session_fingerprint(*scenario_, plan_.mode, args_.frames);
-  config.random_seed = random_seed();
+  config.random_seed = os_random_seed();
   config.frame_us =
       args_.fps == 0 ? 1000 : std::clamp<std::uint32_t>(1'000'000 / args_.fps, 1000, 1'000'000);
   for (const net::UdpPeer& p : plan_.peers)
     config.remotes.push_back(net::RemotePlayer{p.id, p.id});
+  for (const net::UdpPeer& s : plan_.spectators)
+    config.spectators.push_back(s.id);
   auto session = net::Session::create(config, *game_, *transport_);
   if (!session) return session.status();
   session_.emplace(std::move(session.value()));
@@ -209,13 +157,16 @@ Status Netplay::start() {
   } else {
     session_->set_confirmed_listener(on_confirmed);
   }
-  rejected_.assign(args_.players, {});
+  rejected_.assign(args_.players + plan_.spectators.size(), {});
   return Status::success();
 }
 
 bool Netplay::handle_events() {
   for (const net::Event& e : session_->take_events()) {
-    const std::string who = "player " + std::to_string(e.player) + " at " + address(e.player);
+    const std::string who = this->who(e.player);
+    const bool spectator = e.player >= args_.players;
+    // Peers that go quiet once they have everything have simply left.
+    const bool left = spectator ? has_every_frame(e.player) : match_complete_;
     switch (e.type) {
       case net::EventType::synchronized:
         say(who + " connected");
@@ -224,18 +175,20 @@ bool Netplay::handle_events() {
         say("running: every peer is connected");
         break;
       case net::EventType::interrupted:
+        if (left) break;
         std::fprintf(stderr, "detsim netplay: %s has been silent for %s\n", who.c_str(),
                      milliseconds(session_->config().disconnect_warning_us).c_str());
         break;
       case net::EventType::resumed:
+        if (left) break;
         std::fprintf(stderr, "detsim netplay: %s is back\n", who.c_str());
         break;
       case net::EventType::hello_rejected:
-        rejected_[e.player] = std::string(e.reason);
+        if (e.player < rejected_.size()) rejected_[e.player] = std::string(e.reason);
         std::fprintf(stderr,
-                     "detsim netplay: %s plays with other settings (%s): check --players, "
+                     "detsim netplay: %s %s with other settings (%s): check --players, "
                      "--seed, --mode, --frames and the detsim version on both sides\n",
-                     who.c_str(), std::string(e.reason).c_str());
+                     who.c_str(), spectator ? "watches" : "plays", std::string(e.reason).c_str());
         break;
       case net::EventType::desync:
         desyncs_.push_back(e);
@@ -245,14 +198,42 @@ bool Netplay::handle_events() {
         }
         say("DESYNC at frame " + std::to_string(e.frame) + " with " + who + ": this machine " +
             hex(e.local_hash) + ", player " + std::to_string(e.player) + " " + hex(e.remote_hash));
+        if (!args_.desync_report.empty() && desyncs_.size() == 1) write_desync_report();
         break;
       case net::EventType::disconnected:
+        if (left) break;
+        if (spectator) {  // the match goes on without it
+          std::fprintf(stderr, "detsim netplay: %s disconnected at frame %llu\n", who.c_str(),
+                       static_cast<unsigned long long>(e.frame));
+          break;
+        }
         failure_ = who + " disconnected at frame " + std::to_string(e.frame) + " (silent for " +
                    milliseconds(session_->config().disconnect_timeout_us) + ")";
         return false;
     }
   }
   return true;
+}
+
+void Netplay::write_desync_report() {
+  // The session keeps this machine's side of the first desync only; that is what is written.
+  const net::DesyncEvidence* evidence = session_->desync_evidence();
+  Status written = Status::error("the session kept no evidence of the desync");
+  if (evidence) {
+    auto report = net::desync_report(*initial_fingerprint_, args_.me, *evidence);
+    written =
+        report ? replay::write_desync_report(args_.desync_report, report.value()) : report.status();
+  }
+  if (!written) {
+    std::fprintf(stderr, "detsim netplay: --desync-report %s: %s\n", args_.desync_report.c_str(),
+                 written.message().c_str());
+    return;
+  }
+  report_written_ = true;
+  if (args_.json)
+    std::fprintf(stderr, "detsim netplay: desync report written to %s\n",
+                 args_.desync_report.c_str());
+  say("desync report written to " + args_.desync_report);
 }
 
 void Netplay::advance() {
@@ -298,6 +279,20 @@ std::string Netplay::unconfirmed_players() const {
   return out;
 }
 
+std::string Netplay::spectators_behind() const {
+  std::string out;
+  for (std::size_t k = 0; k < plan_.spectators.size(); ++k) {
+    const auto player = args_.players + static_cast<std::uint32_t>(k);
+    const net::PeerStats s = session_->peer_stats(player).value_or(net::PeerStats{});
+    if (s.disconnected || s.acknowledged_frame >= args_.frames) continue;
+    if (!out.empty()) out += ", ";
+    out += who(player) + (s.synchronized ? " (has " + std::to_string(s.acknowledged_frame) +
+                                               " of " + std::to_string(args_.frames) + " frames)"
+                                         : " (never connected)");
+  }
+  return out;
+}
+
 int Netplay::run() {
   if (Status s = start(); !s) return usage_error(netplay_name, s.message());
   say("arena (seed " + std::to_string(args_.seed) + ", " + std::to_string(args_.players) +
@@ -306,6 +301,8 @@ int Netplay::run() {
       std::to_string(args_.input_delay) + ", " + std::to_string(args_.frames) + " frames");
   for (const net::UdpPeer& p : plan_.peers)
     say("waiting for player " + std::to_string(p.id) + " at " + p.endpoint.to_string());
+  for (std::size_t k = 0; k < plan_.spectators.size(); ++k)
+    say("serving " + who(args_.players + static_cast<std::uint32_t>(k)));
 
   const auto timeout_us = static_cast<std::uint64_t>(args_.timeout_seconds * 1e6);
   const std::uint64_t period_us = args_.fps == 0 ? 0 : 1'000'000 / args_.fps;
@@ -332,7 +329,7 @@ int Netplay::run() {
         }
         break;
       }
-      std::this_thread::sleep_for(std::chrono::microseconds(idle_sleep_us));
+      std::this_thread::sleep_for(std::chrono::microseconds(netplay_idle_sleep_us));
       continue;
     }
     if (!running_at) running_at = next_tick = now;
@@ -344,22 +341,28 @@ int Netplay::run() {
         progress.update(session_->current_frame(), args_.frames);
       } else {
         std::this_thread::sleep_for(
-            std::chrono::microseconds(std::min(next_tick - now, idle_sleep_us)));
+            std::chrono::microseconds(std::min(next_tick - now, netplay_idle_sleep_us)));
       }
       continue;
     }
     if (!ended_at) ended_at = now;
-    if (confirmed_ >= args_.frames && peers_at_end()) {
+    if (confirmed_ >= args_.frames && peers_at_end()) match_complete_ = true;
+    if (match_complete_ && spectators_behind().empty()) {
       if (!settled_at) settled_at = now;
-      if (now - *settled_at >= linger_us) break;
+      if (now - *settled_at >= netplay_linger_us) break;
     } else if (now - *ended_at >= timeout_us) {
+      if (match_complete_) {  // the match is complete: a spectator that lags is only warned about
+        std::fprintf(stderr, "detsim netplay: stopped serving %s after the last frame\n",
+                     spectators_behind().c_str());
+        break;
+      }
       const std::string behind = unconfirmed_players();
       failure_ = "timed out after the last frame: " + std::to_string(confirmed_) + " of " +
                  std::to_string(args_.frames) + " frames confirmed; waiting for " +
                  (behind.empty() ? "the peers' last inputs" : behind);
       break;
     }
-    std::this_thread::sleep_for(std::chrono::microseconds(idle_sleep_us));
+    std::this_thread::sleep_for(std::chrono::microseconds(netplay_idle_sleep_us));
   }
   progress.done();
   const std::uint64_t end = now_us();
@@ -390,6 +393,19 @@ int Netplay::report(double handshake_seconds, double match_seconds) {
                           .num("bytes_received", s.bytes_received)
                           .text());
     }
+    std::vector<std::string> spectators;
+    for (std::size_t k = 0; k < plan_.spectators.size(); ++k) {
+      const auto player = args_.players + static_cast<std::uint32_t>(k);
+      const net::PeerStats s = session_->peer_stats(player).value_or(net::PeerStats{});
+      spectators.push_back(Json()
+                               .num("spectator", k)
+                               .str("address", plan_.spectators[k].endpoint.to_string())
+                               .boolean("connected", s.synchronized)
+                               .num("acknowledged_frames", s.acknowledged_frame)
+                               .num("packets_sent", s.packets_sent)
+                               .num("bytes_sent", s.bytes_sent)
+                               .text());
+    }
     std::vector<std::string> desyncs;
     for (const net::Event& e : desyncs_)
       desyncs.push_back(Json()
@@ -403,6 +419,7 @@ int Netplay::report(double handshake_seconds, double match_seconds) {
         .num("seed", args_.seed)
         .num("players", args_.players)
         .num("player", args_.me)
+        .boolean("spectator", false)
         .str("mode", args_.mode)
         .num("input_delay", args_.input_delay)
         .num("frames", confirmed_);
@@ -417,15 +434,27 @@ int Netplay::report(double handshake_seconds, double match_seconds) {
         .num("skipped_advances", skipped_)
         .num("desyncs", desyncs_.size())
         .raw("desync_events", Json::array(desyncs))
-        .raw("peers", Json::array(peers));
+        .raw("peers", Json::array(peers))
+        .raw("spectators", Json::array(spectators));
     if (args_.record.empty()) {
       j.null("record");
     } else {
       j.str("record", args_.record);
     }
+    if (report_written_) {
+      j.str("desync_report", args_.desync_report);
+    } else {
+      j.null("desync_report");
+    }
     j.real("handshake_seconds", handshake_seconds).real("match_seconds", match_seconds).print();
     return code;
   }
+  print_text_report(handshake_seconds, match_seconds);
+  return code;
+}
+
+void Netplay::print_text_report(double handshake_seconds, double match_seconds) const {
+  const net::SessionStats& st = session_->stats();
   std::printf("frames       %llu, final hash %s\n", static_cast<unsigned long long>(confirmed_),
               final_hash_ ? hex(*final_hash_).c_str() : "-");
   std::printf("rollbacks    %llu, %llu frames re-simulated\n",
@@ -442,11 +471,23 @@ int Netplay::report(double handshake_seconds, double match_seconds) {
         static_cast<unsigned long long>(s.packets_lost),
         static_cast<unsigned long long>(s.bytes_sent));
   }
+  for (std::size_t k = 0; k < plan_.spectators.size(); ++k) {
+    const auto player = args_.players + static_cast<std::uint32_t>(k);
+    const net::PeerStats s = session_->peer_stats(player).value_or(net::PeerStats{});
+    std::printf(
+        "spectator %-2zu %s: %llu of %llu frames acknowledged; packets %llu sent, %llu "
+        "bytes sent\n",
+        k, plan_.spectators[k].endpoint.to_string().c_str(),
+        static_cast<unsigned long long>(s.acknowledged_frame),
+        static_cast<unsigned long long>(args_.frames),
+        static_cast<unsigned long long>(s.packets_sent),
+        static_cast<unsigned long long>(s.bytes_sent));
+  }
   if (!args_.record.empty()) std::printf("replay       %s\n", args_.record.c_str());
+  if (report_written_) std::printf("desync report %s\n", args_.desync_report.c_str());
   std::printf("time         handshake %.2f s, match %.2f s (%.0f frames/s)\n", handshake_seconds,
               match_seconds,
               match_seconds > 0 ? static_cast<double>(args_.frames) / match_seconds : 0.0);
-  return code;
 }
 
 }  // namespace
@@ -457,8 +498,9 @@ int netplay_command(const NetplayArgs& args) {
                        "--frames must be 1 .. 100000000, got " + std::to_string(args.frames));
   if (!(args.timeout_seconds > 0 && args.timeout_seconds <= 86'400))
     return usage_error(netplay_name, "--timeout must be more than 0 and at most 86400 seconds");
-  auto plan = plan_of(args);
+  auto plan = netplay_plan(args);
   if (!plan) return usage_error(netplay_name, plan.message());
+  if (args.spectate) return spectate(args, plan.value());
   Netplay match(args, std::move(plan.value()));
   return match.run();
 }

@@ -67,13 +67,17 @@ struct DemoArgs {
 };
 int demo_command(const DemoArgs& args);
 
-/// One player of an arena match over UDP against the listed peers.
+/// One player of an arena match over UDP against the listed peers, or (spectate) a spectator of
+/// one of them.
 struct NetplayArgs {
   std::uint32_t players = 2;
   std::uint32_t me = 0;
+  bool me_given = false;           ///< --me was on the command line (refused with spectate)
   std::string bind;                ///< IP:PORT
-  std::vector<std::string> peers;  ///< "J=IP:PORT", every player but `me` once
-  std::string mode = "rollback";   ///< or "lockstep"
+  std::vector<std::string> peers;  ///< "J=IP:PORT": every player but `me` once; spectate: the host
+  std::vector<std::string> spectators;  ///< IP:PORT of each spectator this player serves
+  bool spectate = false;                ///< watch the match instead of playing in it
+  std::string mode = "rollback";        ///< or "lockstep"
   std::uint32_t input_delay = 2;
   std::uint64_t frames = 3600;
   std::uint64_t seed = 1;  ///< the scenario's seed
@@ -81,7 +85,8 @@ struct NetplayArgs {
   std::uint64_t bot_seed = 0;
   std::uint32_t fps = 60;  ///< 0: as fast as possible
   double timeout_seconds = 10;
-  std::string record;  ///< replay file, or empty
+  std::string record;         ///< replay file, or empty
+  std::string desync_report;  ///< on a desync, write this machine's side here; or empty
   bool json = false;
 };
 int netplay_command(const NetplayArgs& args);

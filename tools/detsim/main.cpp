@@ -214,9 +214,18 @@ has reached the end. With --record every peer writes the same replay, byte for b
 verify checks it. The bot plays by frame number, so the final hash depends only on the
 arguments, never on the network's timing.
 
+A spectator watches through one player, which lists it with --spectator; it simulates the
+confirmed frames only (no prediction, no rollback), catches up when behind, and records the same
+replay as the players. Player 0 above could serve one at 127.0.0.1:7002 with
+--spectator 127.0.0.1:7002, and the spectator would run
+  detsim netplay --spectate --players 2 --bind 127.0.0.1:7002 --peer 0=127.0.0.1:7000
+A player waits for its connected spectators to have every frame before it exits (up to
+--timeout; a spectator that lags is only warned about).
+
 Exit status: 0 the match completed; 1 a desync (the frame, both hashes and the player are
-printed); 2 bad usage, a port in use, a handshake timeout or a peer that disconnected (the message
-on stderr names it). --json prints exactly one JSON object on stdout.)";
+printed; --desync-report writes this machine's side for bisection); 2 bad usage, a port in use, a
+handshake timeout or a peer that disconnected (the message on stderr names it). --json prints
+exactly one JSON object on stdout.)";
 
 void add_netplay(CLI::App& app, int& exit_code) {
   static detsim::cli::NetplayArgs netplay;
@@ -224,16 +233,27 @@ void add_netplay(CLI::App& app, int& exit_code) {
       app.add_subcommand("netplay", "Play one player of an arena match against peers over UDP");
   c->add_option("--players", netplay.players, "Players in the match, 2 .. 8 (default 2)")
       ->type_name("N");
-  c->add_option("--me", netplay.me, "This machine's player index, 0 .. N-1 (default 0)")
-      ->type_name("I");
+  auto* me = c->add_option("--me", netplay.me,
+                           "This machine's player index, 0 .. N-1 (default 0; not with --spectate)")
+                 ->type_name("I");
   c->add_option("--bind", netplay.bind,
                 "Local UDP address and port to listen on, numeric: 127.0.0.1:7000, "
                 "0.0.0.0:7000 or [::1]:7000")
       ->required()
       ->type_name("IP:PORT");
   c->add_option("--peer", netplay.peers,
-                "Player J's address (repeat for every player but --me): 1=192.0.2.7:7000")
+                "Player J's address (repeat for every player but --me): 1=192.0.2.7:7000; with "
+                "--spectate exactly one: the player that serves this spectator")
       ->type_name("J=IP:PORT");
+  c->add_option(
+       "--spectator", netplay.spectators,
+       "Serve a spectator at this address (repeatable, at most 16): it receives every "
+       "confirmed frame from this player (the spectator runs --spectate --peer I=<this --bind>)")
+      ->type_name("IP:PORT");
+  c->add_flag("--spectate", netplay.spectate,
+              "Watch the match instead of playing: no --me, one --peer naming the player that "
+              "lists this machine with --spectator, and the players' --players, --seed, --mode "
+              "and --frames");
   c->add_option("--seed", netplay.seed, "Seed of the arena scenario (default 1; same on all peers)")
       ->type_name("S");
   c->add_option("--mode", netplay.mode,
@@ -259,14 +279,21 @@ void add_netplay(CLI::App& app, int& exit_code) {
                 "last frame (default 10)")
       ->type_name("SECONDS");
   c->add_option("--record", netplay.record,
-                "Record the confirmed frames to a replay file (the same bytes on every peer)")
+                "Record the confirmed frames to a replay file (the same bytes on every peer and "
+                "spectator)")
+      ->type_name("FILE");
+  c->add_option("--desync-report", netplay.desync_report,
+                "On a desync, write this machine's side to FILE: the inputs up to the divergent "
+                "frame, the states at the last agreed and the divergent frame, per-body hashes "
+                "(default: none written)")
       ->type_name("FILE");
   c->add_flag("--json", netplay.json,
               "Print one JSON object: frames, final_hash (16 hex digits), rollbacks, "
-              "resimulated_frames, desyncs, peers, ...");
+              "resimulated_frames, desyncs, peers, spectator, ...");
   c->footer(netplay_footer);
-  c->callback([&exit_code, bot] {
+  c->callback([&exit_code, bot, me] {
     netplay.bot = bot->count() > 0;
+    netplay.me_given = me->count() > 0;
     exit_code = detsim::cli::netplay_command(netplay);
   });
 }

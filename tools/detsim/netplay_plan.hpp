@@ -1,0 +1,52 @@
+// What the two roles of `detsim netplay` share: a player (cmd_netplay.cpp) and a spectator
+// (cmd_spectate.cpp, --spectate). The command line is checked once into a NetplayPlan; both loops
+// use the same pacing constants.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <detsim/net/session.hpp>
+#include <detsim/net/udp.hpp>
+#include <detsim/sim/status.hpp>
+
+#include "commands.hpp"
+
+namespace detsim::cli {
+
+inline constexpr std::string_view netplay_name = "netplay";
+/// Polling after the last frame once everything is confirmed, so that peers get our last
+/// inputs and acknowledgements (they are resent every frame until acknowledged).
+inline constexpr std::uint64_t netplay_linger_us = 500'000;
+/// The pause between polls while there is nothing to do.
+inline constexpr std::uint64_t netplay_idle_sleep_us = 1'000;
+/// SessionConfig::spectators allows 16.
+inline constexpr std::size_t max_spectators = 16;
+/// Spectator k's PeerId on the serving player's transport: above every player index (0 .. 7).
+inline constexpr net::PeerId first_spectator_peer = 100;
+
+/// The netplay command line, checked: where to bind, whom to talk to.
+struct NetplayPlan {
+  net::Endpoint bind;
+  /// A player: every other player, ascending, PeerId = player index. A spectator: the host alone.
+  std::vector<net::UdpPeer> peers;
+  /// The spectators this player serves (--spectator), PeerId first_spectator_peer + k.
+  std::vector<net::UdpPeer> spectators;
+  net::SessionMode mode = net::SessionMode::rollback;
+};
+
+/// Checks `args` (player or --spectate) into a plan; errors name the option and the problem.
+Expected<NetplayPlan> netplay_plan(const NetplayArgs& args);
+
+/// "12.3 ms"
+std::string milliseconds(std::uint64_t us);
+/// A fresh seed from the operating system (session nonces and challenges).
+std::uint64_t os_random_seed();
+
+/// Watches the match as a spectator of plan.peers[0] (`detsim netplay --spectate`); the exit code.
+int spectate(const NetplayArgs& args, const NetplayPlan& plan);
+
+}  // namespace detsim::cli
