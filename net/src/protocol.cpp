@@ -56,8 +56,8 @@ class Reader {
   /// A frame written by put_frame against `ack`; `bad` when it falls outside u32.
   std::uint32_t frame(std::uint32_t ack, bool& bad) noexcept {
     const std::uint64_t z = varint(bad);
-    const std::int64_t d = (z & 1U) != 0 ? -static_cast<std::int64_t>(z >> 1) - 1
-                                         : static_cast<std::int64_t>(z >> 1);
+    const std::int64_t d =
+        (z & 1U) != 0 ? -static_cast<std::int64_t>(z >> 1) - 1 : static_cast<std::int64_t>(z >> 1);
     const std::int64_t frame = std::int64_t{ack} + d;
     if (frame < 0 || frame > 0xFFFF'FFFFLL) {
       bad = true;
