@@ -3,9 +3,9 @@
 // inputs and hashes at every frame, equal to an offline replay, with no desync event.
 //
 // Every combination of 2, 4 and 8 players with 5% loss, 20% loss and a 2 s outage of one peer runs
-// twice: with `arena` (real detsim worlds through ScenarioGame) and with the cheap CounterGame, whose
-// length the sanitizer build does not shorten. The sanitizer build runs a tenth of the arena frames
-// (DETSIM_TEST_SCALE).
+// twice: with `arena` (real detsim worlds through ScenarioGame) and with the cheap CounterGame,
+// whose length the sanitizer build does not shorten. The sanitizer build runs a tenth of the arena
+// frames (DETSIM_TEST_SCALE).
 #include <gtest/gtest.h>
 
 #include <cstdio>
