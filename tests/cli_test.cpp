@@ -47,7 +47,8 @@ std::uint64_t library_final_hash(const std::string& name, const ScenarioParams& 
 TEST(Cli, HelpListsEverySubcommandAndEachHasItsOwnHelp) {
   const Result top = detsim_cli("--help");
   EXPECT_EQ(top.exit_code, 0);
-  for (const char* sub : {"scenarios", "run", "verify", "info", "synctest", "golden", "demo"}) {
+  for (const char* sub :
+       {"scenarios", "run", "verify", "info", "diff", "synctest", "golden", "demo"}) {
     EXPECT_TRUE(has(top.out, std::string("  ") + sub)) << sub;
     const Result help = detsim_cli(std::string(sub) + " --help");
     EXPECT_EQ(help.exit_code, 0) << sub;
@@ -146,6 +147,46 @@ TEST(Cli, BadUsageAndBadInputExitWithTwoAndSayWhatIsWrong) {
     EXPECT_TRUE(has(r.err, c.message)) << c.args << "\nstderr: " << r.err;
     EXPECT_EQ(r.out, "") << c.args;
   }
+}
+
+TEST(Cli, DiffNamesTheFieldThatDiffersAndExitsOneOrZero) {
+  ScenarioParams params;
+  params.players = 2;
+  Scenario s = Scenario::create("arena", params).value();
+  for (int f = 0; f < 30; ++f)
+    s.step();
+  TempFile a("a.state");
+  TempFile b("b.state");
+  write_bytes(a.path(), s.world().save());
+  const BodyId id = s.player_body(0);
+  const Vec3 v = s.world().body(id).value().angular_velocity;
+  ASSERT_TRUE(s.world().set_angular_velocity(id, {v.x + Fixed::from_raw(5), v.y, v.z}).ok());
+  write_bytes(b.path(), s.world().save());
+
+  const Result same = detsim_cli("diff " + a.path() + " " + a.path());
+  EXPECT_EQ(same.exit_code, 0) << same.err;
+  EXPECT_TRUE(has(same.out, "equal: frame 30")) << same.out;
+
+  const Result text = detsim_cli("diff " + a.path() + " " + b.path());
+  EXPECT_EQ(text.exit_code, 1) << text.err;
+  EXPECT_TRUE(has(text.out, "body " + std::to_string(id.value))) << text.out;
+  EXPECT_TRUE(has(text.out, "angular_velocity.x")) << text.out;
+
+  const Result json = detsim_cli("diff " + a.path() + " " + b.path() + " --json");
+  EXPECT_EQ(json.exit_code, 1);
+  expect_one_json_object(json.out);
+  EXPECT_EQ(json_value(json.out, "equal"), "false");
+  EXPECT_TRUE(has(json.out, "\"field\":\"angular_velocity.x\"")) << json.out;
+
+  const Result broken = detsim_cli("diff " + a.path() + " /nonexistent/state");
+  EXPECT_EQ(broken.exit_code, 2);
+  EXPECT_TRUE(has(broken.err, "/nonexistent/state: cannot open the file")) << broken.err;
+  TempFile junk("junk.state");
+  write_bytes(junk.path(), std::vector<std::uint8_t>(64, 0x41));
+  const Result bad = detsim_cli("diff " + junk.path() + " " + a.path());
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_TRUE(has(bad.err, junk.path() + ": ")) << bad.err;
+  EXPECT_EQ(bad.out, "");
 }
 
 TEST(Cli, SynctestPassesOnEveryKindOfScene) {

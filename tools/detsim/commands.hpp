@@ -36,6 +36,14 @@ struct VerifyArgs {
 };
 int verify_command(const VerifyArgs& args);
 
+struct DiffArgs {
+  std::string a;  ///< a saved state (World::save() bytes)
+  std::string b;
+  std::size_t max_fields = 100;
+  bool json = false;
+};
+int diff_command(const DiffArgs& args);
+
 struct InfoArgs {
   std::string file;
   bool json = false;

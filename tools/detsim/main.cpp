@@ -304,6 +304,7 @@ void add_scenario_commands(CLI::App& app, int& exit_code) {
   static cli::RunArgs run;
   static cli::VerifyArgs verify;
   static cli::InfoArgs info;
+  static cli::DiffArgs diff;
   static cli::SynctestArgs synctest;
   static cli::GoldenArgs golden_check;
   static cli::GoldenArgs golden_update;
@@ -347,6 +348,22 @@ without its end marker (a recording that stopped early) verifies up to its last 
   c->add_flag("--json", info.json, "Print one JSON object");
   c->footer(exit_footer);
   c->callback([&exit_code] { exit_code = cli::info_command(info); });
+
+  c = app.add_subcommand("diff", "Compare two saved states field by field");
+  c->add_option("STATE_A", diff.a, "A saved World state (e.g. from synctest --dump)")->required();
+  c->add_option("STATE_B", diff.b, "The state to compare it with")->required();
+  c->add_option("--max", diff.max_fields, "List at most N differences (default 100)")
+      ->type_name("N")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}));
+  c->add_flag("--json", diff.json,
+              "Print one JSON object: equal, frame_a, frame_b, hash_a, hash_b, differences "
+              "(subsystem, body, field, a, b), omitted");
+  c->footer(std::string(R"(
+Each difference names the subsystem (globals, rng, bodies, contacts), the body ID and the field
+(position.y, orientation.w, angular_velocity.x, sleep_time, ...) with both values in decimal and
+raw hex; a body present in one state only is listed as such. Exit 0 when the states are equal.)") +
+            exit_footer);
+  c->callback([&exit_code] { exit_code = cli::diff_command(diff); });
 
   c = app.add_subcommand("synctest",
                          "Every frame, roll back K frames, re-simulate and compare the hashes");
