@@ -129,6 +129,7 @@ Expected<StateDiff> diff_states(std::span<const std::uint8_t> a, std::span<const
       c.add("rng", 0, "state[" + std::to_string(i) + "]", show(ra[i]), show(rb[i]));
 
   // Bodies: a merge of both ascending ID lists.
+  const std::size_t before_bodies = out.fields.size() + out.omitted;
   const std::vector<BodyId> ia = wa.body_ids();
   const std::vector<BodyId> ib = wb.body_ids();
   std::size_t i = 0;
@@ -146,6 +147,9 @@ Expected<StateDiff> diff_states(std::span<const std::uint8_t> a, std::span<const
       ++j;
     }
   }
+  // A body's encoding may hold more than BodyState shows: name the part's hashes then.
+  if (out.a.bodies != out.b.bodies && out.fields.size() + out.omitted == before_bodies)
+    c.add("bodies", 0, "hash", show(out.a.bodies), show(out.b.bodies));
   if (out.a.contacts != out.b.contacts)
     c.add("contacts", 0, "cache", show(out.a.contacts), show(out.b.contacts));
   return out;

@@ -374,8 +374,9 @@ StateHashes World::hashes() const {
 }
 
 StateHashes World::save(std::vector<std::uint8_t>& out) const {
-  // One encoding: the total is the hash of save()'s bytes, each part the hash of its slice.
-  sim_detail::Encoded e;
+  // One encoding: the total is the hash of save()'s bytes, each part the hash of its slice. The
+  // bytes go into `out`'s own buffer, so a caller saving every frame allocates nothing.
+  sim_detail::Encoded e{ByteWriter(std::move(out))};
   sim_detail::encode(*s_, e);
   const std::uint8_t* bytes = e.w.bytes().data();
   const auto slice = [&](std::size_t from, std::size_t to) {

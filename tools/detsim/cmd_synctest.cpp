@@ -11,6 +11,7 @@
 
 #include <detsim/net/scenario_game.hpp>
 #include <detsim/net/synctest.hpp>
+#include <detsim/sim/state_diff.hpp>
 
 #include "commands.hpp"
 #include "output.hpp"
@@ -65,13 +66,12 @@ SyncResult run_synctest(Scenario& s, std::uint64_t frames, std::uint32_t distanc
   return r;
 }
 
-/// Which parts of the state differ between the two states of a mismatch.
+/// Which parts of the state differ between the two states of a mismatch (their part hashes).
 std::string differing_parts(const net::SyncTestMismatch& m) {
-  World expected;
-  World actual;
-  if (!expected.restore(m.expected_state) || !actual.restore(m.actual_state)) return "unknown";
-  const StateHashes a = expected.hashes();
-  const StateHashes b = actual.hashes();
+  auto diff = diff_states(m.expected_state, m.actual_state, 0);  // the hashes, no field list
+  if (!diff) return "unknown";
+  const StateHashes& a = diff.value().a;
+  const StateHashes& b = diff.value().b;
   std::string parts;
   const auto add = [&](const char* name, bool differs) {
     if (!differs) return;

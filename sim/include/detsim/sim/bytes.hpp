@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <detsim/fixed/fixed.hpp>
@@ -19,6 +20,11 @@ namespace detsim {
 
 class ByteWriter {
  public:
+  ByteWriter() = default;
+  /// Writes into `buffer` from its start, reusing its capacity (a session saves every frame).
+  explicit ByteWriter(std::vector<std::uint8_t> buffer) noexcept : bytes_(std::move(buffer)) {
+    bytes_.clear();
+  }
   void u8(std::uint8_t v) { bytes_.push_back(v); }
   void u16(std::uint16_t v) { put(v, 2); }
   void u32(std::uint32_t v) { put(v, 4); }
