@@ -1,9 +1,9 @@
 // Field-level state comparison (state_diff.hpp). Both states are restored into scratch worlds
 // (so both are fully validated) and compared through the public body accessors, field by field in
-// the order BodyState declares them. The contact cache has no public per-contact view: it is
-// compared as a whole through its part hash.
+// the order BodyState declares them; contacts pair by pair (World::contacts()), point by point.
 #include <detsim/sim/state_diff.hpp>
 
+#include <algorithm>
 #include <cstdio>
 
 #include <detsim/fixed/decimal.hpp>
@@ -51,8 +51,9 @@ class Collector {
     out_.fields.push_back(FieldDiff{subsystem, body, std::move(field), std::move(a), std::move(b)});
   }
   template <class T>
-  void field(std::uint32_t body, const std::string& name, const T& a, const T& b) {
-    if (!(a == b)) add("bodies", body, name, show(a), show(b));
+  void field(std::uint32_t body, const std::string& name, const T& a, const T& b,
+             const char* subsystem = "bodies") {
+    if (!(a == b)) add(subsystem, body, name, show(a), show(b));
   }
   void vec(std::uint32_t body, const std::string& name, Vec3 a, Vec3 b) {
     field(body, name + ".x", a.x, b.x);
@@ -96,7 +97,62 @@ void diff_body(Collector& c, const BodyState& a, const BodyState& b) {
   c.vec(id, "torque", a.torque, b.torque);
 }
 
+std::string contact_name(const ContactState& c) {
+  return "contact[" + std::to_string(c.b.value) + "]";
+}
+
+void diff_contact(Collector& c, const ContactState& a, const ContactState& b) {
+  const std::uint32_t id = a.a.value;
+  const std::string name = contact_name(a);
+  c.field(id, name + ".touching", a.touching, b.touching, "contacts");
+  c.field(id, name + ".reported", a.reported, b.reported, "contacts");
+  c.field(id, name + ".point_count", std::uint64_t{a.point_count}, std::uint64_t{b.point_count},
+          "contacts");
+  const std::size_t points = std::min(a.point_count, b.point_count);
+  for (std::size_t i = 0; i < points; ++i) {
+    const std::string p = name + ".point[" + std::to_string(i) + "].";
+    const ContactPointState& pa = a.points[i];
+    const ContactPointState& pb = b.points[i];
+    c.field(id, p + "feature", std::uint64_t{pa.feature}, std::uint64_t{pb.feature}, "contacts");
+    c.field(id, p + "normal_impulse", pa.normal_impulse, pb.normal_impulse, "contacts");
+    c.field(id, p + "tangent_impulse_1", pa.tangent_impulse_1, pb.tangent_impulse_1, "contacts");
+    c.field(id, p + "tangent_impulse_2", pa.tangent_impulse_2, pb.tangent_impulse_2, "contacts");
+  }
+}
+
+// A merge of both contact lists, ascending (a, b); a pair on one side only is "present".
+void diff_contacts(Collector& c, const std::vector<ContactState>& ca,
+                   const std::vector<ContactState>& cb) {
+  const auto key = [](const ContactState& x) {
+    return (std::uint64_t{x.a.value} << 32) | x.b.value;
+  };
+  std::size_t i = 0;
+  std::size_t j = 0;
+  while (i < ca.size() || j < cb.size()) {
+    if (j == cb.size() || (i < ca.size() && key(ca[i]) < key(cb[j]))) {
+      c.add("contacts", ca[i].a.value, contact_name(ca[i]) + ".present", "present", "absent");
+      ++i;
+    } else if (i == ca.size() || key(cb[j]) < key(ca[i])) {
+      c.add("contacts", cb[j].a.value, contact_name(cb[j]) + ".present", "absent", "present");
+      ++j;
+    } else {
+      diff_contact(c, ca[i], cb[j]);
+      ++i;
+      ++j;
+    }
+  }
+}
+
 }  // namespace
+
+std::vector<std::string> differing_subsystems(const StateHashes& a, const StateHashes& b) {
+  std::vector<std::string> out;
+  if (a.globals != b.globals) out.emplace_back("globals");
+  if (a.rng != b.rng) out.emplace_back("rng");
+  if (a.bodies != b.bodies) out.emplace_back("bodies");
+  if (a.contacts != b.contacts) out.emplace_back("contacts");
+  return out;
+}
 
 Expected<StateDiff> diff_states(std::span<const std::uint8_t> a, std::span<const std::uint8_t> b,
                                 std::size_t max_fields) {
@@ -111,13 +167,14 @@ Expected<StateDiff> diff_states(std::span<const std::uint8_t> a, std::span<const
   out.frame_b = wb.frame();
   Collector c(out, max_fields);
 
+  // The count is saved with the bodies, not the globals: listed whichever part's hash differs.
+  const std::size_t before = out.fields.size() + out.omitted;
+  if (wa.body_count() != wb.body_count())
+    c.add("globals", 0, "body count", show(std::uint64_t{wa.body_count()}),
+          show(std::uint64_t{wb.body_count()}));
   if (out.a.globals != out.b.globals) {
-    const std::size_t before = out.fields.size() + out.omitted;
     if (wa.frame() != wb.frame()) c.add("globals", 0, "frame", show(wa.frame()), show(wb.frame()));
     if (!(wa.def() == wb.def())) c.add("globals", 0, "world definition", "(differs)", "(differs)");
-    if (wa.body_count() != wb.body_count())
-      c.add("globals", 0, "body count", show(std::uint64_t{wa.body_count()}),
-            show(std::uint64_t{wb.body_count()}));
     // Otherwise a global without an accessor differs (the next body ID): name the part's hashes.
     if (out.fields.size() + out.omitted == before)
       c.add("globals", 0, "hash", show(out.a.globals), show(out.b.globals));
@@ -150,8 +207,12 @@ Expected<StateDiff> diff_states(std::span<const std::uint8_t> a, std::span<const
   // A body's encoding may hold more than BodyState shows: name the part's hashes then.
   if (out.a.bodies != out.b.bodies && out.fields.size() + out.omitted == before_bodies)
     c.add("bodies", 0, "hash", show(out.a.bodies), show(out.b.bodies));
-  if (out.a.contacts != out.b.contacts)
-    c.add("contacts", 0, "cache", show(out.a.contacts), show(out.b.contacts));
+  if (out.a.contacts != out.b.contacts) {
+    const std::size_t before_contacts = out.fields.size() + out.omitted;
+    diff_contacts(c, wa.contacts(), wb.contacts());
+    if (out.fields.size() + out.omitted == before_contacts)
+      c.add("contacts", 0, "cache", show(out.a.contacts), show(out.b.contacts));
+  }
   return out;
 }
 

@@ -146,6 +146,24 @@ Expected<BodyState> World::body(BodyId id) const {
   return s_->bodies[static_cast<std::size_t>(i)];
 }
 
+std::vector<ContactState> World::contacts() const {
+  std::vector<ContactState> out;
+  out.reserve(s_->contacts.size());
+  for (const sim_detail::Contact& c : s_->contacts) {
+    ContactState v;
+    v.a = BodyId{c.a};
+    v.b = BodyId{c.b};
+    v.touching = c.touching;
+    v.reported = c.reported;
+    v.point_count = c.point_count;
+    for (std::size_t p = 0; p < c.point_count; ++p)
+      v.points[p] = ContactPointState{c.cached[p].feature, c.cached[p].normal_impulse,
+                                      c.cached[p].tangent_impulse_1, c.cached[p].tangent_impulse_2};
+    out.push_back(v);
+  }
+  return out;
+}
+
 namespace {
 
 // Runs `f` on the body, which is woken first when `wake` is set and the body can move.

@@ -4,6 +4,7 @@
 #include <detsim/sim/body.hpp>
 #include <detsim/sim/bytes.hpp>
 #include <detsim/sim/driver.hpp>
+#include <detsim/sim/inject.hpp>
 #include <detsim/sim/mass.hpp>
 #include <detsim/sim/rng.hpp>
 #include <detsim/sim/scenario.hpp>

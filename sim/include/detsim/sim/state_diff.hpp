@@ -18,9 +18,11 @@ namespace detsim {
 struct FieldDiff {
   /// "globals", "rng", "bodies" or "contacts".
   std::string subsystem;
-  std::uint32_t body = 0;  ///< the body's ID for "bodies", else 0
+  /// The body's ID for "bodies"; for "contacts" the pair's lower ID; else 0.
+  std::uint32_t body = 0;
   /// e.g. "position.y", "orientation.w", "angular_velocity.x", "sleep_time", "frame", "state[2]";
-  /// "present" when the body exists on one side only; "cache" for the contact cache as a whole.
+  /// "present" when the body exists on one side only; for a contact of `body` with body 23:
+  /// "contact[23].point[0].normal_impulse", "contact[23].touching", "contact[23].present".
   std::string field;
   std::string a;  ///< the value in A: decimal, then the raw bits ("0.5 (0x0000000080000000)")
   std::string b;  ///< the value in B, alike; "absent" for a body missing on that side
@@ -38,6 +40,10 @@ struct StateDiff {
 
   [[nodiscard]] bool equal() const noexcept { return a == b; }
 };
+
+/// The parts whose hashes differ, in order: "globals", "rng", "bodies", "contacts".
+[[nodiscard]] std::vector<std::string> differing_subsystems(const StateHashes& a,
+                                                            const StateHashes& b);
 
 /// Compares two saved states field by field, listing at most `max_fields` differences. An error
 /// names the side ("state A: byte 12: ...") when a state does not restore.

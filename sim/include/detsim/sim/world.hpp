@@ -5,6 +5,7 @@
 // machine. See docs/SIM.md for the step's stages and docs/DETERMINISM.md for the rules.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -21,6 +22,7 @@ namespace detsim {
 namespace sim_detail {
 struct WorldState;
 }
+struct Injection;
 
 /// A body's complete state as the world holds it (a copy: it does not follow later changes).
 struct BodyState {
@@ -63,6 +65,31 @@ struct StateHashes {
   std::uint64_t contacts = 0;  ///< the contact cache (manifolds and warm-start impulses)
 
   friend constexpr bool operator==(const StateHashes&, const StateHashes&) noexcept = default;
+};
+
+/// One point of a contact as the contact cache keeps it between steps: the feature pair that made
+/// it (to match it with the next step's point) and the impulses the solver accumulated on it (to
+/// warm start with).
+struct ContactPointState {
+  std::uint32_t feature = 0;
+  Fixed normal_impulse{};  ///< N s
+  Fixed tangent_impulse_1{};
+  Fixed tangent_impulse_2{};
+
+  friend constexpr bool operator==(const ContactPointState&,
+                                   const ContactPointState&) noexcept = default;
+};
+
+/// A pair of bodies in the contact cache (their bounding boxes overlap), as saved and hashed.
+struct ContactState {
+  BodyId a{};  ///< the lower ID
+  BodyId b{};
+  bool touching = false;  ///< had at least one point at the last narrowphase
+  bool reported = false;  ///< in touch as contact events report it
+  std::uint8_t point_count = 0;
+  std::array<ContactPointState, 4> points{};  ///< the first point_count are used
+
+  friend constexpr bool operator==(const ContactState&, const ContactState&) noexcept = default;
 };
 
 /// What a query considers: bodies with (layer & filter.mask) != 0 and (filter.layer & mask) != 0,
@@ -197,8 +224,11 @@ class World {
   StateHashes save(std::vector<std::uint8_t>& bytes) const;
   /// XXH3-64 of one body's canonical bytes, or an error for an unknown ID.
   [[nodiscard]] Expected<std::uint64_t> body_hash(BodyId id) const;
+  /// The contact cache (part of the saved state), ascending (a, b).
+  [[nodiscard]] std::vector<ContactState> contacts() const;
 
  private:
+  friend Status apply_injection(World& world, const Injection& injection);
   explicit World(std::unique_ptr<sim_detail::WorldState> state) noexcept;
   std::unique_ptr<sim_detail::WorldState> s_;
 };

@@ -1,0 +1,62 @@
+// Fault injection: a debug aid that changes one field of a World's state at one frame, on this
+// machine only — a stand-in for the non-determinism that desync tools must find. `detsim run`,
+// `verify` and `netplay` take it as `--inject FRAME:BODY:FIELD:DELTA`; tests use it to prove that
+// bisection names exactly the frame, body and field that were changed.
+//
+// The change is made to the state of frame FRAME: after the step that produces that frame and
+// before its hash is taken, so the frame's hash is the first that differs and a field-level diff
+// of that frame shows exactly the injected field (a removed body also takes its contacts).
+//
+// FIELD uses the names state_diff.hpp prints:
+//   position.x|y|z  orientation.w|x|y|z  linear_velocity.x|y|z  angular_velocity.x|y|z
+//   force.x|y|z  torque.x|y|z  sleep_time                         DELTA: a decimal, added
+//   awake                                                         DELTA: 1 toggles the flag
+//   user_data                                                     DELTA: an integer, added
+//   present               DELTA -1: BODY is removed (its contacts with it; nothing is woken);
+//                         +1: a static copy of BODY's shape and material is added 1000 m above
+//                         it with the next free ID and user_data 0 (not for a plane)
+//   rng.state[0..3]       BODY 0; DELTA: an integer, added modulo 2^64
+//   contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2
+//                         the cached impulse of point I of the pair (BODY, OTHER); DELTA: a decimal
+// Results that restore() would refuse (an orientation no longer a unit quaternion, a negative
+// sleep time, a static body awake, an all-zero RNG state) are refused, and the world is unchanged.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include <detsim/fixed/fixed.hpp>
+#include <detsim/sim/status.hpp>
+#include <detsim/sim/world.hpp>
+
+namespace detsim {
+
+struct Injection {
+  std::uint64_t frame = 0;  ///< the state frame changed (1 or later: frame 0 is never stepped into)
+  std::uint32_t body = 0;   ///< the body; for contact fields either body of the pair; 0 for rng
+  std::string field;        ///< as written, e.g. "position.y"
+  std::string delta;        ///< as written, e.g. "0.001"
+
+  /// The spec back in FRAME:BODY:FIELD:DELTA form.
+  [[nodiscard]] std::string text() const;
+};
+
+/// Parses FRAME:BODY:FIELD:DELTA, checking the field's name and the delta's form for that field.
+/// Errors name the part that is wrong and what is allowed.
+Expected<Injection> parse_injection(std::string_view spec);
+
+/// Applies `injection` to `world` now (callers do it when world.frame() == injection.frame). An
+/// unknown body or contact point, or a result restore() would refuse, is an error and the world is
+/// unchanged.
+Status apply_injection(World& world, const Injection& injection);
+
+/// Applies, in order, every injection whose frame is world.frame(): what a run calls after each
+/// step. Stops at the first error.
+Status apply_injections(World& world, std::span<const Injection> injections);
+
+/// One line per field form, for --help texts.
+[[nodiscard]] std::string_view injection_fields_help() noexcept;
+
+}  // namespace detsim

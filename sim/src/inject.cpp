@@ -1,0 +1,319 @@
+// Fault injection (inject.hpp). Parsing checks the field's name and the delta's form; applying
+// changes a copy of the one thing touched (a body, the RNG state, a contact point), checks it as
+// restore() would, and only then writes it back, so a refused injection changes nothing.
+#include <detsim/sim/inject.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <optional>
+
+#include <detsim/fixed/decimal.hpp>
+#include <detsim/fixed/quat.hpp>
+
+#include "world_state.hpp"
+
+namespace detsim {
+namespace {
+
+constexpr std::string_view kFieldsHelp =
+    "position.x|y|z, orientation.w|x|y|z, linear_velocity.x|y|z, angular_velocity.x|y|z, "
+    "force.x|y|z, torque.x|y|z, sleep_time (DELTA a decimal, added); awake (DELTA 1 toggles); "
+    "user_data (DELTA an integer, added); present (DELTA -1 removes BODY, +1 adds a static copy of "
+    "its shape 1000 m above); rng.state[0..3] (BODY 0, DELTA an integer, added mod 2^64); "
+    "contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2 (DELTA a decimal)";
+
+enum class Kind { fixed, toggle, integer, presence };
+
+/// What a field name refers to, once parsed.
+struct Target {
+  Kind kind = Kind::fixed;
+  enum class Part { body, rng, contact } part = Part::body;
+  std::string base;         ///< "position", "sleep_time", "normal_impulse", ...
+  int component = -1;       ///< x y z = 0 1 2, w = 3; the RNG word; -1: none
+  std::uint32_t other = 0;  ///< contact: the other body
+  std::size_t point = 0;    ///< contact: the point
+};
+
+/// A decimal without sign or leading zeros ("0" itself is fine).
+std::optional<std::uint64_t> parse_u64(std::string_view text) {
+  if (text.size() > 1 && text.front() == '0') return std::nullopt;
+  std::uint64_t v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc{} || end != text.data() + text.size()) return std::nullopt;
+  return v;
+}
+
+std::optional<std::int64_t> parse_i64(std::string_view text) {
+  if (text.size() > 1 && text.front() == '+' && text[1] != '-') text.remove_prefix(1);
+  std::int64_t v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc{} || end != text.data() + text.size()) return std::nullopt;
+  return v;
+}
+
+/// "a[N]" -> N when `text` starts with `prefix` + "[", ends the index with "]"; `rest` gets what
+/// follows.
+std::optional<std::uint64_t> indexed(std::string_view text, std::string_view prefix,
+                                     std::string_view& rest) {
+  if (text.substr(0, prefix.size() + 1) != std::string(prefix) + "[") return std::nullopt;
+  text.remove_prefix(prefix.size() + 1);
+  const std::size_t close = text.find(']');
+  if (close == std::string_view::npos) return std::nullopt;
+  auto n = parse_u64(text.substr(0, close));
+  rest = text.substr(close + 1);
+  return n;
+}
+
+Expected<Target> parse_field(std::string_view field) {
+  Target t;
+  const auto unknown = [&] {
+    return Status::error("unknown field \"" + std::string(field) +
+                         "\"; fields: " + std::string(kFieldsHelp));
+  };
+  if (field.starts_with("rng.")) {
+    std::string_view rest;
+    auto word = indexed(field.substr(4), "state", rest);
+    if (!word || !rest.empty() || *word > 3) return unknown();
+    t.part = Target::Part::rng;
+    t.kind = Kind::integer;
+    t.component = static_cast<int>(*word);
+    return t;
+  }
+  if (field.starts_with("contact[")) {
+    std::string_view rest;
+    auto other = indexed(field, "contact", rest);
+    if (!other || *other == 0 || *other > 0xFFFFFFFFU || !rest.starts_with(".")) return unknown();
+    std::string_view name;
+    auto point = indexed(rest.substr(1), "point", name);
+    if (!point || *point > 3 || !name.starts_with(".")) return unknown();
+    name.remove_prefix(1);
+    if (name != "normal_impulse" && name != "tangent_impulse_1" && name != "tangent_impulse_2")
+      return unknown();
+    t.part = Target::Part::contact;
+    t.other = static_cast<std::uint32_t>(*other);
+    t.point = static_cast<std::size_t>(*point);
+    t.base = std::string(name);
+    return t;
+  }
+  if (field == "sleep_time") {
+    t.base = "sleep_time";
+    return t;
+  }
+  if (field == "awake" || field == "user_data" || field == "present") {
+    t.base = std::string(field);
+    t.kind = field == "awake"       ? Kind::toggle
+             : field == "user_data" ? Kind::integer
+                                    : Kind::presence;
+    return t;
+  }
+  const std::size_t dot = field.rfind('.');
+  if (dot == std::string_view::npos || dot + 2 != field.size()) return unknown();
+  t.base = std::string(field.substr(0, dot));
+  const char c = field.back();
+  const bool vector = t.base == "position" || t.base == "linear_velocity" ||
+                      t.base == "angular_velocity" || t.base == "force" || t.base == "torque";
+  if (vector && c >= 'x' && c <= 'z') {
+    t.component = c - 'x';
+  } else if (t.base == "orientation" && (c == 'w' || (c >= 'x' && c <= 'z'))) {
+    t.component = c == 'w' ? 3 : c - 'x';
+  } else {
+    return unknown();
+  }
+  return t;
+}
+
+Status check_delta(const Target& t, std::string_view delta) {
+  switch (t.kind) {
+    case Kind::fixed: {
+      const ParseResult r = Fixed::parse(delta);
+      if (!r) return Status::error("DELTA \"" + std::string(delta) + "\": " + describe(r.error));
+      return Status::success();
+    }
+    case Kind::toggle:
+      if (delta != "1") return Status::error("DELTA for awake must be 1 (toggle the flag)");
+      return Status::success();
+    case Kind::integer:
+      if (!parse_i64(delta))
+        return Status::error("DELTA \"" + std::string(delta) + "\" is not a 64-bit integer");
+      return Status::success();
+    case Kind::presence:
+      if (delta != "-1" && delta != "+1" && delta != "1")
+        return Status::error("DELTA for present must be -1 (remove the body) or +1 (add a copy)");
+      return Status::success();
+  }
+  return Status::success();
+}
+
+Fixed& component(Vec3& v, int c) {
+  return c == 0 ? v.x : c == 1 ? v.y : v.z;
+}
+Fixed& component(Quat& q, int c) {
+  return c == 0 ? q.x : c == 1 ? q.y : c == 2 ? q.z : q.w;
+}
+
+Status change_body(BodyState& b, const Target& t, std::string_view delta) {
+  const Fixed d = Fixed::parse(delta).value;
+  if (t.base == "position") component(b.position, t.component) += d;
+  if (t.base == "linear_velocity") component(b.linear_velocity, t.component) += d;
+  if (t.base == "angular_velocity") component(b.angular_velocity, t.component) += d;
+  if (t.base == "force") component(b.force, t.component) += d;
+  if (t.base == "torque") component(b.torque, t.component) += d;
+  if (t.base == "orientation") {
+    component(b.orientation, t.component) += d;
+    if (auto e = sim_detail::check_orientation(b.orientation); !e.empty())
+      return Status::error("the change would leave an invalid state: " + e);
+  }
+  if (t.base == "sleep_time") {
+    b.sleep_time += d;
+    if (b.sleep_time < Fixed::zero())
+      return Status::error("the change would leave a negative sleep time");
+  }
+  if (t.base == "awake") {
+    if (b.type == BodyType::static_body)
+      return Status::error("body " + std::to_string(b.id.value) + " is static: it cannot be awake");
+    b.awake = !b.awake;
+  }
+  if (t.base == "user_data")
+    b.user_data += static_cast<std::uint64_t>(*parse_i64(delta));  // modulo 2^64
+  return Status::success();
+}
+
+Status add_copy(World& world, const BodyState& of) {
+  if (of.shape.type == ShapeType::plane)
+    return Status::error("body " + std::to_string(of.id.value) +
+                         " is a plane: a copy above it would still touch everything");
+  BodyDef def;
+  def.type = BodyType::static_body;
+  def.shape = of.shape;
+  def.position = of.position;
+  def.position.y += Fixed::from_int(1000);
+  def.orientation = of.orientation;
+  def.friction = of.friction;
+  def.restitution = of.restitution;
+  def.layer = of.layer;
+  def.mask = of.mask;
+  def.sensor = of.sensor;  // user_data stays 0: game logic must not take it for the original
+  auto id = world.create_body(def);
+  if (!id)
+    return Status::error("adding a copy of body " + std::to_string(of.id.value) + ": " +
+                         id.message());
+  return Status::success();
+}
+
+}  // namespace
+
+std::string Injection::text() const {
+  return std::to_string(frame) + ":" + std::to_string(body) + ":" + field + ":" + delta;
+}
+
+Status apply_injections(World& world, std::span<const Injection> injections) {
+  for (const Injection& i : injections) {
+    if (i.frame != world.frame()) continue;
+    if (Status s = apply_injection(world, i); !s) return s;
+  }
+  return Status::success();
+}
+
+std::string_view injection_fields_help() noexcept {
+  return kFieldsHelp;
+}
+
+Expected<Injection> parse_injection(std::string_view spec) {
+  const std::string where = "--inject \"" + std::string(spec) + "\": ";
+  std::string_view parts[4];
+  std::string_view rest = spec;
+  for (int i = 0; i < 3; ++i) {
+    const std::size_t colon = rest.find(':');
+    if (colon == std::string_view::npos)
+      return Status::error(where + "expected FRAME:BODY:FIELD:DELTA (four parts separated by ':')");
+    parts[i] = rest.substr(0, colon);
+    rest.remove_prefix(colon + 1);
+  }
+  parts[3] = rest;
+  Injection out;
+  auto frame = parse_u64(parts[0]);
+  if (!frame || *frame == 0)
+    return Status::error(where + "FRAME \"" + std::string(parts[0]) +
+                         "\" must be a frame number >= 1 (the state after that step)");
+  auto body = parse_u64(parts[1]);
+  if (!body || *body > 0xFFFFFFFFU)
+    return Status::error(where + "BODY \"" + std::string(parts[1]) + "\" must be a body ID");
+  auto target = parse_field(parts[2]);
+  if (!target) return Status::error(where + target.message());
+  if (target->part == Target::Part::rng && *body != 0)
+    return Status::error(where + "BODY must be 0 for an RNG field");
+  if (target->part != Target::Part::rng && *body == 0)
+    return Status::error(where + "BODY must be a body ID (IDs start at 1)");
+  if (target->part == Target::Part::contact && target->other == *body)
+    return Status::error(where + "a contact is between BODY and another body, not itself");
+  if (Status s = check_delta(target.value(), parts[3]); !s)
+    return Status::error(where + s.message());
+  out.frame = *frame;
+  out.body = static_cast<std::uint32_t>(*body);
+  out.field = std::string(parts[2]);
+  out.delta = std::string(parts[3]);
+  return out;
+}
+
+Status apply_injection(World& world, const Injection& injection) {
+  const std::string where = "inject " + injection.text() + ": ";
+  auto parsed = parse_field(injection.field);
+  if (!parsed) return Status::error(where + parsed.message());
+  const Target& t = parsed.value();
+  if (Status st = check_delta(t, injection.delta); !st) return Status::error(where + st.message());
+  sim_detail::WorldState& s = *world.s_;
+
+  if (t.part == Target::Part::rng) {
+    Rng::State state = s.rng.state();
+    state[static_cast<std::size_t>(t.component)] +=
+        static_cast<std::uint64_t>(*parse_i64(injection.delta));
+    if (!s.rng.set_state(state))
+      return Status::error(where + "the change would leave the all-zero RNG state");
+    return Status::success();
+  }
+
+  const std::ptrdiff_t index = s.find(injection.body);
+  if (index < 0) return Status::error(where + "no body with ID " + std::to_string(injection.body));
+  BodyState& body = s.bodies[static_cast<std::size_t>(index)];
+
+  if (t.part == Target::Part::contact) {
+    const std::uint32_t a = std::min(injection.body, t.other);
+    const std::uint32_t b = std::max(injection.body, t.other);
+    auto it = std::find_if(s.contacts.begin(), s.contacts.end(),
+                           [&](const sim_detail::Contact& c) { return c.a == a && c.b == b; });
+    if (it == s.contacts.end())
+      return Status::error(where + "bodies " + std::to_string(a) + " and " + std::to_string(b) +
+                           " have no contact");
+    if (t.point >= it->point_count)
+      return Status::error(where + "the contact of " + std::to_string(a) + " and " +
+                           std::to_string(b) + " has " + std::to_string(it->point_count) +
+                           " cached points");
+    sim_detail::CachedPoint& p = it->cached[t.point];
+    const Fixed d = Fixed::parse(injection.delta).value;
+    if (t.base == "normal_impulse") p.normal_impulse += d;
+    if (t.base == "tangent_impulse_1") p.tangent_impulse_1 += d;
+    if (t.base == "tangent_impulse_2") p.tangent_impulse_2 += d;
+    return Status::success();
+  }
+
+  if (t.kind == Kind::presence) {
+    if (injection.delta != "-1") {
+      if (Status st = add_copy(world, body); !st) return Status::error(where + st.message());
+      return Status::success();
+    }
+    // Removed as a fault, not as a game action: nothing else notices (no wake, no events).
+    const std::uint32_t id = injection.body;
+    std::erase_if(s.contacts,
+                  [id](const sim_detail::Contact& c) { return c.a == id || c.b == id; });
+    s.bodies.erase(s.bodies.begin() + index);
+    return Status::success();
+  }
+
+  BodyState changed = body;
+  if (Status st = change_body(changed, t, injection.delta); !st)
+    return Status::error(where + st.message());
+  body = changed;
+  return Status::success();
+}
+
+}  // namespace detsim
