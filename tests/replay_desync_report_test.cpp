@@ -35,8 +35,10 @@ replay::DesyncReport sample_report() {
   r.agreed_frame = 30;
   r.divergent_frame = 60;
   const std::size_t unit = 1 + std::size_t{r.fingerprint.players} * r.fingerprint.input_size;
+  r.origin = replay::ReportOrigin::session;
   for (std::uint64_t f = 0; f < 60; ++f) {
     if (f == 30) r.agreed_state = scenario.world().save();
+    if (f > 30) r.intermediate_states.push_back({f, scenario.world().save()});
     for (std::size_t i = 0; i < unit; ++i)
       r.confirmed_frames.push_back(static_cast<std::uint8_t>(f + i));
     scenario.step();
@@ -101,14 +103,15 @@ TEST(DesyncReport, CorruptionIsCaughtByTheChecksum) {
   magic[0] = 'X';
   EXPECT_NE(replay::parse_desync_report(magic, "m").message().find("magic"), std::string::npos);
   std::vector<std::uint8_t> version = bytes;
-  version[8] = 2;
-  EXPECT_NE(replay::parse_desync_report(version, "v").message().find("version 2"),
+  version[8] = 3;
+  EXPECT_NE(replay::parse_desync_report(version, "v").message().find("version 3"),
             std::string::npos);
 }
 
 /// A file whose checksum is right but whose fields lie: built from a payload by hand.
-std::vector<std::uint8_t> with_valid_checksum(const std::vector<std::uint8_t>& payload) {
-  std::vector<std::uint8_t> file = {'D', 'S', 'D', 'E', 'S', 'Y', 'N', 'C', 1, 0, 0, 0};
+std::vector<std::uint8_t> with_valid_checksum(const std::vector<std::uint8_t>& payload,
+                                              std::uint8_t version = 2) {
+  std::vector<std::uint8_t> file = {'D', 'S', 'D', 'E', 'S', 'Y', 'N', 'C', version, 0, 0, 0};
   for (int i = 0; i < 8; ++i)
     file.push_back(static_cast<std::uint8_t>(payload.size() >> (8 * i)));
   file.insert(file.end(), payload.begin(), payload.end());
@@ -133,13 +136,54 @@ TEST(DesyncReport, HostileLengthsAreRefusedBeforeAllocating) {
   std::vector<std::uint8_t> bytes = file_bytes(temp_path("count"));
   std::remove(temp_path("count").c_str());
   std::vector<std::uint8_t> body(bytes.begin() + 20, bytes.end() - 8);
-  const std::size_t count_at = body.size() - (8 + 11 * 12);  // the divergent bodies' count
-  body[count_at + 7] = 0x7F;
-  r = replay::parse_desync_report(with_valid_checksum(body), "c.dsd");
+  // From the end: the intermediate states (29 of them, each a frame and a length-prefixed state),
+  // their count, the origin, the divergent bodies.
+  const replay::DesyncReport sample = sample_report();
+  std::size_t tail = 8 + 1;
+  for (const replay::FrameState& f : sample.intermediate_states)
+    tail += 16 + f.state.size();
+  const std::size_t count_at = body.size() - tail - (8 + 11 * 12);  // the divergent bodies' count
+  std::vector<std::uint8_t> inflated = body;
+  inflated[count_at + 7] = 0x7F;
+  r = replay::parse_desync_report(with_valid_checksum(inflated), "c.dsd");
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.message().find("divergent body hashes: expected a body count within the file"),
             std::string::npos)
       << r.message();
+  // An intermediate state count that is neither 0 nor the frames in between.
+  std::vector<std::uint8_t> miscounted = body;
+  miscounted[body.size() - tail + 1] = 28;
+  r = replay::parse_desync_report(with_valid_checksum(miscounted), "i.dsd");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.message().find("intermediate state count: expected 0 or one per frame"),
+            std::string::npos)
+      << r.message();
+  // An origin that is not one.
+  std::vector<std::uint8_t> origin = body;
+  origin[body.size() - tail] = 7;
+  r = replay::parse_desync_report(with_valid_checksum(origin), "o.dsd");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.message().find("origin: expected 0 (a session) or 1 (verify)"), std::string::npos)
+      << r.message();
+}
+
+TEST(DesyncReport, VersionOneReportsAreStillRead) {
+  // Version 1 ends after the divergent bodies: no origin, no intermediate states.
+  ASSERT_TRUE(replay::write_desync_report(temp_path("v1"), sample_report()).ok());
+  std::vector<std::uint8_t> bytes = file_bytes(temp_path("v1"));
+  std::remove(temp_path("v1").c_str());
+  const replay::DesyncReport sample = sample_report();
+  std::size_t tail = 8 + 1;
+  for (const replay::FrameState& f : sample.intermediate_states)
+    tail += 16 + f.state.size();
+  std::vector<std::uint8_t> body(bytes.begin() + 20, bytes.end() - 8 - static_cast<long>(tail));
+  auto r = replay::parse_desync_report(with_valid_checksum(body, 1), "v1.dsd");
+  ASSERT_TRUE(r.ok()) << r.message();
+  replay::DesyncReport expected = sample;
+  expected.intermediate_states.clear();
+  EXPECT_EQ(r.value(), expected);
+  // The same bytes labelled version 2 lack the version 2 fields.
+  EXPECT_FALSE(replay::parse_desync_report(with_valid_checksum(body, 2), "v2.dsd").ok());
 }
 
 TEST(DesyncReport, AMissingFileIsNamed) {

@@ -64,6 +64,34 @@ std::vector<BodyHash> read_bodies(ByteReader& r, const char* what) {
   return bodies;
 }
 
+// Either none or every frame strictly between the agreed and the divergent frame, ascending.
+void read_intermediate(ByteReader& r, DesyncReport& report) {
+  const std::size_t at = r.offset();
+  const std::uint64_t n = r.u64("intermediate state count");
+  if (!r.ok()) return;
+  const std::uint64_t between = report.divergent_frame - report.agreed_frame - 1;
+  if (n != 0 && n != between) {
+    r.fail_at(at, "intermediate state count",
+              "0 or one per frame between the agreed and the divergent frame");
+    return;
+  }
+  if (n > r.remaining() / 16) {
+    r.fail_at(at, "intermediate state count", "a count within the file");
+    return;
+  }
+  report.intermediate_states.resize(static_cast<std::size_t>(n));
+  std::uint64_t expected = report.agreed_frame + 1;
+  for (FrameState& f : report.intermediate_states) {
+    const std::size_t frame_at = r.offset();
+    f.frame = r.u64("intermediate state frame");
+    if (r.ok() && f.frame != expected)
+      r.fail_at(frame_at, "intermediate state frame", "consecutive frames after the agreed frame");
+    f.state = read_bytes(r, "intermediate state");
+    if (!r.ok()) return;
+    ++expected;
+  }
+}
+
 }  // namespace
 
 Expected<std::vector<BodyHash>> body_hashes(std::span<const std::uint8_t> state) {
@@ -91,6 +119,12 @@ Status write_desync_report(const std::string& path, const DesyncReport& report) 
   write_bytes(payload, report.divergent_state);
   write_bodies(payload, report.agreed_bodies);
   write_bodies(payload, report.divergent_bodies);
+  payload.u8(static_cast<std::uint8_t>(report.origin));
+  payload.u64(report.intermediate_states.size());
+  for (const FrameState& f : report.intermediate_states) {
+    payload.u64(f.frame);
+    write_bytes(payload, f.state);
+  }
 
   ByteWriter file;
   file.raw({reinterpret_cast<const std::uint8_t*>(kMagic), 8});
@@ -121,9 +155,9 @@ Expected<DesyncReport> parse_desync_report(std::span<const std::uint8_t> bytes,
   ByteReader head(bytes.subspan(8, 12));
   const std::uint32_t version = head.u32("version");
   const std::uint64_t size = head.u64("payload size");
-  if (version != desync_report_version)
+  if (version != 1 && version != desync_report_version)
     return fail(8, "version " + std::to_string(version) + ", this build reads version " +
-                       std::to_string(desync_report_version));
+                       std::to_string(desync_report_version) + " (and version 1)");
   if (size != bytes.size() - kHeaderSize - kTrailerSize)
     return fail(12, "payload size " + std::to_string(size) + ", but the file holds " +
                         std::to_string(bytes.size() - kHeaderSize - kTrailerSize) +
@@ -163,7 +197,15 @@ Expected<DesyncReport> parse_desync_report(std::span<const std::uint8_t> bytes,
   report.divergent_state = read_bytes(r, "divergent state");
   report.agreed_bodies = read_bodies(r, "agreed body hashes");
   report.divergent_bodies = read_bodies(r, "divergent body hashes");
-  if (r.ok() && !r.at_end()) r.fail("report", "no bytes after the divergent body hashes");
+  if (version >= 2) {
+    const std::size_t origin_at = r.offset();
+    const std::uint8_t origin = r.u8("origin");
+    if (r.ok() && origin > static_cast<std::uint8_t>(ReportOrigin::verify))
+      r.fail_at(origin_at, "origin", "0 (a session) or 1 (verify)");
+    report.origin = static_cast<ReportOrigin>(origin);
+    read_intermediate(r, report);
+  }
+  if (r.ok() && !r.at_end()) r.fail("report", "no bytes after the last field");
   if (!r.ok()) return fail(kHeaderSize + r.error_offset(), r.error_detail());
   return report;
 }

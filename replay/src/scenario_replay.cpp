@@ -35,6 +35,61 @@ void decode_inputs(std::span<const std::uint8_t> bytes, std::vector<PlayerInput>
   }
 }
 
+/// What verify keeps to write this machine's side of a frame as a desync report: the state before
+/// the current frame and every frame's inputs so far (as a session's confirmed frames: a zero
+/// "disconnected" byte, then the inputs).
+class ReportBuilder {
+ public:
+  ReportBuilder(const Fingerprint& fingerprint, bool active)
+      : fingerprint_(fingerprint), active_(active) {}
+
+  void remember(const World& world) { world.save(current_); }
+
+  /// After a frame's step: keeps its inputs and state, returns its hashes.
+  StateHashes step(const World& world, std::span<const std::uint8_t> inputs) {
+    confirmed_.push_back(0);
+    confirmed_.insert(confirmed_.end(), inputs.begin(), inputs.end());
+    previous_.swap(current_);
+    return world.save(current_);
+  }
+
+  /// The report of `frame` (the frame last stepped; the steps so far are frames 0 .. frame - 1).
+  Expected<DesyncReport> build_checked(std::uint64_t frame, std::uint64_t local,
+                                       std::uint64_t remote) const {
+    DesyncReport r;
+    r.fingerprint = fingerprint_;
+    r.origin = ReportOrigin::verify;
+    r.agreed_frame = frame - 1;
+    r.divergent_frame = frame;
+    r.local_hash = local;
+    r.remote_hash = remote;
+    r.confirmed_frames = confirmed_;  // steps 0 .. frame - 1
+    r.agreed_state = previous_;
+    r.divergent_state = current_;
+    auto agreed = body_hashes(r.agreed_state);
+    if (!agreed) return agreed.status();
+    auto divergent = body_hashes(r.divergent_state);
+    if (!divergent) return divergent.status();
+    r.agreed_bodies = std::move(agreed).value();
+    r.divergent_bodies = std::move(divergent).value();
+    return r;
+  }
+  std::optional<DesyncReport> build(std::uint64_t frame, std::uint64_t local,
+                                    std::uint64_t remote) const {
+    if (!active_) return std::nullopt;
+    auto r = build_checked(frame, local, remote);
+    if (!r) return std::nullopt;  // never: both states were saved by this build's World
+    return std::move(r).value();
+  }
+
+ private:
+  const Fingerprint& fingerprint_;
+  bool active_;
+  std::vector<std::uint8_t> previous_;
+  std::vector<std::uint8_t> current_;
+  std::vector<std::uint8_t> confirmed_;
+};
+
 std::string fixed_text(Fixed v) {
   return to_string(v) + " (raw " + std::to_string(v.raw()) + ")";
 }
@@ -60,8 +115,11 @@ Fingerprint fingerprint_of(const Scenario& scenario, std::uint32_t keyframe_inte
 }
 
 Expected<Scenario> scenario_of(const ReplayReader& reader) {
-  const Fingerprint& f = reader.fingerprint();
-  const std::string where = reader.path() + ": fingerprint: ";
+  return scenario_of(reader.fingerprint(), reader.path());
+}
+
+Expected<Scenario> scenario_of(const Fingerprint& f, const std::string& name) {
+  const std::string where = name + ": fingerprint: ";
   if (f.fixed_fraction_bits != Fixed::fraction_bits)
     return Status::error(where + "recorded with Q" + std::to_string(64 - f.fixed_fraction_bits) +
                          "." + std::to_string(f.fixed_fraction_bits) +
@@ -121,6 +179,9 @@ Expected<RecordResult> record(Scenario& scenario, const std::string& path,
         inputs[p] = scripted_input(seed, f, p);
     }
     scenario.step(inputs);
+    if (options.after_step) {
+      if (Status s = options.after_step(scenario); !s) return s;
+    }
     const StateHashes hashes = scenario.world().hashes();
     chain.add(hashes.total);
     result.final_hash = hashes.total;
@@ -142,6 +203,17 @@ Expected<RecordResult> record(Scenario& scenario, const std::string& path,
 }
 
 Expected<VerifyResult> verify(const ReplayReader& reader, const Progress& progress) {
+  VerifyOptions options;
+  options.progress = progress;
+  return verify(reader, options);
+}
+
+Expected<VerifyResult> verify(const ReplayReader& reader, const VerifyOptions& options) {
+  const std::uint64_t total = reader.frame_count();
+  if (options.report_at && (*options.report_at == 0 || *options.report_at > total))
+    return Status::error(reader.path() + ": cannot report frame " +
+                         std::to_string(*options.report_at) + ": the replay holds frames 1 to " +
+                         std::to_string(total));
   auto created = scenario_of(reader);
   if (!created) return created.status();
   Scenario& scenario = created.value();
@@ -156,16 +228,28 @@ Expected<VerifyResult> verify(const ReplayReader& reader, const Progress& progre
     result.note = "the scenario's initial state differs from the recorded one";
     return result;
   }
+  const bool reporting = options.report || options.report_at;
+  ReportBuilder report(fp, reporting);
+  if (reporting) report.remember(scenario.world());
   const std::vector<KeyframeInfo>& keyframes = reader.keyframes();
   std::size_t next_keyframe = 0;
   std::vector<PlayerInput> inputs;
   HashChain chain;
-  Status keyframe_error;
-  const std::uint64_t total = reader.frame_count();
+  Status stop_error;
   const Status read = reader.for_each_frame(1, total, [&](const FrameRecord& record) {
     decode_inputs(record.inputs, inputs);
     scenario.step(inputs);
-    const StateHashes hashes = scenario.world().hashes();
+    if (options.after_step) {
+      if (Status s = options.after_step(scenario); !s) {
+        stop_error = s;
+        return false;
+      }
+    }
+    const StateHashes hashes =
+        reporting ? report.step(scenario.world(), record.inputs) : scenario.world().hashes();
+    if (options.report_at && record.frame == *options.report_at)
+      result.report = report.build(record.frame, hashes.total, record.hashes.total);
+    if (result.first_mismatch) return !options.report_at || record.frame < *options.report_at;
     chain.add(hashes.total);
     result.frames = record.frame;
     result.final_hash = hashes.total;
@@ -173,26 +257,28 @@ Expected<VerifyResult> verify(const ReplayReader& reader, const Progress& progre
       result.first_mismatch = record.frame;
       result.expected = record.hashes;
       result.actual = hashes;
-      return false;
+      if (options.report && !options.report_at)
+        result.report = report.build(record.frame, hashes.total, record.hashes.total);
+      return options.report_at && record.frame < *options.report_at;
     }
     if (next_keyframe < keyframes.size() && keyframes[next_keyframe].frame == record.frame) {
       auto state = reader.keyframe_state(keyframes[next_keyframe]);
       if (!state) {
-        keyframe_error = state.status();
+        stop_error = state.status();
         return false;
       }
       if (XXH3_64bits(state.value().data(), state.value().size()) != record.hashes.total) {
-        keyframe_error = Status::error(reader.path() + ": the keyframe of frame " +
-                                       std::to_string(record.frame) +
-                                       " does not hash to its frame's recorded hash");
+        stop_error = Status::error(reader.path() + ": the keyframe of frame " +
+                                   std::to_string(record.frame) +
+                                   " does not hash to its frame's recorded hash");
         return false;
       }
       ++next_keyframe;
     }
-    return !progress || progress(record.frame, total);
+    return !options.progress || options.progress(record.frame, total);
   });
   if (!read) return read;
-  if (!keyframe_error) return keyframe_error;
+  if (!stop_error) return stop_error;
   if (result.first_mismatch) return result;
   if (result.frames != total) {
     result.note =

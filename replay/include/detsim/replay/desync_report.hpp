@@ -17,7 +17,8 @@
 
 namespace detsim::replay {
 
-inline constexpr std::uint32_t desync_report_version = 1;
+/// The version written; version 1 (without `origin` and `intermediate_states`) is still read.
+inline constexpr std::uint32_t desync_report_version = 2;
 /// The largest report file read_desync_report() reads (two states of ~150,000 bodies and hours
 /// of inputs fit).
 inline constexpr std::size_t max_desync_report_size = std::size_t{256} << 20;
@@ -29,10 +30,25 @@ struct BodyHash {
   friend constexpr bool operator==(const BodyHash&, const BodyHash&) noexcept = default;
 };
 
+/// One machine's state at one frame.
+struct FrameState {
+  std::uint64_t frame = 0;
+  std::vector<std::uint8_t> state;  ///< World::save()
+
+  friend bool operator==(const FrameState&, const FrameState&) = default;
+};
+
+/// Who wrote a report.
+enum class ReportOrigin : std::uint8_t {
+  session = 0,  ///< a peer of a net session that saw a peer's hash differ
+  verify = 1,   ///< `detsim verify --report`: this machine's re-simulation of a replay
+};
+
 struct DesyncReport {
   Fingerprint fingerprint;
-  std::uint32_t reporter = 0;  ///< the player whose machine wrote the report
-  std::uint32_t other = 0;     ///< the player it disagreed with
+  ReportOrigin origin = ReportOrigin::session;
+  std::uint32_t reporter = 0;  ///< the player whose machine wrote the report (0 for verify)
+  std::uint32_t other = 0;     ///< the player it disagreed with (0 for verify)
   std::uint64_t agreed_frame = 0;
   std::uint64_t divergent_frame = 0;
   std::uint64_t local_hash = 0;   ///< this machine's hash of divergent_frame
@@ -44,6 +60,9 @@ struct DesyncReport {
   std::vector<std::uint8_t> divergent_state;  ///< World::save() at divergent_frame
   std::vector<BodyHash> agreed_bodies;        ///< ascending ID
   std::vector<BodyHash> divergent_bodies;
+  /// This machine's states at the frames strictly between agreed_frame and divergent_frame,
+  /// ascending: either every one of them or none (then bisection knows only the two ends).
+  std::vector<FrameState> intermediate_states;
 
   friend bool operator==(const DesyncReport&, const DesyncReport&) = default;
 };

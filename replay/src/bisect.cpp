@@ -1,0 +1,465 @@
+// Desync bisection (bisect.hpp).
+//
+// Each record is loaded as one Side: its fingerprint, every step's inputs, the state hashes of the
+// frames it holds (a replay: every frame; a desync report: the frames whose states it carries) and
+// the states it can give (a report's states, a replay's keyframes). The sides are compared
+// fingerprint first, inputs second, hashes third. This machine then re-simulates from the last
+// state both sides agree on (a keyframe or a report's agreed state), which (1) fills the frames a
+// side has no hash for, on the side it agrees with, and (2) gives that side's state at frames it
+// stored none for. The field-level diff is taken at the first frame from the first divergent one
+// on where both sides' states are known.
+#include <detsim/replay/bisect.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <set>
+
+#include <detsim/fixed/decimal.hpp>
+#include <detsim/replay/desync_report.hpp>
+#include <detsim/replay/replay.hpp>
+#include <detsim/replay/scenario_replay.hpp>
+
+#include "replay_detail.hpp"
+
+namespace detsim::replay {
+namespace {
+
+using State = std::vector<std::uint8_t>;
+
+struct Side {
+  std::string path;
+  std::string kind;
+  std::string label;  ///< "A" or "B"
+  Fingerprint fp;
+  std::uint64_t last = 0;                 ///< state frames 0 .. last
+  std::vector<StateHashes> hashes;        ///< by frame
+  std::vector<std::uint8_t> known;        ///< 1 where hashes[frame] was recorded
+  std::vector<std::uint8_t> inputs;       ///< steps 0 .. last - 1, players * input_size bytes each
+  std::vector<std::uint8_t> gone;         ///< a report's "disconnected" byte per step; else empty
+  std::map<std::uint64_t, State> states;  ///< a report's states by frame
+  std::optional<ReplayReader> replay;     ///< for keyframes
+
+  [[nodiscard]] bool has(std::uint64_t f) const { return f <= last && known[f] != 0; }
+  [[nodiscard]] std::size_t unit() const { return std::size_t{fp.players} * fp.input_size; }
+
+  /// The state this side stored at frame f (a report's, or a replay's keyframe), if any.
+  [[nodiscard]] std::optional<State> stored(std::uint64_t f) const {
+    if (auto it = states.find(f); it != states.end()) return it->second;
+    if (!replay) return std::nullopt;
+    for (const KeyframeInfo& k : replay->keyframes()) {
+      if (k.frame != f) continue;
+      auto s = replay->keyframe_state(k);
+      if (s) return std::move(s).value();
+    }
+    return std::nullopt;
+  }
+  /// Frames with a stored state, ascending.
+  [[nodiscard]] std::vector<std::uint64_t> stored_frames() const {
+    std::vector<std::uint64_t> out;
+    for (const auto& [f, s] : states)
+      out.push_back(f);
+    if (replay)
+      for (const KeyframeInfo& k : replay->keyframes())
+        out.push_back(k.frame);
+    return out;
+  }
+};
+
+std::string hex_bytes(std::span<const std::uint8_t> bytes) {
+  static constexpr char digits[] = "0123456789abcdef";
+  std::string out;
+  for (const std::uint8_t b : bytes) {
+    out += digits[b >> 4];
+    out += digits[b & 15];
+  }
+  return out;
+}
+
+bool is_report(const std::string& path) {
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> in(std::fopen(path.c_str(), "rb"), &std::fclose);
+  char magic[8] = {};
+  return in && std::fread(magic, 1, 8, in.get()) == 8 && std::equal(magic, magic + 8, "DSDESYNC");
+}
+
+Status load_replay(Side& side) {
+  auto reader = ReplayReader::open(side.path);
+  if (!reader) return reader.status();
+  side.kind = "replay";
+  side.fp = reader->fingerprint();
+  side.last = reader->frame_count();
+  side.hashes.assign(side.last + 1, StateHashes{});
+  side.known.assign(side.last + 1, 1);
+  side.hashes[0].total = side.fp.initial_hash;
+  side.inputs.reserve(side.last * side.unit());
+  Status read = reader->for_each_frame(1, side.last, [&](const FrameRecord& r) {
+    side.hashes[r.frame] = r.hashes;
+    side.inputs.insert(side.inputs.end(), r.inputs.begin(), r.inputs.end());
+    return true;
+  });
+  if (!read) return read;
+  side.replay.emplace(std::move(reader.value()));
+  return Status::success();
+}
+
+Status load_report(Side& side) {
+  auto read = read_desync_report(side.path);
+  if (!read) return read.status();
+  DesyncReport& r = read.value();
+  side.kind = "desync report";
+  side.fp = r.fingerprint;
+  side.last = r.divergent_frame;
+  side.hashes.assign(side.last + 1, StateHashes{});
+  side.known.assign(side.last + 1, 0);
+  side.hashes[0].total = side.fp.initial_hash;
+  side.known[0] = 1;
+  const std::size_t unit = side.unit();
+  for (std::size_t at = 0; at < r.confirmed_frames.size(); at += 1 + unit) {
+    side.gone.push_back(r.confirmed_frames[at]);
+    side.inputs.insert(side.inputs.end(),
+                       r.confirmed_frames.begin() + static_cast<std::ptrdiff_t>(at) + 1,
+                       r.confirmed_frames.begin() + static_cast<std::ptrdiff_t>(at + 1 + unit));
+  }
+  if (side.gone.size() < side.last)
+    return Status::error("desync report " + side.path + ": holds the inputs of " +
+                         std::to_string(side.gone.size()) + " steps, not the " +
+                         std::to_string(side.last) + " before its divergent frame");
+  side.states[r.agreed_frame] = std::move(r.agreed_state);
+  for (FrameState& f : r.intermediate_states)
+    side.states[f.frame] = std::move(f.state);
+  side.states[r.divergent_frame] = std::move(r.divergent_state);
+  World world;
+  for (const auto& [frame, state] : side.states) {
+    if (Status s = world.restore(state); !s)
+      return Status::error("desync report " + side.path + ": the state of frame " +
+                           std::to_string(frame) + ": " + s.message());
+    if (world.frame() != frame)
+      return Status::error("desync report " + side.path + ": the state stored for frame " +
+                           std::to_string(frame) + " is of frame " + std::to_string(world.frame()));
+    side.hashes[frame] = world.hashes();
+    side.known[frame] = 1;
+  }
+  return Status::success();
+}
+
+Expected<Side> load(const std::string& path, const char* label) {
+  Side side;
+  side.path = path;
+  side.label = label;
+  const Status s = is_report(path) ? load_report(side) : load_replay(side);
+  if (!s) return Status::error(std::string("side ") + label + ": " + s.message());
+  return side;
+}
+
+std::vector<std::string> fingerprint_differences(const Fingerprint& a, const Fingerprint& b) {
+  std::vector<std::string> out;
+  const auto num = [&](const char* what, std::uint64_t x, std::uint64_t y) {
+    if (x != y)
+      out.push_back(std::string(what) + ": " + std::to_string(x) + " vs " + std::to_string(y));
+  };
+  if (a.scenario != b.scenario) out.push_back("scenario: " + a.scenario + " vs " + b.scenario);
+  num("seed", a.params.seed, b.params.seed);
+  num("players", a.params.players, b.params.players);
+  num("count", a.params.count, b.params.count);
+  num("fixed fraction bits", a.fixed_fraction_bits, b.fixed_fraction_bits);
+  num("state encoding", a.state_version, b.state_version);
+  if (a.dt != b.dt) out.push_back("dt: " + to_string(a.dt) + " vs " + to_string(b.dt));
+  num("substeps", a.substeps, b.substeps);
+  num("iterations", a.iterations, b.iterations);
+  num("inputs per frame", a.players, b.players);
+  num("input size", a.input_size, b.input_size);
+  if (a.initial_hash != b.initial_hash)
+    out.push_back("initial hash: " + detail::hex64(a.initial_hash) + " vs " +
+                  detail::hex64(b.initial_hash));
+  return out;
+}
+
+/// This machine's re-simulation, from a state both sides agree on.
+class Local {
+ public:
+  Local(Scenario scenario, const Side& inputs_from)
+      : scenario_(std::move(scenario)), in_(inputs_from) {}
+
+  std::uint64_t frame() const { return scenario_.world().frame(); }
+  const StateHashes* hashes(std::uint64_t f) const {
+    auto it = hashes_.find(f);
+    return it == hashes_.end() ? nullptr : &it->second;
+  }
+  const State* state(std::uint64_t f) const {
+    auto it = states_.find(f);
+    return it == states_.end() ? nullptr : &it->second;
+  }
+  /// Steps up to frame `to` (no further than the inputs reach), keeping each frame's hashes and
+  /// the states of the frames in `keep`.
+  void step_to(std::uint64_t to, const std::set<std::uint64_t>& keep) {
+    const std::size_t unit = in_.unit();
+    std::vector<PlayerInput> inputs(in_.fp.players);
+    State bytes;
+    while (frame() < to && frame() < in_.last) {
+      const std::size_t at = static_cast<std::size_t>(frame()) * unit;
+      const std::uint8_t gone = in_.gone.empty() ? 0 : in_.gone[static_cast<std::size_t>(frame())];
+      for (std::size_t p = 0; p < inputs.size(); ++p) {
+        inputs[p] = (p < 8 && ((gone >> p) & 1U) != 0)
+                        ? PlayerInput{}
+                        : decode_input(std::span<const std::uint8_t, PlayerInput::encoded_size>(
+                              in_.inputs.data() + at + p * PlayerInput::encoded_size,
+                              PlayerInput::encoded_size));
+      }
+      scenario_.step(inputs);
+      hashes_[frame()] = scenario_.world().save(bytes);
+      if (keep.count(frame()) != 0) states_[frame()] = bytes;
+    }
+  }
+
+ private:
+  Scenario scenario_;
+  const Side& in_;
+  std::map<std::uint64_t, StateHashes> hashes_;
+  std::map<std::uint64_t, State> states_;
+};
+
+std::vector<AgreementSpan> timeline(const Side& a, const Side& b) {
+  std::vector<AgreementSpan> out;
+  const std::uint64_t end = std::max(a.last, b.last);
+  for (std::uint64_t f = 0; f <= end; ++f) {
+    AgreementSpan::State s = AgreementSpan::State::unknown;
+    if (a.has(f) && b.has(f))
+      s = a.hashes[f].total == b.hashes[f].total ? AgreementSpan::State::agree
+                                                 : AgreementSpan::State::differ;
+    if (!out.empty() && out.back().state == s && out.back().last + 1 == f) {
+      out.back().last = f;
+    } else {
+      out.push_back({f, f, s});
+    }
+  }
+  return out;
+}
+
+std::vector<ScenePose> scene_of(const State& state, const std::set<std::uint32_t>& differing) {
+  std::vector<ScenePose> out;
+  World w;
+  if (!w.restore(state)) return out;
+  for (const BodyId id : w.body_ids()) {
+    const BodyState b = w.body(id).value();
+    out.push_back(
+        {id.value, b.type, b.shape, b.position, b.orientation, differing.count(id.value) != 0});
+  }
+  return out;
+}
+
+}  // namespace
+
+Expected<BisectResult> bisect(const std::string& path_a, const std::string& path_b,
+                              const BisectOptions& options) {
+  auto loaded_a = load(path_a, "A");
+  if (!loaded_a) return loaded_a.status();
+  auto loaded_b = load(path_b, "B");
+  if (!loaded_b) return loaded_b.status();
+  const Side& a = loaded_a.value();
+  const Side& b = loaded_b.value();
+
+  BisectResult r;
+  r.a = a.path;
+  r.b = b.path;
+  r.a_kind = a.kind;
+  r.b_kind = b.kind;
+  r.players = a.fp.players;
+  r.input_size = a.fp.input_size;
+  r.frames_a = a.last;
+  r.frames_b = b.last;
+  r.fingerprint_differences = fingerprint_differences(a.fp, b.fp);
+  if (!r.fingerprint_differences.empty()) {
+    r.outcome = BisectOutcome::different_runs;
+    return r;
+  }
+  if (a.fp.detsim_version != b.fp.detsim_version)
+    r.notes.push_back("recorded by detsim " + a.fp.detsim_version + " and " + b.fp.detsim_version);
+
+  // Inputs of the steps both hold.
+  const std::uint64_t common = std::min(a.last, b.last);
+  const std::size_t unit = a.unit();
+  for (std::uint64_t step = 0; step < common; ++step) {
+    const std::size_t at = static_cast<std::size_t>(step) * unit;
+    const bool gone_differs = !a.gone.empty() && !b.gone.empty() && a.gone[step] != b.gone[step];
+    const std::span<const std::uint8_t> step_a(a.inputs.data() + at, unit);
+    const std::span<const std::uint8_t> step_b(b.inputs.data() + at, unit);
+    if (!gone_differs && std::equal(step_a.begin(), step_a.end(), step_b.begin())) continue;
+    r.outcome = BisectOutcome::inputs_differ;
+    r.input_frame = step + 1;
+    for (std::uint32_t p = 0; p < a.fp.players; ++p) {
+      const std::size_t pa = at + std::size_t{p} * a.fp.input_size;
+      const std::span<const std::uint8_t> ia(a.inputs.data() + pa, a.fp.input_size);
+      const std::span<const std::uint8_t> ib(b.inputs.data() + pa, a.fp.input_size);
+      const bool flag = gone_differs && (((a.gone[step] ^ b.gone[step]) >> p) & 1U) != 0;
+      if (!flag && std::equal(ia.begin(), ia.end(), ib.begin())) continue;
+      r.input_player = p;
+      r.input_a = hex_bytes(ia) + (!a.gone.empty() && ((a.gone[step] >> p) & 1U) ? " (gone)" : "");
+      r.input_b = hex_bytes(ib) + (!b.gone.empty() && ((b.gone[step] >> p) & 1U) ? " (gone)" : "");
+      break;
+    }
+    r.timeline = timeline(a, b);
+    return r;
+  }
+
+  // The first frame both hold a hash for and disagree on.
+  std::uint64_t last_agreed = 0;
+  std::optional<std::uint64_t> divergent;
+  for (std::uint64_t f = 1; f <= common; ++f) {
+    if (!a.has(f) || !b.has(f)) continue;
+    if (a.hashes[f].total != b.hashes[f].total) {
+      divergent = f;
+      break;
+    }
+    last_agreed = f;
+  }
+  r.timeline = timeline(a, b);
+  if (!divergent) {
+    r.outcome = BisectOutcome::identical;
+    if (a.last != b.last)
+      r.notes.push_back("A holds frames 0 to " + std::to_string(a.last) + ", B 0 to " +
+                        std::to_string(b.last) + "; they agree on every frame both hold");
+    return r;
+  }
+  r.outcome = BisectOutcome::diverged;
+
+  // This machine's re-simulation from the latest stored state both sides agree on.
+  auto scenario = scenario_of(a.fp, a.path);
+  std::optional<Local> local;
+  std::uint64_t start = 0;
+  if (scenario) {
+    for (const Side* s : {&a, &b})
+      for (const std::uint64_t f : s->stored_frames())
+        if (f <= last_agreed && f > start && a.has(f) && b.has(f)) start = f;
+    if (start > 0) {
+      const Side& from = a.stored(start) ? a : b;
+      if (Status st = scenario.value().world().restore(*from.stored(start)); !st)
+        return Status::error("side " + from.label + ": the state of frame " +
+                             std::to_string(start) + ": " + st.message());
+    }
+    // The inputs are equal where both have them (checked above): the longer record's reach further.
+    local.emplace(std::move(scenario).value(), a.last >= b.last ? a : b);
+  } else {
+    r.notes.push_back("not re-simulated here: " + scenario.message());
+  }
+
+  // Candidate frames for the field-level diff: the divergent frame, then every stored state's.
+  std::set<std::uint64_t> candidates{*divergent};
+  for (const Side* s : {&a, &b})
+    for (const std::uint64_t f : s->stored_frames())
+      if (f > *divergent) candidates.insert(f);
+
+  // Which side this machine agrees with at the first frame both recorded as different.
+  bool local_is_a = false;
+  bool local_is_b = false;
+  if (local) {
+    std::set<std::uint64_t> keep(candidates);
+    for (std::uint64_t f = last_agreed + 1; f < *divergent; ++f)
+      keep.insert(f);
+    local->step_to(*divergent, keep);
+    if (const StateHashes* h = local->hashes(*divergent)) {
+      local_is_a = h->total == a.hashes[*divergent].total;
+      local_is_b = h->total == b.hashes[*divergent].total;
+      r.local_agrees_with = local_is_a ? "A" : local_is_b ? "B" : "neither";
+    }
+    // Frames one side has no hash for: that side's hashes are this machine's if it agrees with it.
+    const auto hash_of = [&](const Side& s, bool is_local, std::uint64_t f) -> const StateHashes* {
+      if (s.has(f)) return &s.hashes[f];
+      return is_local ? local->hashes(f) : nullptr;
+    };
+    for (std::uint64_t f = last_agreed + 1; f < *divergent; ++f) {
+      const StateHashes* ha = hash_of(a, local_is_a, f);
+      const StateHashes* hb = hash_of(b, local_is_b, f);
+      if (ha == nullptr || hb == nullptr) continue;
+      if (ha->total != hb->total) {
+        r.notes.push_back("frames " + std::to_string(last_agreed + 1) + " to " +
+                          std::to_string(*divergent - 1) + " of side " + (local_is_a ? "B" : "A") +
+                          " have no recorded hash; side " + (local_is_a ? "A" : "B") +
+                          "'s were re-simulated here");
+        divergent = f;
+        break;
+      }
+      last_agreed = f;
+    }
+  }
+  r.first_divergent_frame = divergent;
+  r.last_agreed_frame = last_agreed;
+  r.exact = last_agreed + 1 == *divergent;
+  candidates.insert(*divergent);
+  const auto hashes_at = [&](const Side& s, bool is_local, std::uint64_t f) {
+    if (s.has(f)) return s.hashes[f];
+    const StateHashes* h = is_local && local ? local->hashes(f) : nullptr;
+    return h != nullptr ? *h : StateHashes{};
+  };
+  r.hashes_a = hashes_at(a, local_is_a, *divergent);
+  r.hashes_b = hashes_at(b, local_is_b, *divergent);
+  if (r.hashes_a.globals != 0 && r.hashes_b.globals != 0)
+    r.subsystems = differing_subsystems(r.hashes_a, r.hashes_b);
+  for (std::uint64_t f = last_agreed;
+       f < *divergent && r.inputs_between.size() < options.max_input_frames; ++f) {
+    const std::size_t at = static_cast<std::size_t>(f) * unit;
+    r.inputs_between.push_back(
+        {f + 1,
+         std::vector<std::uint8_t>(a.inputs.begin() + static_cast<std::ptrdiff_t>(at),
+                                   a.inputs.begin() + static_cast<std::ptrdiff_t>(at + unit))});
+  }
+
+  // A side's state at frame f: stored, or this machine's when it agrees with that side there.
+  const auto state_of = [&](const Side& s, bool is_local, std::uint64_t f,
+                            std::string& source) -> std::optional<State> {
+    if (auto stored = s.stored(f)) {
+      source = s.kind == "replay" ? "keyframe" : "desync report";
+      return stored;
+    }
+    if (!local || !is_local) return std::nullopt;
+    local->step_to(f, candidates);
+    const State* mine = local->state(f);
+    const StateHashes* h = local->hashes(f);
+    if (mine == nullptr || h == nullptr || (s.has(f) && s.hashes[f].total != h->total))
+      return std::nullopt;
+    source = "re-simulated here";
+    return *mine;
+  };
+  for (const std::uint64_t f : candidates) {
+    if (f < *divergent) continue;
+    std::string source_a;
+    std::string source_b;
+    auto sa = state_of(a, local_is_a, f, source_a);
+    if (!sa) continue;
+    auto sb = state_of(b, local_is_b, f, source_b);
+    if (!sb) continue;
+    auto diff = diff_states(*sa, *sb, options.max_diffs);
+    if (!diff) return diff.status();
+    r.diff_frame = f;
+    r.diff_source_a = source_a;
+    r.diff_source_b = source_b;
+    r.diffs = std::move(diff.value().fields);
+    r.diffs_omitted = diff.value().omitted;
+    std::set<std::uint32_t> bodies;
+    for (const FieldDiff& d : r.diffs)
+      if (d.subsystem == "bodies" || d.subsystem == "contacts") bodies.insert(d.body);
+    r.scene_a = scene_of(*sa, bodies);
+    r.scene_b = scene_of(*sb, bodies);
+    break;
+  }
+  if (r.diff_frame != divergent) {
+    std::string missing;
+    for (const Side* s : {&a, &b}) {
+      std::string ignored;
+      if (state_of(*s, s == &a ? local_is_a : local_is_b, *divergent, ignored)) continue;
+      if (s->kind == "replay") {
+        missing = "on the machine that recorded side " + s->label + ": detsim verify " + s->path +
+                  " --report " + s->path + "." + std::to_string(*divergent) + ".report --at " +
+                  std::to_string(*divergent) + ", then bisect with that report";
+      } else if (missing.empty()) {
+        missing = "on the machine that wrote side " + s->label +
+                  ": detsim verify REPLAY --report OUT --at " + std::to_string(*divergent) +
+                  " with its replay of this match, then bisect with that report";
+      }
+    }
+    r.advice = missing;
+  }
+  return r;
+}
+
+}  // namespace detsim::replay

@@ -1,0 +1,246 @@
+// The scene plot of bisect_html (bisect.hpp): both sides' bodies at the diff frame, top-down.
+//
+// The SVG view box is in world metres, x to the right and z downwards (SVG's own y axis points
+// down), so shapes are drawn at their world coordinates and no scale factor is computed; strokes
+// are non-scaling, so outlines stay one pixel wide whatever the scene's size. Everything is
+// computed in Fixed and printed with dec3: no floating point.
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <detsim/fixed/fixed.hpp>
+#include <detsim/fixed/math.hpp>
+#include <detsim/fixed/quat.hpp>
+#include <detsim/fixed/vec3.hpp>
+#include <detsim/replay/bisect.hpp>
+
+#include "bisect_html_detail.hpp"
+
+namespace detsim::replay::html_detail {
+namespace {
+
+/// `v` rounded to 3 decimals (half away from zero), trailing zeros dropped: the magnitude's
+/// fraction bits times 1000 stay below 2^42, so the rounding is exact integer arithmetic.
+std::string dec3(Fixed v) {
+  const std::int64_t raw = v.raw();
+  const std::uint64_t magnitude =
+      raw < 0 ? 0U - static_cast<std::uint64_t>(raw) : static_cast<std::uint64_t>(raw);
+  std::uint64_t whole = magnitude >> 32;
+  std::uint64_t milli = ((magnitude & 0xFFFFFFFFU) * 1000U + (std::uint64_t{1} << 31)) >> 32;
+  if (milli == 1000) {
+    ++whole;
+    milli = 0;
+  }
+  std::string out = raw < 0 && (whole != 0 || milli != 0) ? "-" : "";
+  out += std::to_string(whole);
+  if (milli != 0) {
+    char digits[5];
+    std::snprintf(digits, sizeof digits, ".%03u", static_cast<unsigned>(milli));
+    std::string_view fraction(digits);
+    while (fraction.back() == '0')
+      fraction.remove_suffix(1);
+    out += fraction;
+  }
+  return out;
+}
+
+struct Point {
+  Fixed x;
+  Fixed z;
+};
+
+/// A body's top-down footprint: a circle (centre a), a capsule (core a..b) or a polygon.
+struct Footprint {
+  ShapeType type = ShapeType::sphere;
+  Point a;
+  Point b;
+  Fixed radius;
+  std::vector<Point> polygon;
+};
+
+Point top_down(Vec3 v) {
+  return {v.x, v.z};
+}
+
+Fixed cross(Point o, Point a, Point b) {
+  return (a.x - o.x) * (b.z - o.z) - (a.z - o.z) * (b.x - o.x);
+}
+
+/// Convex hull by Andrew's monotone chain (counter-clockwise in x/z, collinear points dropped).
+std::vector<Point> convex_hull(std::vector<Point> points) {
+  const auto less = [](Point p, Point q) { return p.x < q.x || (p.x == q.x && p.z < q.z); };
+  std::sort(points.begin(), points.end(), less);
+  const auto same = [](Point p, Point q) { return p.x == q.x && p.z == q.z; };
+  points.erase(std::unique(points.begin(), points.end(), same), points.end());
+  if (points.size() < 3) return points;
+  std::vector<Point> hull(2 * points.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {  // lower chain
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= Fixed{})
+      --k;
+    hull[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {  // upper chain
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], points[i]) <= Fixed{})
+      --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1);  // the last point is the first one again
+  return hull;
+}
+
+Footprint footprint(const ScenePose& body) {
+  Footprint f;
+  f.type = body.shape.type;
+  f.radius = body.shape.radius;
+  f.a = top_down(body.position);
+  if (f.type == ShapeType::box) {
+    const Vec3 h = body.shape.half_extents;
+    std::vector<Point> corners;
+    for (const int i : {0, 1, 2, 3, 4, 5, 6, 7}) {
+      const Vec3 local{(i & 1) != 0 ? h.x : -h.x, (i & 2) != 0 ? h.y : -h.y,
+                       (i & 4) != 0 ? h.z : -h.z};
+      corners.push_back(top_down(body.position + rotate(body.orientation, local)));
+    }
+    f.polygon = convex_hull(std::move(corners));
+  } else if (f.type == ShapeType::capsule) {
+    const Vec3 axis = rotate(body.orientation, Vec3{Fixed{}, body.shape.half_height, Fixed{}});
+    f.a = top_down(body.position - axis);
+    f.b = top_down(body.position + axis);
+    // Seen along its axis, a capsule is a circle (a core shorter than a thousandth of the radius
+    // would only give the path a meaningless direction).
+    const Fixed core = hypot(f.b.x - f.a.x, f.b.z - f.a.z);
+    if (core == Fixed{} || core <= (f.radius >> 10)) {
+      f.type = ShapeType::sphere;
+      f.a = top_down(body.position);
+    }
+  }
+  return f;
+}
+
+struct Bounds {
+  Fixed min_x = Fixed::max(), min_z = Fixed::max(), max_x = Fixed::min(), max_z = Fixed::min();
+  void add(Point p, Fixed r) {
+    min_x = min(min_x, p.x - r);
+    min_z = min(min_z, p.z - r);
+    max_x = max(max_x, p.x + r);
+    max_z = max(max_z, p.z + r);
+  }
+  [[nodiscard]] bool empty() const { return min_x > max_x; }
+};
+
+void add_bounds(Bounds& b, const Footprint& f) {
+  for (const Point p : f.polygon)
+    b.add(p, Fixed{});
+  if (f.type != ShapeType::box) b.add(f.a, f.radius);
+  if (f.type == ShapeType::capsule) b.add(f.b, f.radius);
+}
+
+std::string point(Point p) {
+  return dec3(p.x) + "," + dec3(p.z);
+}
+
+/// One body's element: a few dozen bytes of markup, since scenes can hold thousands of bodies.
+std::string body_svg(const ScenePose& body, const Footprint& f) {
+  const char* type = body.type == BodyType::static_body ? "s"
+                     : body.type == BodyType::kinematic ? "k"
+                                                        : "d";
+  const std::string cls = std::string("class=\"") + type + (body.differs ? " x\"" : "\"");
+  const std::string title = "<title>body " + std::to_string(body.id) + " (" +
+                            dec3(body.position.x) + ", " + dec3(body.position.z) + ")</title>";
+  switch (f.type) {
+    case ShapeType::box: {
+      std::string points;
+      for (const Point p : f.polygon)
+        points.append(points.empty() ? "" : " ").append(point(p));
+      return "<polygon " + cls + " points=\"" + points + "\">" + title + "</polygon>";
+    }
+    case ShapeType::capsule: {
+      // The core segment offset by +-radius along its normal, joined by two half circles.
+      const Fixed dx = f.b.x - f.a.x, dz = f.b.z - f.a.z, length = hypot(dx, dz);
+      const Point n{-(dz / length) * f.radius, (dx / length) * f.radius};
+      const std::string arc = " A" + dec3(f.radius) + " " + dec3(f.radius) + " 0 0 0 ";
+      return "<path " + cls + " d=\"M" + point({f.a.x + n.x, f.a.z + n.z}) + " L" +
+             point({f.b.x + n.x, f.b.z + n.z}) + arc + point({f.b.x - n.x, f.b.z - n.z}) + " L" +
+             point({f.a.x - n.x, f.a.z - n.z}) + arc + point({f.a.x + n.x, f.a.z + n.z}) + "Z\">" +
+             title + "</path>";
+    }
+    default:
+      return "<circle " + cls + " cx=\"" + dec3(f.a.x) + "\" cy=\"" + dec3(f.a.z) + "\" r=\"" +
+             dec3(f.radius) + "\">" + title + "</circle>";
+  }
+}
+
+void scene_panel(std::string& out, const std::string& caption, const std::vector<ScenePose>& scene,
+                 const std::vector<Footprint>& prints, const Bounds& view, Fixed font) {
+  const Fixed width = view.max_x - view.min_x, height = view.max_z - view.min_z;
+  out += "<figure><figcaption>" + caption + "</figcaption><svg class=\"scene\" viewBox=\"" +
+         dec3(view.min_x) + " " + dec3(view.min_z) + " " + dec3(width) + " " + dec3(height) +
+         "\" font-size=\"" + dec3(font) + "\"><path class=\"axis\" d=\"M" + dec3(view.min_x) +
+         " 0H" + dec3(view.max_x) + "M0 " + dec3(view.min_z) + "V" + dec3(view.max_z) + "\"/>";
+  std::size_t planes = 0;
+  std::string labels;
+  for (const bool highlighted : {false, true}) {  // differing bodies on top
+    for (std::size_t i = 0; i < scene.size(); ++i) {
+      if (scene[i].differs != highlighted) continue;
+      if (scene[i].shape.type == ShapeType::plane) {
+        ++planes;
+        continue;
+      }
+      out += body_svg(scene[i], prints[i]);
+      if (!highlighted) continue;
+      Bounds b;
+      add_bounds(b, prints[i]);
+      labels += "<text class=\"lbl\" x=\"" + dec3(b.max_x) + "\" y=\"" + dec3(b.min_z) + "\">" +
+                std::to_string(scene[i].id) + "</text>";
+    }
+  }
+  out += "<g class=\"lbl\" stroke-width=\"" + dec3(font >> 3) + "\">" + labels + "</g></svg>";
+  if (scene.empty()) out += "<p class=\"note\">No bodies.</p>";
+  if (planes != 0)
+    out += "<p class=\"note\">" + std::to_string(planes) + " plane(s) not drawn.</p>";
+  out += "</figure>";
+}
+
+}  // namespace
+
+void scene_section(std::string& out, const BisectResult& r) {
+  if (r.scene_a.empty() && r.scene_b.empty()) return;
+  std::vector<Footprint> prints_a, prints_b;
+  Bounds view;
+  for (const auto& [scene, prints] : {std::pair{&r.scene_a, &prints_a}, {&r.scene_b, &prints_b}}) {
+    for (const ScenePose& body : *scene) {
+      prints->push_back(footprint(body));
+      if (body.shape.type != ShapeType::plane) add_bounds(view, prints->back());
+    }
+  }
+  if (view.empty()) view.add({}, Fixed::from_int(10));
+  // One view for both panels: a 5% margin, at least 0.1 m, and an aspect between 1:1 and 16:9.
+  const Fixed tenth = Fixed::from_raw(Fixed::one_raw / 10);
+  Fixed width = max(view.max_x - view.min_x, tenth), height = max(view.max_z - view.min_z, tenth);
+  const Fixed margin = max(width, height) / Fixed::from_int(20);
+  width = max(width + 2 * margin, height * Fixed::from_int(9) / Fixed::from_int(16));
+  height = max(height + 2 * margin, width * Fixed::from_int(9) / Fixed::from_int(16));
+  width = max(width, height);
+  const Point centre{(view.min_x >> 1) + (view.max_x >> 1), (view.min_z >> 1) + (view.max_z >> 1)};
+  view.min_x = centre.x - (width >> 1);
+  view.max_x = view.min_x + width;
+  view.min_z = centre.z - (height >> 1);
+  view.max_z = view.min_z + height;
+  const Fixed font = width / Fixed::from_int(45);
+  const std::string frame = r.diff_frame ? std::to_string(*r.diff_frame) : "?";
+  out += "<h2>Scene at frame " + frame + " (top-down: x right, z down)</h2><div class=\"scenes\">";
+  const auto caption = [](const char* side, const std::string& file, const std::string& source) {
+    return side + escape(file) + (source.empty() ? "" : " (" + escape(source) + ")");
+  };
+  scene_panel(out, caption("A: ", r.a, r.diff_source_a), r.scene_a, prints_a, view, font);
+  scene_panel(out, caption("B: ", r.b, r.diff_source_b), r.scene_b, prints_b, view, font);
+  out += "</div>";
+}
+
+}  // namespace detsim::replay::html_detail
