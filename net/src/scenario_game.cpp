@@ -28,8 +28,44 @@ void ScenarioGame::advance(const FrameInputs& inputs, bool resimulating) {
       inputs_[p] = decode_input(inputs.input(p).first<PlayerInput::encoded_size>());
     }
   }
-  scenario_->step(inputs_);
+  step_and_hook();
   ++(resimulating ? resimulated_ : simulated_);
+}
+
+void ScenarioGame::step_and_hook() {
+  scenario_->step(inputs_);
+  if (after_step_) {
+    Status s = after_step_(*scenario_);
+    if (!s && after_step_status_.ok()) after_step_status_ = std::move(s);
+  }
+}
+
+Expected<std::vector<std::vector<std::uint8_t>>> ScenarioGame::resimulate(
+    std::span<const std::uint8_t> state, std::span<const std::uint8_t> frames) {
+  World& world = scenario_->world();
+  const std::size_t players = scenario_->params().players;
+  const std::size_t unit = 1 + players * input_size;
+  if (frames.size() % unit != 0)
+    return Status::error("re-simulation: confirmed frames are not whole frames of " +
+                         std::to_string(unit) + " bytes");
+  const World kept = world;
+  if (Status s = world.restore(state); !s) return Status::error("re-simulation: " + s.message());
+  std::vector<std::vector<std::uint8_t>> out;
+  out.reserve(frames.size() / unit);
+  for (std::size_t at = 0; at < frames.size(); at += unit) {
+    const std::uint8_t disconnected = frames[at];
+    inputs_.assign(players, PlayerInput{});
+    for (std::size_t p = 0; p < players; ++p) {
+      if (p < 8 && ((disconnected >> p) & 1U) != 0) continue;
+      inputs_[p] =
+          decode_input(frames.subspan(at + 1 + p * input_size).first<PlayerInput::encoded_size>());
+    }
+    step_and_hook();
+    out.emplace_back();
+    world.save(out.back());
+  }
+  world = kept;
+  return out;
 }
 
 std::optional<StateHashes> ScenarioGame::hashes_at(std::uint64_t frame) const noexcept {

@@ -111,4 +111,25 @@ Expected<replay::DesyncReport> desync_report(const replay::Fingerprint& fingerpr
   return r;
 }
 
+Expected<replay::DesyncReport> desync_report(const replay::Fingerprint& fingerprint,
+                                             std::uint32_t reporter, const DesyncEvidence& evidence,
+                                             ScenarioGame& game) {
+  auto report = desync_report(fingerprint, reporter, evidence);
+  if (!report) return report;
+  replay::DesyncReport& r = report.value();
+  const std::size_t unit = 1 + std::size_t{fingerprint.players} * fingerprint.input_size;
+  if (r.confirmed_frames.size() / unit < r.divergent_frame) return report;  // log cut short
+  const std::span<const std::uint8_t> steps =
+      std::span<const std::uint8_t>(r.confirmed_frames)
+          .subspan(static_cast<std::size_t>(r.agreed_frame) * unit,
+                   static_cast<std::size_t>(r.divergent_frame - r.agreed_frame) * unit);
+  auto states = game.resimulate(r.agreed_state, steps);
+  if (!states) return Status::error("desync report: " + states.message());
+  std::vector<std::vector<std::uint8_t>>& s = states.value();
+  if (s.empty() || s.back() != r.divergent_state) return report;  // not repeatable here
+  for (std::size_t i = 0; i + 1 < s.size(); ++i)
+    r.intermediate_states.push_back({r.agreed_frame + 1 + i, std::move(s[i])});
+  return report;
+}
+
 }  // namespace detsim::net

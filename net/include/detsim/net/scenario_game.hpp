@@ -9,12 +9,14 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <vector>
 
 #include <detsim/net/game.hpp>
 #include <detsim/sim/scenario.hpp>
+#include <detsim/sim/status.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace detsim::net {
@@ -35,6 +37,19 @@ class ScenarioGame final : public Game {
   void load(std::span<const std::uint8_t> state) override;
   /// Steps the scenario with every player's decoded input; a disconnected player's is neutral.
   void advance(const FrameInputs& inputs, bool resimulating) override;
+
+  /// A debug hook run after each step, before the state is saved or hashed: a fault injection
+  /// (<detsim/sim/inject.hpp>) that makes this machine's game differ, for tests and demos. It runs
+  /// on every simulation of a frame, re-simulations included. Its first error is kept.
+  void set_after_step(std::function<Status(Scenario&)> hook) { after_step_ = std::move(hook); }
+  /// The after-step hook's first error (success when none).
+  [[nodiscard]] const Status& after_step_status() const noexcept { return after_step_status_; }
+
+  /// Re-simulates from `state` (a state save() wrote) through `frames` (confirmed frames as in
+  /// DesyncEvidence::confirmed_frames, one step each, the after-step hook included) and returns
+  /// the state after each step. The game's current state is kept (restored afterwards).
+  Expected<std::vector<std::vector<std::uint8_t>>> resimulate(std::span<const std::uint8_t> state,
+                                                              std::span<const std::uint8_t> frames);
 
   [[nodiscard]] Scenario& scenario() noexcept { return *scenario_; }
   [[nodiscard]] std::uint64_t failed_loads() const noexcept { return failed_loads_; }
@@ -60,7 +75,11 @@ class ScenarioGame final : public Game {
     std::vector<std::uint8_t> state;
   };
 
+  void step_and_hook();
+
   Scenario* scenario_;
+  std::function<Status(Scenario&)> after_step_;
+  Status after_step_status_;
   std::vector<PlayerInput> inputs_;
   std::array<Remembered, remembered_hashes> remembered_{};
   std::array<Keyframe, 2> keyframes_{};

@@ -60,4 +60,14 @@ Expected<replay::DesyncReport> desync_report(const replay::Fingerprint& fingerpr
                                              std::uint32_t reporter,
                                              const DesyncEvidence& evidence);
 
+/// The same, with this machine's state at every frame between the agreed and the divergent one
+/// (DesyncReport::intermediate_states), so that bisection can name the exact first divergent frame
+/// and its fields whatever the check interval: `game` (this machine's, its after-step hook
+/// included) re-simulates them from the agreed state and is left as it was. When the
+/// re-simulation does not reproduce the divergent frame's hash (the machine is not repeatable),
+/// the report has no intermediate states.
+Expected<replay::DesyncReport> desync_report(const replay::Fingerprint& fingerprint,
+                                             std::uint32_t reporter, const DesyncEvidence& evidence,
+                                             ScenarioGame& game);
+
 }  // namespace detsim::net
