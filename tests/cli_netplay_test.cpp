@@ -208,6 +208,43 @@ TEST(CliNetplay, TwoProcessesPlayTheSameMatchAndRecordTheSameReplay) {
   EXPECT_EQ(json_value(verify.out, "final_hash"), json_value(out_a, "final_hash"));
 }
 
+TEST(CliNetplay, AnInjectedPeerDesyncsAndBisectNamesTheFrameBodyAndField) {
+  // Player 1's machine changes body 7's position at frame 400: both peers see the desync at the
+  // next check and write their sides; bisect of the two reports names exactly that change.
+  TempFile report_a("inject_a.dsd");
+  TempFile report_b("inject_b.dsd");
+  const std::vector<std::string> common = {"--frames", "1200", "--fps", "1000", "--json"};
+  std::vector<std::string> a = {"--bot", "11", "--desync-report", report_a.path()};
+  std::vector<std::string> b = {"--bot",         "12",       "--desync-report",
+                                report_b.path(), "--inject", "400:7:position.y:0.001"};
+  a.insert(a.end(), common.begin(), common.end());
+  b.insert(b.end(), common.begin(), common.end());
+  const Pair pair = run_pair(a, b, std::chrono::seconds(120));
+  ASSERT_FALSE(pair.timed_out) << "killed after 120 s\nA: " << pair.a->err()
+                               << "\nB: " << pair.b->err();
+  EXPECT_EQ(pair.a->exit_code(), 1) << pair.a->out() << pair.a->err();
+  EXPECT_EQ(pair.b->exit_code(), 1) << pair.b->out() << pair.b->err();
+  EXPECT_EQ(json_value(pair.a->out(), "desyncs"), "1") << pair.a->out();
+  const test::CliResult r =
+      detsim_cli("bisect " + report_a.path() + " " + report_b.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  expect_one_json_object(r.out);
+  EXPECT_EQ(json_value(r.out, "outcome"), "diverged") << r.out;
+  EXPECT_EQ(json_value(r.out, "first_divergent_frame"), "400") << r.out;
+  EXPECT_EQ(json_value(r.out, "last_agreed_frame"), "399") << r.out;
+  EXPECT_EQ(json_value(r.out, "exact"), "true") << r.out;
+  EXPECT_EQ(json_value(r.out, "diff_frame"), "400") << r.out;
+  EXPECT_TRUE(has(r.out, R"("diffs":[{"subsystem":"bodies","body":7,"field":"position.y",)"))
+      << r.out;
+  EXPECT_TRUE(has(r.out, R"("diffs_omitted":0)")) << r.out;
+  // Exactly one difference: the injected field.
+  std::size_t fields = 0;
+  for (std::size_t at = r.out.find("\"subsystem\":"); at != std::string::npos;
+       at = r.out.find("\"subsystem\":", at + 1))
+    ++fields;
+  EXPECT_EQ(fields, 1U) << r.out;
+}
+
 TEST(CliNetplay, ASpectatorReachesThePlayersHashAndRecordsTheSameReplay) {
   TempFile replay_a("netplay_a.dsr");
   TempFile replay_b("netplay_b.dsr");

@@ -8,6 +8,7 @@
 #include <detsim/sim/state_diff.hpp>
 
 #include "commands.hpp"
+#include "diff_output.hpp"
 #include "output.hpp"
 
 namespace detsim::cli {
@@ -34,6 +35,24 @@ Expected<std::vector<std::uint8_t>> read_state(const std::string& path) {
 
 }  // namespace
 
+std::string field_json(const FieldDiff& f) {
+  return Json()
+      .str("subsystem", f.subsystem)
+      .num("body", f.body)
+      .str("field", f.field)
+      .str("a", f.a)
+      .str("b", f.b)
+      .text();
+}
+
+void print_field(const FieldDiff& f) {
+  const std::string where = f.subsystem == "bodies" || f.subsystem == "contacts"
+                                ? "body " + std::to_string(f.body)
+                                : f.subsystem;
+  std::printf("  %-12s %-22s A %s\n  %-12s %-22s B %s\n", where.c_str(), f.field.c_str(),
+              f.a.c_str(), "", "", f.b.c_str());
+}
+
 int diff_command(const DiffArgs& args) {
   auto a = read_state(args.a);
   if (!a) return usage_error("diff", a.message());
@@ -50,15 +69,8 @@ int diff_command(const DiffArgs& args) {
   const StateDiff& d = diff.value();
   if (args.json) {
     std::vector<std::string> fields;
-    for (const FieldDiff& f : d.fields) {
-      fields.push_back(Json()
-                           .str("subsystem", f.subsystem)
-                           .num("body", f.body)
-                           .str("field", f.field)
-                           .str("a", f.a)
-                           .str("b", f.b)
-                           .text());
-    }
+    for (const FieldDiff& f : d.fields)
+      fields.push_back(field_json(f));
     Json()
         .boolean("equal", d.equal())
         .num("frame_a", d.frame_a)
@@ -78,12 +90,8 @@ int diff_command(const DiffArgs& args) {
   std::printf("DIFFERENT: A frame %llu hash %s, B frame %llu hash %s\n",
               static_cast<unsigned long long>(d.frame_a), hex(d.a.total).c_str(),
               static_cast<unsigned long long>(d.frame_b), hex(d.b.total).c_str());
-  for (const FieldDiff& f : d.fields) {
-    const std::string where =
-        f.subsystem == "bodies" ? "body " + std::to_string(f.body) : f.subsystem;
-    std::printf("  %-12s %-22s A %s\n  %-12s %-22s B %s\n", where.c_str(), f.field.c_str(),
-                f.a.c_str(), "", "", f.b.c_str());
-  }
+  for (const FieldDiff& f : d.fields)
+    print_field(f);
   if (d.omitted != 0) std::printf("  ... and %zu more differences (--max shows more)\n", d.omitted);
   return exit_check_failed;
 }

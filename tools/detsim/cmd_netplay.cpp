@@ -116,6 +116,13 @@ Status Netplay::start() {
   if (!scenario) return scenario.status();
   scenario_.emplace(std::move(scenario.value()));
   game_.emplace(*scenario_);
+  auto injections = parse_injections(args_.injections);
+  if (!injections) return injections.status();
+  if (!injections->empty()) {
+    game_->set_after_step([list = std::move(injections).value()](Scenario& s) {
+      return apply_injections(s.world(), list);
+    });
+  }
   // A desync report names the run by the fingerprint of the scenario at frame 0.
   if (!args_.desync_report.empty()) initial_fingerprint_ = replay::fingerprint_of(*scenario_);
   auto transport = net::UdpTransport::open(plan_.bind, plan_.peers);
@@ -220,7 +227,8 @@ void Netplay::write_desync_report() {
   const net::DesyncEvidence* evidence = session_->desync_evidence();
   Status written = Status::error("the session kept no evidence of the desync");
   if (evidence) {
-    auto report = net::desync_report(*initial_fingerprint_, args_.me, *evidence);
+    // With the states of every frame between the agreed and the divergent one, re-simulated.
+    auto report = net::desync_report(*initial_fingerprint_, args_.me, *evidence, *game_);
     written =
         report ? replay::write_desync_report(args_.desync_report, report.value()) : report.status();
   }

@@ -39,6 +39,16 @@ Expected<ChosenScenario> choose_scenario(const ScenarioArgs& args) {
   return ChosenScenario{std::move(scenario.value()), frames};
 }
 
+Expected<std::vector<Injection>> parse_injections(const std::vector<std::string>& specs) {
+  std::vector<Injection> out;
+  for (const std::string& spec : specs) {
+    auto parsed = parse_injection(spec);
+    if (!parsed) return parsed.status();
+    out.push_back(std::move(parsed).value());
+  }
+  return out;
+}
+
 std::string describe(const Scenario& scenario) {
   const ScenarioParams& p = scenario.params();
   std::string out = std::string(scenario.info().name) + " (seed " + std::to_string(p.seed);
@@ -134,6 +144,12 @@ int run_command(const RunArgs& args) {
   if (!chosen) return usage_error("run", chosen.message());
   Scenario& scenario = chosen.value().scenario;
   const std::uint64_t frames = chosen.value().frames;
+  auto injections = parse_injections(args.injections);
+  if (!injections) return usage_error("run", injections.message());
+  for (const Injection& i : injections.value())
+    if (i.frame > frames)
+      return usage_error("run", "--inject " + i.text() + ": frame " + std::to_string(i.frame) +
+                                    " is beyond the run's " + std::to_string(frames) + " frames");
   Progress progress("run " + args.scene.scenario);
   replay::RecordOptions options;
   options.frames = static_cast<std::uint32_t>(frames);
@@ -142,6 +158,11 @@ int run_command(const RunArgs& args) {
     progress.update(done, total);
     return true;
   };
+  if (!injections->empty()) {
+    options.after_step = [&injections](Scenario& s) {
+      return apply_injections(s.world(), injections.value());
+    };
+  }
   const auto start = std::chrono::steady_clock::now();
   auto result = replay::record(scenario, args.record, options);
   const double seconds = seconds_since(start);

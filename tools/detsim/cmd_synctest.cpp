@@ -70,18 +70,9 @@ SyncResult run_synctest(Scenario& s, std::uint64_t frames, std::uint32_t distanc
 std::string differing_parts(const net::SyncTestMismatch& m) {
   auto diff = diff_states(m.expected_state, m.actual_state, 0);  // the hashes, no field list
   if (!diff) return "unknown";
-  const StateHashes& a = diff.value().a;
-  const StateHashes& b = diff.value().b;
   std::string parts;
-  const auto add = [&](const char* name, bool differs) {
-    if (!differs) return;
-    if (!parts.empty()) parts += ", ";
-    parts += name;
-  };
-  add("globals", a.globals != b.globals);
-  add("rng", a.rng != b.rng);
-  add("bodies", a.bodies != b.bodies);
-  add("contacts", a.contacts != b.contacts);
+  for (const std::string& part : differing_subsystems(diff.value().a, diff.value().b))
+    parts += (parts.empty() ? "" : ", ") + part;
   return parts.empty() ? "none" : parts;
 }
 

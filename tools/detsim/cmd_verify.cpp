@@ -6,9 +6,11 @@
 
 #include <detsim/fixed/decimal.hpp>
 #include <detsim/replay.hpp>
+#include <detsim/sim/state_diff.hpp>
 
 #include "commands.hpp"
 #include "output.hpp"
+#include "scenario_args.hpp"
 
 namespace detsim::cli {
 
@@ -24,16 +26,6 @@ std::string hashes_json(const StateHashes& h) {
       .text();
 }
 
-/// The parts whose hashes differ: "globals", "rng", "bodies", "contacts".
-std::vector<std::string> differing_parts(const StateHashes& a, const StateHashes& b) {
-  std::vector<std::string> out;
-  if (a.globals != b.globals) out.emplace_back("globals");
-  if (a.rng != b.rng) out.emplace_back("rng");
-  if (a.bodies != b.bodies) out.emplace_back("bodies");
-  if (a.contacts != b.contacts) out.emplace_back("contacts");
-  return out;
-}
-
 std::string describe(const replay::Fingerprint& f) {
   std::string out = f.scenario + " (seed " + std::to_string(f.params.seed);
   if (f.params.players != 0) out += ", " + std::to_string(f.params.players) + " players";
@@ -44,23 +36,50 @@ std::string describe(const replay::Fingerprint& f) {
 }  // namespace
 
 int verify_command(const VerifyArgs& args) {
+  if (args.at != 0 && args.report.empty())
+    return usage_error("verify",
+                       "--at needs --report FILE (where to write the state of that frame)");
+  auto injections = parse_injections(args.injections);
+  if (!injections) return usage_error("verify", injections.message());
   auto reader = replay::ReplayReader::open(args.file);
   if (!reader) return usage_error("verify", reader.message());
   const replay::Fingerprint& fp = reader->fingerprint();
+  if (args.at > reader->frame_count())
+    return usage_error("verify", "--at " + std::to_string(args.at) + ": " + args.file +
+                                     " holds frames 1 to " + std::to_string(reader->frame_count()));
   Progress progress("verify");
+  replay::VerifyOptions options;
+  options.progress = [&progress](std::uint64_t done, std::uint64_t total) {
+    progress.update(done, total);
+    return true;
+  };
+  if (!injections->empty()) {
+    options.after_step = [&injections](Scenario& s) {
+      return apply_injections(s.world(), injections.value());
+    };
+  }
+  options.report = !args.report.empty();
+  if (args.at != 0) options.report_at = args.at;
   const auto start = std::chrono::steady_clock::now();
-  auto result =
-      replay::verify(reader.value(), [&progress](std::uint64_t done, std::uint64_t total) {
-        progress.update(done, total);
-        return true;
-      });
+  auto result = replay::verify(reader.value(), options);
   const double seconds = seconds_since(start);
   progress.done();
   if (!result) return usage_error("verify", result.message());
   const replay::VerifyResult& v = result.value();
+  std::string report_line;
+  if (v.report) {
+    if (Status s = replay::write_desync_report(args.report, *v.report); !s)
+      return usage_error("verify", s.message());
+    report_line = "this machine's state at frame " + std::to_string(v.report->divergent_frame) +
+                  " written to " + args.report;
+  } else if (!args.report.empty()) {
+    report_line =
+        "no mismatch, so no report written (--at FRAME writes this machine's state at "
+        "a frame whatever verification finds)";
+  }
   const double fps = seconds > 0 ? static_cast<double>(v.frames) / seconds : 0.0;
   const double realtime = fps * fp.dt.to_double();
-  const std::vector<std::string> parts = differing_parts(v.expected, v.actual);
+  const std::vector<std::string> parts = differing_subsystems(v.expected, v.actual);
   if (args.json) {
     std::vector<std::string> quoted;
     for (const std::string& p : parts)
@@ -83,6 +102,11 @@ int verify_command(const VerifyArgs& args) {
       j.null("note");
     } else {
       j.str("note", v.note);
+    }
+    if (v.report) {
+      j.str("report", args.report).num("report_frame", v.report->divergent_frame);
+    } else {
+      j.null("report").null("report_frame");
     }
     j.real("seconds", seconds).real("frames_per_second", fps).real("realtime_factor", realtime);
     j.print();
@@ -109,6 +133,7 @@ int verify_command(const VerifyArgs& args) {
                 static_cast<unsigned long long>(v.frames));
   }
   if (!v.note.empty()) std::printf("  note: %s\n", v.note.c_str());
+  if (!report_line.empty()) std::printf("  %s\n", report_line.c_str());
   return v.ok ? exit_ok : exit_check_failed;
 }
 

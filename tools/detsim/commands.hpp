@@ -24,7 +24,8 @@ int scenarios_command(const ScenariosArgs& args);
 
 struct RunArgs {
   ScenarioArgs scene;
-  std::string record;  ///< replay file to write, or empty
+  std::vector<std::string> injections;  ///< --inject FRAME:BODY:FIELD:DELTA, each
+  std::string record;                   ///< replay file to write, or empty
   std::uint32_t keyframe_interval = 300;
   bool json = false;
 };
@@ -32,9 +33,21 @@ int run_command(const RunArgs& args);
 
 struct VerifyArgs {
   std::string file;
+  std::vector<std::string> injections;  ///< --inject FRAME:BODY:FIELD:DELTA, each
+  std::string report;                   ///< desync report to write, or empty
+  std::uint64_t at = 0;                 ///< --at FRAME: report this frame; 0: the first mismatch
   bool json = false;
 };
 int verify_command(const VerifyArgs& args);
+
+struct BisectArgs {
+  std::string a;  ///< a replay or a desync report
+  std::string b;
+  std::string html;  ///< write the HTML report here, or empty
+  std::size_t max_fields = 100;
+  bool json = false;
+};
+int bisect_command(const BisectArgs& args);
 
 struct DiffArgs {
   std::string a;  ///< a saved state (World::save() bytes)
@@ -93,8 +106,9 @@ struct NetplayArgs {
   std::uint64_t bot_seed = 0;
   std::uint32_t fps = 60;  ///< 0: as fast as possible
   double timeout_seconds = 10;
-  std::string record;         ///< replay file, or empty
-  std::string desync_report;  ///< on a desync, write this machine's side here; or empty
+  std::string record;                   ///< replay file, or empty
+  std::string desync_report;            ///< on a desync, write this machine's side here; or empty
+  std::vector<std::string> injections;  ///< --inject FRAME:BODY:FIELD:DELTA, each
   bool json = false;
 };
 int netplay_command(const NetplayArgs& args);

@@ -184,6 +184,18 @@ constexpr const char* exit_footer =
     "\nExit status: 0 success; 1 a check failed (hash mismatch, desync); 2 bad usage or bad input\n"
     "(the message on stderr names what is wrong). --json prints exactly one JSON object on stdout.";
 
+void add_inject_option(CLI::App* cmd, std::vector<std::string>& specs) {
+  cmd->add_option("--inject", specs,
+                  "Debug aid: change one field of this machine's state at one frame (repeatable; "
+                  "see below)")
+      ->type_name("FRAME:BODY:FIELD:DELTA");
+}
+
+const std::string inject_footer = std::string(R"(
+--inject FRAME:BODY:FIELD:DELTA changes the state of frame FRAME (after its step, before its hash)
+on this machine only, as non-determinism would: e.g. 500:17:position.y:0.001. FIELD is one of: )") +
+                                  std::string(detsim::injection_fields_help()) + ".\n";
+
 void add_scenario_options(CLI::App* cmd, detsim::cli::ScenarioArgs& a) {
   cmd->add_option("--scenario", a.scenario, "Scenario name (detsim scenarios lists them)")
       ->required()
@@ -282,6 +294,7 @@ void add_netplay(CLI::App& app, int& exit_code) {
                 "Record the confirmed frames to a replay file (the same bytes on every peer and "
                 "spectator)")
       ->type_name("FILE");
+  add_inject_option(c, netplay.injections);
   c->add_option("--desync-report", netplay.desync_report,
                 "On a desync, write this machine's side to FILE: the inputs up to the divergent "
                 "frame, the states at the last agreed and the divergent frame, per-body hashes "
@@ -290,7 +303,7 @@ void add_netplay(CLI::App& app, int& exit_code) {
   c->add_flag("--json", netplay.json,
               "Print one JSON object: frames, final_hash (16 hex digits), rollbacks, "
               "resimulated_frames, desyncs, peers, spectator, ...");
-  c->footer(netplay_footer);
+  c->footer(std::string(netplay_footer) + inject_footer);
   c->callback([&exit_code, bot, me] {
     netplay.bot = bot->count() > 0;
     netplay.me_given = me->count() > 0;
@@ -305,6 +318,7 @@ void add_scenario_commands(CLI::App& app, int& exit_code) {
   static cli::VerifyArgs verify;
   static cli::InfoArgs info;
   static cli::DiffArgs diff;
+  static cli::BisectArgs bisect;
   static cli::SynctestArgs synctest;
   static cli::GoldenArgs golden_check;
   static cli::GoldenArgs golden_update;
@@ -323,23 +337,37 @@ void add_scenario_commands(CLI::App& app, int& exit_code) {
                 "Frames between the replay's keyframes, for seeking (default 300)")
       ->type_name("K")
       ->check(CLI::Range(1U, 1'000'000U));
+  add_inject_option(c, run.injections);
   c->add_flag("--json", run.json,
               "Print one JSON object: scenario, frames, final_hash (16 hex digits), ...");
   c->footer(std::string(R"(
 Players are driven by a deterministic script (a function of the seed, the frame and the player), so
-the same arguments give the same final hash on every machine.)") +
+the same arguments give the same final hash on every machine.
+)") + inject_footer +
             exit_footer);
   c->callback([&exit_code] { exit_code = cli::run_command(run); });
 
   c = app.add_subcommand(
       "verify", "Re-simulate a replay and compare every frame's hash with the recorded one");
   c->add_option("FILE", verify.file, "Replay file")->required();
+  c->add_option("--report", verify.report,
+                "On a mismatch, write this machine's side as a desync report to FILE: its states "
+                "at the first mismatching frame and the one before, the inputs so far (for "
+                "detsim bisect)")
+      ->type_name("FILE");
+  c->add_option("--at", verify.at,
+                "With --report: write this machine's state at FRAME instead, whether or not "
+                "verification passes (the command bisect asks the other machine to run)")
+      ->type_name("FRAME")
+      ->check(CLI::Range(std::uint64_t{1}, detsim::cli::max_frames));
+  add_inject_option(c, verify.injections);
   c->add_flag("--json", verify.json,
-              "Print one JSON object: ok, frames, first_mismatch (null or a frame), ...");
+              "Print one JSON object: ok, frames, first_mismatch (null or a frame), report, ...");
   c->footer(std::string(R"(
 Prints the first frame whose hash differs, both hashes, which parts of the state differ (globals,
 rng, bodies, contacts) and the last frame both agreed on; also the speed in frames/s. A replay
-without its end marker (a recording that stopped early) verifies up to its last complete chunk.)") +
+without its end marker (a recording that stopped early) verifies up to its last complete chunk.
+)") + inject_footer +
             exit_footer);
   c->callback([&exit_code] { exit_code = cli::verify_command(verify); });
 
@@ -348,6 +376,34 @@ without its end marker (a recording that stopped early) verifies up to its last 
   c->add_flag("--json", info.json, "Print one JSON object");
   c->footer(exit_footer);
   c->callback([&exit_code] { exit_code = cli::info_command(info); });
+
+  c = app.add_subcommand("bisect",
+                         "Find where two records of one match diverged: frame, subsystem, body, "
+                         "field");
+  c->add_option("A", bisect.a, "A replay or desync report")->required();
+  c->add_option("B", bisect.b, "A replay or desync report of the same match")->required();
+  c->add_option("--html", bisect.html,
+                "Also write a self-contained HTML page: agreement timeline, diff table, top-down "
+                "plot of both sides' scenes")
+      ->type_name("REPORT");
+  c->add_option("--max", bisect.max_fields, "List at most N field differences (default 100)")
+      ->type_name("N")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}));
+  c->add_flag("--json", bisect.json,
+              "Print one JSON object: outcome, first_divergent_frame, last_agreed_frame, diffs "
+              "(subsystem, body, field, a, b), ...");
+  c->footer(std::string(R"(
+A and B are records of the same match from two machines: replays (detsim run --record, netplay
+--record) and/or desync reports (netplay --desync-report, verify --report). First the fingerprints
+are compared (different runs are reported as such), then the inputs (differing inputs are not a
+desync), then the state hashes frame by frame: the first frame that differs, the subsystems that
+differ there, and every differing field with both values in decimal and raw hex. Where a side has a
+hash but no state at that frame, this machine re-simulates from the last state both agree on and
+says which side it agrees with; if neither side's state at the exact frame can be known, the diff
+is taken at the first later frame where both are, and the verify command that would give the exact
+frame is printed. Exit 0 when the records agree.)") +
+            exit_footer);
+  c->callback([&exit_code] { exit_code = cli::bisect_command(bisect); });
 
   c = app.add_subcommand("diff", "Compare two saved states field by field");
   c->add_option("STATE_A", diff.a, "A saved World state (e.g. from synctest --dump)")->required();

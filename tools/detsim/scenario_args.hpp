@@ -3,8 +3,10 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <detsim/net/session.hpp>
+#include <detsim/sim/inject.hpp>
 #include <detsim/sim/scenario.hpp>
 #include <detsim/sim/status.hpp>
 
@@ -22,6 +24,9 @@ struct ChosenScenario {
   std::uint64_t frames = 0;
 };
 Expected<ChosenScenario> choose_scenario(const ScenarioArgs& args);
+
+/// The --inject options, parsed (errors name the option and what is wrong).
+Expected<std::vector<Injection>> parse_injections(const std::vector<std::string>& specs);
 
 /// "arena (seed 1, 2 players)" / "pile_boxes (seed 1, 1000 bodies)".
 std::string describe(const Scenario& scenario);

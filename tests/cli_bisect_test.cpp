@@ -1,0 +1,151 @@
+// detsim bisect, detsim verify --report/--at and --inject from the command line: the replay path of
+// a desync end to end (the faulty machine records with --inject, the healthy one verifies and
+// reports, the faulty one reports the flagged frame, bisect names the frame, body and field), the
+// other outcomes (identical, different runs, different inputs), the HTML report, and bad usage.
+#include <gtest/gtest.h>
+
+#include <detsim/replay/scenario_replay.hpp>
+
+#include "support/cli.hpp"
+#include "support/replay_files.hpp"
+
+namespace detsim {
+namespace {
+
+using test::detsim_cli;
+using test::expect_one_json_object;
+using test::has;
+using test::json_value;
+using test::read_text;
+using test::TempFile;
+
+constexpr const char* kInject = "1234:17:linear_velocity.x:0.01";
+
+std::string record(const TempFile& file, const std::string& extra = "") {
+  return "run --scenario arena --players 8 --frames 2000 --record " + file.path() + " " + extra;
+}
+
+TEST(CliBisect, ReplayPathNamesTheInjectedFrameBodyAndField) {
+  TempFile faulty("faulty.dsr");
+  TempFile healthy_report("healthy.dsd");
+  TempFile faulty_report("faulty.dsd");
+  TempFile html("bisect.html");
+  auto r = detsim_cli(record(faulty, std::string("--inject ") + kInject));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  // The healthy machine: the first mismatch is frame 1234, and its side is written.
+  r = detsim_cli("verify " + faulty.path() + " --report " + healthy_report.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "first_mismatch"), "1234") << r.out;
+  EXPECT_EQ(json_value(r.out, "report"), healthy_report.path()) << r.out;
+  EXPECT_EQ(json_value(r.out, "report_frame"), "1234") << r.out;
+  // The faulty machine reproduces its replay and writes its side of frame 1234.
+  r = detsim_cli("verify " + faulty.path() + " --inject " + kInject + " --report " +
+                 faulty_report.path() + " --at 1234");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "ok: 2000 frames")) << r.out;
+  EXPECT_TRUE(has(r.out, "state at frame 1234 written to " + faulty_report.path())) << r.out;
+
+  r = detsim_cli("bisect " + healthy_report.path() + " " + faulty_report.path() +
+                 " --json --html " + html.path());
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  expect_one_json_object(r.out);
+  EXPECT_EQ(json_value(r.out, "outcome"), "diverged");
+  EXPECT_EQ(json_value(r.out, "first_divergent_frame"), "1234");
+  EXPECT_EQ(json_value(r.out, "last_agreed_frame"), "1233");
+  EXPECT_EQ(json_value(r.out, "diff_frame"), "1234");
+  EXPECT_TRUE(
+      has(r.out, R"("diffs":[{"subsystem":"bodies","body":17,"field":"linear_velocity.x",)"))
+      << r.out;
+  EXPECT_TRUE(has(r.out, R"(}],"diffs_omitted":0)")) << "exactly one difference: " << r.out;
+  const std::string page = read_text(html.path());
+  EXPECT_TRUE(page.starts_with("<!DOCTYPE html>"));
+  EXPECT_TRUE(has(page, "linear_velocity.x"));
+  EXPECT_FALSE(has(page, "http://") || has(page, "https://")) << "self-contained";
+
+  // Text output, and the faulty replay against the healthy report.
+  r = detsim_cli("bisect " + faulty.path() + " " + healthy_report.path());
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "DIVERGED at frame 1234 (last agreed frame 1233)")) << r.out;
+  EXPECT_TRUE(has(r.out, "this machine's re-simulation agrees with: B")) << r.out;
+  EXPECT_TRUE(has(r.out, "detsim verify " + faulty.path() + " --report")) << r.out;
+  EXPECT_TRUE(has(r.out, "--at 1234")) << r.out;
+}
+
+TEST(CliBisect, IdenticalRecordsDifferentRunsAndDifferentInputs) {
+  TempFile a("a.dsr");
+  TempFile b("b.dsr");
+  ASSERT_EQ(detsim_cli(record(a)).exit_code, 0);
+  ASSERT_EQ(detsim_cli(record(b)).exit_code, 0);
+  auto r = detsim_cli("bisect " + a.path() + " " + b.path() + " --json");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "outcome"), "identical") << r.out;
+  EXPECT_EQ(json_value(r.out, "first_divergent_frame"), "null") << r.out;
+
+  TempFile other_seed("seed.dsr");
+  ASSERT_EQ(detsim_cli(record(other_seed, "--seed 2")).exit_code, 0);
+  r = detsim_cli("bisect " + a.path() + " " + other_seed.path());
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "DIFFERENT RUNS")) << r.out;
+  EXPECT_TRUE(has(r.out, "seed: 1 vs 2")) << r.out;
+
+  // The same match with player 3 pressing something else at frame 700: not a desync.
+  TempFile other_inputs("inputs.dsr");
+  {
+    ScenarioParams params;
+    params.players = 8;
+    Scenario scenario = Scenario::create("arena", params).value();
+    replay::RecordOptions options;
+    options.frames = 2000;
+    options.inputs = [](std::uint64_t frame, std::span<PlayerInput> out) {
+      for (std::uint32_t p = 0; p < out.size(); ++p)
+        out[p] = scripted_input(1, frame, p);
+      if (frame == 700) out[3].move_x = static_cast<std::int8_t>(out[3].move_x ^ 5);
+    };
+    ASSERT_TRUE(replay::record(scenario, other_inputs.path(), options).ok());
+  }
+  r = detsim_cli("bisect " + a.path() + " " + other_inputs.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "outcome"), "inputs_differ") << r.out;
+  EXPECT_EQ(json_value(r.out, "input_frame"), "700") << r.out;
+  EXPECT_EQ(json_value(r.out, "input_player"), "3") << r.out;
+}
+
+TEST(CliBisect, BadUsageExitsWithTwoAndNamesTheProblem) {
+  TempFile a("a.dsr");
+  ASSERT_EQ(detsim_cli(record(a)).exit_code, 0);
+  TempFile junk("junk.bin");
+  test::write_bytes(junk.path(), std::vector<std::uint8_t>(100, 7));
+  const struct {
+    std::string args;
+    std::string message;
+  } cases[] = {
+      {"bisect " + a.path() + " /nonexistent/x.dsr", "/nonexistent/x.dsr"},
+      {"bisect " + a.path() + " " + junk.path(), "side B"},
+      {"bisect " + a.path(), "B is required"},
+      {"verify " + a.path() + " --at 5", "--at needs --report"},
+      {"verify " + a.path() + " --report /tmp/x.dsd --at 2001", "holds frames 1 to 2000"},
+      {"verify " + a.path() + " --inject 5:17:position.q:1", "unknown field \"position.q\""},
+      {"verify " + a.path() + " --inject 5:17:position.x", "FRAME:BODY:FIELD:DELTA"},
+      {"run --scenario arena --frames 100 --inject 500:3:position.x:1", "beyond the run"},
+      {"run --scenario arena --frames 100 --inject 50:999:position.x:1", "no body with ID 999"},
+  };
+  for (const auto& c : cases) {
+    const auto r = detsim_cli(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.out << r.err;
+    EXPECT_TRUE(has(r.err, c.message)) << c.args << "\n" << r.err;
+  }
+}
+
+TEST(CliBisect, HelpDescribesTheOptions) {
+  const auto r = detsim_cli("bisect --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* word : {"--html", "--json", "--max", "desync report", "Exit status"})
+    EXPECT_TRUE(has(r.out, word)) << word << "\n" << r.out;
+  const auto verify = detsim_cli("verify --help");
+  for (const char* word : {"--report", "--at", "--inject", "FRAME:BODY:FIELD:DELTA"})
+    EXPECT_TRUE(has(verify.out, word)) << word << "\n" << verify.out;
+}
+
+}  // namespace
+}  // namespace detsim
