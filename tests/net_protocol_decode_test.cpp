@@ -189,9 +189,17 @@ TEST(NetProtocolDecode, BodyShorterOrLongerThanItsType) {
 }
 
 /// The header and the fields before the deltas of crafted datagrams: ack_frame 10, the other
-/// frames a few frames from it (a varint byte each).
+/// frames a few frames from it (a varint byte each), no gone reports.
 Writer& crafted_fields(Writer& w, std::uint8_t count) {
-  return w.header(3, 1, 2).varint(10).frame(20, 10).frame(30, 10).u8(0).frame(40, 10).u8(count);
+  return w.header(3, 1, 2)
+      .varint(10)
+      .frame(20, 10)
+      .frame(30, 10)
+      .u8(0)
+      .frame(40, 10)
+      .u8(count)
+      .frame(10, 10)
+      .u8(0);
 }
 
 /// An input datagram of `count` inputs whose deltas are the raw `tokens`, then `tail` (the checks
@@ -264,6 +272,32 @@ TEST(NetProtocolDecode, InputCraftedWithACorrectChecksum) {
   EXPECT_EQ(decode_bytes(crafted_input(255, deltas, no_checks), 64), DecodeError::bad_field);
 }
 
+TEST(NetProtocolDecode, GoneReportsAreBoundedAndNamePlayersBelowEight) {
+  // The fields before the gone reports, then `gone`, then no deltas and no checks.
+  const auto crafted = [](const Bytes& gone) {
+    Writer w;
+    w.header(3, 1, 2).varint(10).frame(20, 10).frame(30, 10).u8(0).frame(40, 10).u8(0);
+    w.frame(10, 10).raw(gone).u8(0);
+    return w.sealed();
+  };
+  Packet p;
+  ASSERT_EQ(decode(crafted({2, 3, 0, 7, 1}), 4, p), DecodeError::none);  // players 3 and 7
+  ASSERT_EQ(p.input.gone.size(), 2U);
+  EXPECT_EQ(p.input.gone[0], (GoneReport{3, 10}));
+  EXPECT_EQ(p.input.gone[1], (GoneReport{7, 9}));
+  EXPECT_EQ(decode(crafted({1, 8, 0}), 4, p), DecodeError::bad_field);  // player 8
+  Bytes nine = {9};
+  for (std::uint8_t player = 0; player < 9; ++player)
+    nine.insert(nine.end(), {static_cast<std::uint8_t>(player % 8), 0});
+  EXPECT_EQ(decode(crafted(nine), 4, p), DecodeError::bad_field);        // more than 8 reports
+  EXPECT_EQ(decode(crafted({2, 3, 0}), 4, p), DecodeError::bad_length);  // one report missing
+  // encode() refuses what decode() refuses.
+  Packet many = input_packet(0, {});
+  many.input.gone.assign(max_gone_reports + 1, GoneReport{1, 11});
+  Bytes out;
+  EXPECT_FALSE(encode(many, 4, out));
+}
+
 TEST(NetProtocolDecode, NonCanonicalTokensAreAcceptedAndReencodeCanonically) {
   // The decoder accepts any tokens that produce exactly count * input_size bytes: a literal token
   // covering zeros, or a zero run split in two. encode() then writes the canonical tokens, so the
@@ -307,7 +341,8 @@ using FrameFields = std::array<Bytes, 5>;
 /// An input datagram of no inputs and one check whose frame fields are `f`, sealed.
 Bytes crafted_frames(const FrameFields& f) {
   Writer w;
-  w.header(3, 1, 2).raw(f[0]).raw(f[1]).raw(f[2]).u8(0).raw(f[3]).u8(0).u8(1).raw(f[4]);
+  // ... start_frame, count 0, held_frame = ack_frame, no gone reports, no deltas, one check.
+  w.header(3, 1, 2).raw(f[0]).raw(f[1]).raw(f[2]).u8(0).raw(f[3]).u8(0).u8(0).u8(0).u8(1).raw(f[4]);
   return w.u64(0x5555555555555555ULL).sealed();
 }
 

@@ -70,11 +70,13 @@ TEST(NetProtocolRoundTrip, HeaderFieldsAreLittleEndian) {
 TEST(NetProtocolRoundTrip, EmptyInputAtMinimum) {
   Packet p = input_packet(0, {});
   p.header = {PacketType::input, 0, 0};
-  p.input.ack_frame = p.input.check_ack = p.input.current_frame = p.input.start_frame = 0;
+  p.input.ack_frame = p.input.check_ack = p.input.current_frame = p.input.start_frame =
+      p.input.held_frame = 0;
   p.input.advantage = std::numeric_limits<std::int8_t>::min();
   const Bytes expected = input_bytes(p, {});
-  // ack_frame 0 and every difference 0: one varint byte each; advantage, count, checks count.
-  EXPECT_EQ(expected.size(), header_size + 4 + 1 + 1 + 1 + trailer_size);
+  // ack_frame 0 and every difference 0: one varint byte each (ack, check_ack, current, start,
+  // held); advantage, count, checks count, gone count.
+  EXPECT_EQ(expected.size(), header_size + 5 + 1 + 1 + 1 + 1 + trailer_size);
   for (const std::size_t size : {std::size_t{1}, max_input_size, max_unit_size})
     expect_round_trip(p, size, expected);
 }
@@ -84,13 +86,17 @@ TEST(NetProtocolRoundTrip, FullInputAtMaximum) {
   // maximum; then every frame as far from ack_frame as u32 allows (5 varint bytes each).
   Packet p = input_packet(255, Bytes(255, 0xFF), max_checks());
   p.header = {PacketType::input, max_u32, 0xFFFF};
-  p.input.ack_frame = p.input.check_ack = p.input.current_frame = p.input.start_frame = max_u32;
+  p.input.ack_frame = p.input.check_ack = p.input.current_frame = p.input.start_frame =
+      p.input.held_frame = max_u32;
+  for (std::uint8_t player = 0; player < max_gone_reports; ++player)
+    p.input.gone.push_back({player, max_u32 - player});
   p.input.advantage = std::numeric_limits<std::int8_t>::max();
   expect_round_trip(p, 1, input_bytes(p, literal_tokens(p.input.deltas)));
   far_frames(p);
   const Bytes expected = input_bytes(p, literal_tokens(p.input.deltas));
   EXPECT_EQ(expected.size(), header_size + 4 * max_varint_size + 2 + 255 + 2 + 1 +
-                                 max_checks_per_packet * (max_varint_size + 8) + trailer_size);
+                                 max_checks_per_packet * (max_varint_size + 8) + max_varint_size +
+                                 1 + max_gone_reports * (1 + max_varint_size) + trailer_size);
   expect_round_trip(p, 1, expected);
 }
 
@@ -135,7 +141,8 @@ struct VarintCase {
 /// An empty input packet with every frame at `ack`: each difference is 0, one byte.
 Packet frames_at(std::uint32_t ack) {
   Packet p = input_packet(0, {});
-  p.input.ack_frame = p.input.check_ack = p.input.current_frame = p.input.start_frame = ack;
+  p.input.ack_frame = p.input.check_ack = p.input.current_frame = p.input.start_frame =
+      p.input.held_frame = ack;
   return p;
 }
 
@@ -160,8 +167,9 @@ TEST(NetProtocolVarint, AckFrameAtEveryGroupBoundary) {
     const Packet p = frames_at(static_cast<std::uint32_t>(c.value));
     const Bytes expected = input_bytes(p, {});
     EXPECT_EQ(slice(expected, header_size, c.bytes.size()), c.bytes) << c.value;
-    // The ack, three zero differences, advantage, count 0, checks count 0.
-    EXPECT_EQ(expected.size(), header_size + c.bytes.size() + 3 + 3 + trailer_size) << c.value;
+    // The ack, four zero differences (check_ack, current, start, held), advantage, count 0, gone
+    // count 0, checks count 0.
+    EXPECT_EQ(expected.size(), header_size + c.bytes.size() + 4 + 4 + trailer_size) << c.value;
     expect_round_trip(p, 4, expected);
   }
 }
@@ -193,23 +201,23 @@ TEST(NetProtocolVarint, FrameDifferencesBothWaysInEveryField) {
       {-std::int64_t{ack}, {0xFF, 0xFF, 0xFF, 0xFF, 0x0F}},
   }};
   // Where each frame field starts when every frame before it is at ack (one byte each): check_ack,
-  // current_frame, start_frame (after advantage), the first check's frame (after count and the
-  // checks count; no deltas).
-  const std::array<std::size_t, 4> offsets = {5, 6, 8, 11};
+  // current_frame, start_frame (after advantage), held_frame (after count), the first check's
+  // frame (after the gone count and the checks count; no deltas).
+  const std::array<std::size_t, 5> offsets = {5, 6, 8, 10, 13};
   for (const Difference& d : differences) {
     const auto frame = static_cast<std::uint32_t>(std::int64_t{ack} + d.d);
     for (std::size_t field = 0; field < offsets.size(); ++field) {
       Packet p = frames_at(ack);
       p.input.checks = {{ack, 0x0123456789ABCDEFULL}};
-      const std::array<std::uint32_t*, 4> targets = {&p.input.check_ack, &p.input.current_frame,
-                                                     &p.input.start_frame,
+      const std::array<std::uint32_t*, 5> targets = {&p.input.check_ack, &p.input.current_frame,
+                                                     &p.input.start_frame, &p.input.held_frame,
                                                      &p.input.checks[0].frame};
       *targets[field] = frame;
       const Bytes expected = input_bytes(p, {});
       EXPECT_EQ(slice(expected, header_size + offsets[field], d.bytes.size()), d.bytes)
           << "difference " << d.d << ", field " << field;
-      // The ack, the three other frames, advantage, count, checks count, the check's hash.
-      EXPECT_EQ(expected.size(), header_size + 5 + 3 + 3 + 8 + d.bytes.size() + trailer_size);
+      // The ack, the four other frames, advantage, count, gone count, checks count, the hash.
+      EXPECT_EQ(expected.size(), header_size + 5 + 4 + 4 + 8 + d.bytes.size() + trailer_size);
       expect_round_trip(p, 4, expected);
     }
   }
@@ -226,24 +234,26 @@ TEST(NetProtocolVarint, ExtremeDifferences) {
     const VarintCase& c = falling ? down : up;
     ASSERT_EQ(zigzag(frame, ack), c.value);
     Packet p = frames_at(ack);
-    p.input.check_ack = p.input.current_frame = p.input.start_frame = frame;
+    p.input.check_ack = p.input.current_frame = p.input.start_frame = p.input.held_frame = frame;
     p.input.checks.assign(max_checks_per_packet, HashCheck{frame, max_u64});
     const Bytes expected = input_bytes(p, {});
-    // check_ack after the ack, current_frame, start_frame after advantage, the first check's
-    // frame after count and the checks count.
+    // check_ack after the ack, current_frame, start_frame after advantage, held_frame after
+    // count, the first check's frame after the gone count and the checks count.
     const std::size_t after_ack = header_size + (falling ? 5 : 1);
-    for (const std::size_t at : {after_ack, after_ack + 5, after_ack + 11, after_ack + 18})
+    for (const std::size_t at :
+         {after_ack, after_ack + 5, after_ack + 11, after_ack + 17, after_ack + 24})
       EXPECT_EQ(slice(expected, at, 5), c.bytes) << "falling " << falling << ", at " << at;
     EXPECT_EQ(expected.size(),
-              after_ack + 3 * 5 + 3 + max_checks_per_packet * (5 + 8) + trailer_size);
+              after_ack + 4 * 5 + 4 + max_checks_per_packet * (5 + 8) + trailer_size);
     expect_round_trip(p, 4, expected);
   }
 }
 
 TEST(NetProtocolVarint, TypicalInputPacketIsAtMostThirtyBytes) {
   // What a player sends every frame: ack_frame around 100000 (about half an hour at 60 Hz), the
-  // other frames within 60 of it, two held inputs of 4 bytes, no checks. Version 1 took 34 bytes
-  // (four u32 frames); now the ack takes 3 bytes and each difference 1 (zigzag <= 120 < 128).
+  // other frames within 60 of it, two held inputs of 4 bytes, no checks, no player gone. Version 1
+  // took 34 bytes (four u32 frames); now the ack takes 3 bytes and each difference 1 (zigzag <=
+  // 120 < 128); version 3 added the held frame and the gone count (one byte each).
   const Bytes held = {0x10, 0x00, 0x7F, 0x01};
   const Bytes inputs = {0x10, 0x00, 0x7F, 0x01, 0x10, 0x00, 0x7F, 0x01};
   Bytes deltas;
@@ -258,8 +268,9 @@ TEST(NetProtocolVarint, TypicalInputPacketIsAtMostThirtyBytes) {
       p.input.current_frame = ack + 60;
       p.input.advantage = 3;
       p.input.start_frame = static_cast<std::uint32_t>(std::int64_t{ack} + d);
-      // The ack, three one-byte differences, advantage, count, the tokens, checks count.
-      const std::size_t expected_size = header_size + varint_size(ack) + 3 + 1 + 1 +
+      p.input.held_frame = ack - 2;
+      // The ack, four one-byte differences, advantage, count, gone count, the tokens, checks count.
+      const std::size_t expected_size = header_size + varint_size(ack) + 4 + 1 + 1 + 1 +
                                         zero_tokens(deltas.size()).size() + 1 + trailer_size;
       ASSERT_EQ(expected_size, input_datagram_size(p.input, zero_tokens(deltas.size()).size()));
       Bytes out;
@@ -269,7 +280,7 @@ TEST(NetProtocolVarint, TypicalInputPacketIsAtMostThirtyBytes) {
       largest = std::max(largest, out.size());
     }
   }
-  EXPECT_EQ(largest, 24U);
+  EXPECT_EQ(largest, 26U);
   EXPECT_LE(largest, 30U);
   RecordProperty("typical_input_bytes", std::to_string(largest));
 }
@@ -440,7 +451,7 @@ TEST(NetProtocolRunLength, InputsOfOneByteMorePerInputAlwaysFitWithEightChecks) 
   // max_datagram, the packet encodes, whatever the inputs are (here the worst case for a coder
   // that gives each lone zero a token: alternating zero and non-zero bytes), and its frames as far
   // apart as u32 allows (every frame varint at its longest).
-  const std::size_t overhead = header_size + 4 * max_varint_size + 2 + 1 +
+  const std::size_t overhead = header_size + 5 * max_varint_size + 3 + 1 +
                                max_checks_per_packet * (max_varint_size + 8) + trailer_size;
   for (const std::size_t size : all_sizes()) {
     const std::size_t count =

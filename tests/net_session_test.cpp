@@ -341,5 +341,87 @@ TEST(NetSession, ASilentPeerIsDisconnectedAndTheOthersGoOnTogether) {
   EXPECT_EQ(m.record(0).status.back(), net::InputStatus::disconnected);  // player 2, last frame
 }
 
+/// The frame from which `record` shows player `player` as disconnected, or the record's length.
+std::size_t gone_from(const test::PeerRecord& record, std::uint32_t players, std::uint32_t player) {
+  const std::size_t frames = record.status.size() / players;
+  for (std::size_t f = 0; f < frames; ++f)
+    if (record.status[f * players + player] == net::InputStatus::disconnected) return f;
+  return frames;
+}
+
+/// Peer 1's transport, which stops delivering player 3's datagrams once `cut` is set.
+class CutOff final : public net::Transport {
+ public:
+  CutOff(net::Transport& inner, const bool& cut) : inner_(inner), cut_(cut) {}
+  void send(net::PeerId to, std::span<const std::uint8_t> bytes) override {
+    inner_.send(to, bytes);
+  }
+  void receive(std::vector<net::Datagram>& out) override {
+    const std::size_t before = out.size();
+    inner_.receive(out);
+    if (!cut_) return;
+    out.erase(std::remove_if(out.begin() + static_cast<std::ptrdiff_t>(before), out.end(),
+                             [](const net::Datagram& d) { return d.from == 3; }),
+              out.end());
+  }
+
+ private:
+  net::Transport& inner_;
+  const bool& cut_;
+};
+
+TEST(NetSession, PeersAgreeOnOneDisconnectFrameWhenTheyHeldDifferentInputs) {
+  // Player 3 leaves for good after 4 s (tick 240), but peer 1 stops hearing it 15 frames earlier,
+  // so peers 0 and 2 hold ~15 more frames of its inputs than peer 1. Each peer taking it as gone
+  // from its own last held input would give player 3 real inputs on two peers and zero inputs on
+  // the third for those frames: a desync. The peers must agree on one frame (the lowest any of
+  // them holds), roll back to it where needed, and confirm nothing beyond what every peer holds
+  // meanwhile.
+  bool cut = false;
+  MatchOptions o;
+  o.players = 4;
+  o.frames = 900;
+  o.link.latency_us = 10'000;
+  o.max_ticks = 5000;
+  o.setup = [](net::SimNetwork& n) { ASSERT_TRUE(n.add_outage(3, 4'000'000, ~0ULL >> 1).ok()); };
+  o.active = [](std::uint32_t p, std::uint64_t tick) { return p != 3 || tick < 240; };
+  o.on_tick = [&cut](std::uint32_t, std::uint64_t tick, net::Session&) {
+    if (tick == 225) cut = true;
+  };
+  o.wrap = [&cut](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
+    if (p != 1) return nullptr;
+    return std::make_unique<CutOff>(inner, cut);
+  };
+  Match m(o);
+  m.run();
+  std::size_t common = m.record(0).hashes.size();
+  for (std::uint32_t p : {1U, 2U})
+    common = std::min(common, m.record(p).hashes.size());
+  ASSERT_GE(common, 900U);
+  const std::size_t gone = gone_from(m.record(0), 4, 3);
+  EXPECT_GT(gone, 150U);
+  EXPECT_LT(gone, 260U);
+  for (std::uint32_t p : {0U, 1U, 2U}) {
+    SCOPED_TRACE("peer " + std::to_string(p));
+    EXPECT_TRUE(m.record(p).has(EventType::disconnected));
+    EXPECT_FALSE(m.record(p).has(EventType::desync));
+    EXPECT_EQ(gone_from(m.record(p), 4, 3), gone) << "one disconnect frame for every peer";
+    const auto frames = static_cast<std::ptrdiff_t>(common);
+    EXPECT_TRUE(std::equal(m.record(0).hashes.begin(), m.record(0).hashes.begin() + frames,
+                           m.record(p).hashes.begin()));
+    // CounterGame inputs are 4 bytes: 16 bytes a frame.
+    EXPECT_TRUE(std::equal(m.record(0).inputs.begin(), m.record(0).inputs.begin() + frames * 16,
+                           m.record(p).inputs.begin()));
+  }
+  // The agreed frame is peer 1's: the lowest holdings, 15 frames behind the others'.
+  const std::uint64_t from_peer_1 = [&] {
+    for (const net::Event& e : m.record(1).events)
+      if (e.type == EventType::disconnected && e.player == 3) return e.frame;
+    return std::uint64_t{0};
+  }();
+  EXPECT_EQ(gone, from_peer_1);
+  EXPECT_EQ(m.compare().find("raised a desync"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace detsim

@@ -153,7 +153,9 @@ bool body_ok(const Packet& p, std::size_t input_size) {
   if (p.header.type != PacketType::input) return true;
   const InputBody& b = p.input;
   return b.deltas.size() == std::size_t{b.count} * input_size &&
-         b.checks.size() <= max_checks_per_packet;
+         b.checks.size() <= max_checks_per_packet && b.gone.size() <= max_gone_reports &&
+         std::all_of(b.gone.begin(), b.gone.end(),
+                     [](const GoneReport& g) { return g.player < max_gone_reports; });
 }
 
 }  // namespace
@@ -210,6 +212,12 @@ bool encode(const Packet& packet, std::size_t input_size, std::vector<std::uint8
       out.push_back(static_cast<std::uint8_t>(b.advantage));
       put_frame(out, b.start_frame, b.ack_frame);
       out.push_back(b.count);
+      put_frame(out, b.held_frame, b.ack_frame);
+      out.push_back(static_cast<std::uint8_t>(b.gone.size()));
+      for (const GoneReport& g : b.gone) {
+        out.push_back(g.player);
+        put_frame(out, g.frame, b.ack_frame);
+      }
       run_length_encode(b.deltas, out);
       out.push_back(static_cast<std::uint8_t>(b.checks.size()));
       for (const HashCheck& c : b.checks) {
@@ -274,6 +282,16 @@ DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, 
       b.advantage = static_cast<std::int8_t>(in.u8());
       b.start_frame = in.frame(b.ack_frame, bad);
       b.count = in.u8();
+      b.held_frame = in.frame(b.ack_frame, bad);
+      const std::uint8_t gone = in.u8();
+      if (!in.ok()) return DecodeError::bad_length;
+      if (bad || gone > max_gone_reports) return DecodeError::bad_field;
+      b.gone.resize(gone);
+      for (GoneReport& g : b.gone) {
+        g.player = in.u8();
+        g.frame = in.frame(b.ack_frame, bad);
+        if (g.player >= max_gone_reports) bad = true;
+      }
       if (!in.ok()) return DecodeError::bad_length;
       if (bad) return DecodeError::bad_field;
       // count <= 255 and input_size <= 513 bound the allocation to 128 KiB whatever the bytes say.

@@ -3,7 +3,8 @@
 //
 // Frame numbering: the game's state is "at frame F" after F steps; step F turns state F into
 // F + 1 using every player's input for frame F. After each step the session saves state F + 1 in a
-// ring of max_prediction + 3 states, so the oldest frame a correction can reach is always held.
+// ring of 2 * max_prediction + emission_slack states, and waits rather than outgrow it, so the
+// oldest frame a correction or a disconnect can reach is always held.
 #include <algorithm>
 #include <string>
 
@@ -78,6 +79,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
   for (const RemotePlayer& r : remotes) {
     detail::Peer peer;
     peer.player = r.player;
+    peer.reported_gone.assign(c.players, never);
     peer.id = r.peer;
     peer.challenge = static_cast<std::uint32_t>(rng.next_u64());
     peer.stats.player = r.player;
@@ -93,7 +95,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
     spectators.push_back(std::move(spectator));
   }
   unit_size = 1 + std::size_t{c.players} * c.input_size;
-  states.resize(max_prediction + 3U);
+  states.resize(2U * max_prediction + detail::emission_slack);
   frame_inputs.resize(std::size_t{c.players} * c.input_size);
   frame_status.resize(c.players);
   scratch_input.resize(c.input_size);
@@ -104,11 +106,32 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
   agreed_state = zero.bytes;  // every peer starts from the same state (the fingerprint says so)
 }
 
+bool Session::Impl::gone_final(std::uint32_t player) const noexcept {
+  for (const detail::Peer& peer : peers) {
+    if (!peer.synchronized || peer.disconnected) continue;
+    if (peer.reported_gone[player] != disconnect_frame[player]) return false;
+  }
+  return true;
+}
+
 std::uint64_t Session::Impl::confirmed_frame() const noexcept {
   std::uint64_t frame = never;
-  for (std::size_t p = 0; p < queues.size(); ++p)
-    if (disconnect_frame[p] == never) frame = std::min(frame, queues[p].next_confirmed());
+  for (std::uint32_t p = 0; p < config.players; ++p) {
+    if (disconnect_frame[p] == never) {
+      frame = std::min(frame, queues[p].next_confirmed());
+    } else if (!gone_final(p)) {
+      frame = std::min(frame, disconnect_frame[p]);  // peers may still move it earlier
+    }
+  }
   return frame == never ? current : frame;
+}
+
+std::uint64_t Session::Impl::emit_limit() const noexcept {
+  std::uint64_t limit =
+      std::min({confirmed_frame(), current, first_incorrect.value_or(detail::never)});
+  for (const detail::Peer& peer : peers)
+    if (peer.synchronized && !peer.disconnected) limit = std::min(limit, peer.reported_held);
+  return limit;
 }
 
 std::uint64_t Session::Impl::window_start() const noexcept {
@@ -176,10 +199,10 @@ void Session::Impl::rollback() {
 }
 
 void Session::Impl::emit_confirmed() {
-  // A frame is final once its inputs are all confirmed, it was simulated, and no pending
-  // correction reaches back to it (states after first_incorrect are re-simulated first).
-  const std::uint64_t limit =
-      std::min({confirmed_frame(), current, first_incorrect.value_or(detail::never)});
+  // A frame is final once its inputs are all confirmed, it was simulated, no pending correction
+  // reaches back to it (states after first_incorrect are re-simulated first), and every peer holds
+  // every input of it (so a disconnect can never be agreed before it).
+  const std::uint64_t limit = emit_limit();
   const std::size_t size = config.input_size;
   for (; next_emit < limit; ++next_emit) {
     const std::uint64_t frame = next_emit;
@@ -278,14 +301,31 @@ void Session::Impl::receive_input(detail::Peer& peer, std::uint64_t frame,
 }
 
 void Session::Impl::disconnect(detail::Peer& peer) {
-  peer.disconnected = true;
-  peer.stats.disconnected = true;
-  const std::uint64_t from = queues[peer.player].next_confirmed();
-  disconnect_frame[peer.player] = from;
-  // Frames from `from` on were simulated with predictions; they now take zero inputs.
-  if (from < current) first_incorrect = std::min(first_incorrect.value_or(from), from);
-  raise(Event{EventType::disconnected, peer.player, from, 0, 0, {}});
-  retire_checks();
+  player_gone(peer.player, queues[peer.player].next_confirmed());
+}
+
+void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame) {
+  // Frames already emitted are final: no peer can report an earlier frame unless the network is
+  // partitioned, and then the hash checks will tell.
+  frame = std::max(frame, next_emit);
+  if (disconnect_frame[player] == never) {
+    // From now on this machine takes no input of the player: its holdings are frozen.
+    frame = std::min(frame, queues[player].next_confirmed());
+    disconnect_frame[player] = frame;
+    for (detail::Peer& peer : peers) {
+      if (peer.player != player) continue;
+      peer.disconnected = true;
+      peer.stats.disconnected = true;
+    }
+    raise(Event{EventType::disconnected, player, frame, 0, 0, {}});
+    retire_checks();
+  } else if (frame < disconnect_frame[player]) {
+    disconnect_frame[player] = frame;
+  } else {
+    return;
+  }
+  // Frames from `frame` on were simulated with predictions or inputs; they now take zero inputs.
+  if (frame < current) first_incorrect = std::min(first_incorrect.value_or(frame), frame);
 }
 
 // ---- the public face ----
@@ -314,7 +354,10 @@ Expected<Advance> Session::advance_frame(std::span<const std::uint8_t> local_inp
       if (peer.synchronized && !peer.disconnected) s.send_inputs(peer);
   if (s.first_incorrect) s.rollback();
   s.emit_confirmed();
-  if (s.current >= s.confirmed_frame() + s.max_prediction) {
+  // The ring must hold every state from the oldest frame not yet emitted to the one about to be
+  // saved (rollbacks and emission read them).
+  const bool ring_full = s.current + 2 - s.next_emit > s.states.size();
+  if (s.current >= s.confirmed_frame() + s.max_prediction || ring_full) {
     if (s.max_prediction == 0) return Advance::waiting_for_inputs;
     ++s.stats.prediction_limit_waits;
     return Advance::prediction_limit;

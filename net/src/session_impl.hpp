@@ -23,6 +23,10 @@ inline constexpr std::size_t input_capacity = 256;
 inline constexpr std::size_t max_pending_checks = 64;
 /// "No frame": a connected player's disconnect frame.
 inline constexpr std::uint64_t never = ~std::uint64_t{0};
+/// States the ring keeps beyond twice the prediction window: room for the frames between the last
+/// emitted confirmed frame and the present (emission waits for every peer's holdings, a one-way
+/// trip later). The session waits rather than let that span outgrow the ring.
+inline constexpr std::size_t emission_slack = 24;
 
 /// One confirmed-frame hash this machine computed, kept until every peer's hash was compared.
 struct LocalCheck {
@@ -45,6 +49,10 @@ struct Peer {
   std::uint64_t last_hello_us = 0;
   bool hello_sent = false;
   bool hello_rejected = false;  ///< reported once
+  // What the peer holds: every player's input before reported_held (from its latest packet), and
+  // the frame from which it takes each player as gone (never: connected; only ever lowered).
+  std::uint64_t reported_held = 0;
+  std::vector<std::uint64_t> reported_gone;
   // Inputs and checks the peer holds of ours.
   std::uint64_t acked_inputs = 0;  ///< the peer holds our inputs before this frame
   std::uint64_t acked_checks = 0;  ///< the peer holds our checks up to this frame
@@ -92,7 +100,17 @@ struct Session::Impl {
   void retire_checks();
   void receive_input(detail::Peer& peer, std::uint64_t frame, std::span<const std::uint8_t> input);
   void disconnect(detail::Peer& peer);
+  /// Takes `player` as gone from `frame` (or from the frame of its first input this machine does
+  /// not hold, if earlier); a later call can only move the frame earlier. Peers converge on the
+  /// lowest frame any of them reports (docs/NET.md, "Disconnects").
+  void player_gone(std::uint32_t player, std::uint64_t frame);
+  /// Every player's input before this frame is held, or known final (zero) for a gone player whose
+  /// disconnect frame every connected peer reports: what this machine may simulate as confirmed.
   [[nodiscard]] std::uint64_t confirmed_frame() const noexcept;
+  /// The frames before this one are final everywhere: confirmed here and held by every connected
+  /// peer (so no peer can still take a player as gone from an earlier frame).
+  [[nodiscard]] std::uint64_t emit_limit() const noexcept;
+  [[nodiscard]] bool gone_final(std::uint32_t player) const noexcept;
   [[nodiscard]] std::uint64_t window_start() const noexcept;
   [[nodiscard]] detail::State& state_slot(std::uint64_t frame) noexcept {
     return states[static_cast<std::size_t>(frame % states.size())];
@@ -104,7 +122,8 @@ struct Session::Impl {
   void handle(detail::Peer& peer, const protocol::Packet& packet);
   /// False when the hello was rejected (counted, maybe reported).
   bool handle_hello(detail::Peer& peer, const protocol::Packet& packet);
-  void handle_input(detail::Peer& peer, const protocol::InputBody& body);
+  /// `fresh`: the datagram is newer than every one handled before from this peer.
+  void handle_input(detail::Peer& peer, const protocol::InputBody& body, bool fresh);
   void send_due();
   void send_inputs(detail::Peer& peer);
   void send_frames(detail::Peer& spectator);

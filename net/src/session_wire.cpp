@@ -75,13 +75,15 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
       return;
     }
     // Loss statistics from the sequence numbers (modulo 2^16; a late one fills a gap).
+    bool fresh = true;
     if (peer.last_sequence) {
       const auto step = static_cast<std::uint16_t>(p.header.sequence - *peer.last_sequence);
       if (step != 0 && step < 0x8000U) {
         peer.stats.packets_lost += step - 1U;
         peer.last_sequence = p.header.sequence;
-      } else if (step >= 0x8000U && peer.stats.packets_lost > 0) {
-        --peer.stats.packets_lost;
+      } else {
+        fresh = false;
+        if (step >= 0x8000U && peer.stats.packets_lost > 0) --peer.stats.packets_lost;
       }
     } else {
       peer.last_sequence = p.header.sequence;
@@ -101,7 +103,7 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
         peer.jitter_x16 = smooth(peer.jitter_x16, deviation / 16, first);
       }
     } else {
-      handle_input(peer, p.input);
+      handle_input(peer, p.input, fresh);
     }
   }
   ++peer.stats.packets_received;
@@ -157,7 +159,7 @@ bool Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) 
   return true;
 }
 
-void Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& b) {
+void Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& b, bool fresh) {
   if (peer.spectator) {  // a spectator only acknowledges frames
     const std::uint64_t logged = frame_log.size() / unit_size;
     if (b.ack_frame <= logged)
@@ -214,6 +216,18 @@ void Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& 
   }
   compare_checks(peer);
   retire_checks();
+  // Disconnect agreement, with the peers this machine still plays with only.
+  if (peer.disconnected) return;
+  if (fresh) peer.reported_held = b.held_frame;  // a late datagram's may be out of date
+  for (const protocol::GoneReport& g : b.gone) {
+    if (g.player >= config.players) {
+      ++stats.dropped_out_of_window;
+      continue;
+    }
+    peer.reported_gone[g.player] = std::min<std::uint64_t>(peer.reported_gone[g.player], g.frame);
+    player_gone(g.player, g.frame);
+    if (peer.disconnected) return;  // the report was about the peer itself
+  }
 }
 
 void Session::Impl::send(detail::Peer& peer, protocol::Packet& p) {
@@ -260,6 +274,11 @@ void Session::Impl::send_inputs(detail::Peer& peer) {
     if (b.checks.size() == protocol::max_checks_per_packet) break;
     b.checks.push_back(protocol::HashCheck{wire_frame(c.frame), c.hash});
   }
+  b.held_frame = wire_frame(confirmed_frame());
+  b.gone.clear();
+  for (std::uint32_t q = 0; q < config.players; ++q)
+    if (disconnect_frame[q] != detail::never)
+      b.gone.push_back({static_cast<std::uint8_t>(q), wire_frame(disconnect_frame[q])});
   peer.needs_ack = false;
   send(peer, p);
 }

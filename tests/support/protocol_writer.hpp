@@ -153,8 +153,11 @@ inline Bytes input_bytes(const Packet& p, std::span<const std::uint8_t> tokens) 
       .u8(static_cast<std::uint8_t>(b.advantage))
       .frame(b.start_frame, b.ack_frame)
       .u8(b.count)
-      .raw(tokens)
-      .u8(b.checks.size());
+      .frame(b.held_frame, b.ack_frame)
+      .u8(b.gone.size());
+  for (const GoneReport& g : b.gone)
+    w.u8(g.player).frame(g.frame, b.ack_frame);
+  w.raw(tokens).u8(b.checks.size());
   for (const HashCheck& c : b.checks)
     w.frame(c.frame, b.ack_frame).u64(c.hash);
   return w.sealed();
@@ -189,10 +192,20 @@ inline Bytes plain_bytes(const Packet& p) {
 // --- Exact sizes of an input packet's parts
 // -------------------------------------------------------
 
-/// ack_frame, check_ack, current_frame, advantage, start_frame and count.
+/// held_frame, the gone count and the gone reports.
+inline std::size_t status_size(const InputBody& b) {
+  std::size_t n = frame_size(b.held_frame, b.ack_frame) + 1;
+  for (const GoneReport& g : b.gone)
+    n += 1 + frame_size(g.frame, b.ack_frame);
+  return n;
+}
+
+/// ack_frame, check_ack, current_frame, advantage, start_frame, count, held_frame and the gone
+/// reports: everything before the deltas.
 inline std::size_t input_fields_size(const InputBody& b) {
   return varint_size(b.ack_frame) + frame_size(b.check_ack, b.ack_frame) +
-         frame_size(b.current_frame, b.ack_frame) + 1 + frame_size(b.start_frame, b.ack_frame) + 1;
+         frame_size(b.current_frame, b.ack_frame) + 1 + frame_size(b.start_frame, b.ack_frame) + 1 +
+         status_size(b);
 }
 
 /// The checks count and the checks.
@@ -247,6 +260,7 @@ inline Packet input_packet(std::uint8_t count, Bytes deltas, std::vector<HashChe
   p.input.count = count;
   p.input.deltas = std::move(deltas);
   p.input.checks = std::move(checks);
+  p.input.held_frame = 9;
   return p;
 }
 
@@ -254,9 +268,11 @@ inline Packet input_packet(std::uint8_t count, Bytes deltas, std::vector<HashChe
 /// each frame field takes max_varint_size bytes.
 inline void far_frames(Packet& p) {
   p.input.ack_frame = max_u32;
-  p.input.check_ack = p.input.current_frame = p.input.start_frame = 0;
+  p.input.check_ack = p.input.current_frame = p.input.start_frame = p.input.held_frame = 0;
   for (HashCheck& c : p.input.checks)
     c.frame = 0;
+  for (GoneReport& g : p.input.gone)
+    g.frame = 0;
 }
 
 inline std::vector<HashCheck> max_checks() {
@@ -299,6 +315,8 @@ inline testing::AssertionResult same_packet(const Packet& a, const Packet& b) {
         return testing::AssertionFailure() << "input fields differ";
       if (x.deltas != y.deltas) return testing::AssertionFailure() << "input deltas differ";
       if (x.checks != y.checks) return testing::AssertionFailure() << "input checks differ";
+      if (x.held_frame != y.held_frame || x.gone != y.gone)
+        return testing::AssertionFailure() << "input held frame or gone reports differ";
       break;
     }
     case PacketType::ping:

@@ -16,8 +16,9 @@
 //     hello        fingerprint u64 | players u8 | player u8 | input_size u8 | challenge u32
 //     hello_reply  challenge u32
 //     input        ack_frame v | check_ack z | current_frame z | advantage i8 | start_frame z |
-//                  count u8 | deltas: run-length coded bytes (below) |
-//                  checks u8 | checks x (frame z, hash u64)
+//                  count u8 | held_frame z | gone u8 | gone x (player u8, frame z) |
+//                  deltas: run-length coded bytes (below) | checks u8 | checks x (frame z, hash
+//                  u64)
 //     ping, pong   time u64 (microseconds of the pinging side's clock)
 //
 // Frame numbers are u32 values. `v` is an unsigned LEB128 varint (7 bits per byte, low first, at
@@ -44,7 +45,7 @@ namespace detsim::net::protocol {
 
 /// Changes whenever the layout above changes; peers of different versions drop each other's
 /// datagrams (counted as bad_version) and never synchronise.
-inline constexpr std::uint8_t version = 2;
+inline constexpr std::uint8_t version = 3;
 inline constexpr std::uint8_t magic0 = 'D';
 inline constexpr std::uint8_t magic1 = 'N';
 inline constexpr std::size_t header_size = 10;
@@ -89,6 +90,18 @@ struct HashCheck {
   friend constexpr bool operator==(const HashCheck&, const HashCheck&) noexcept = default;
 };
 
+/// "I take `player` as gone from `frame` on" (its inputs are all zero from there): how peers
+/// agree on one disconnect frame (docs/NET.md, "Disconnects").
+struct GoneReport {
+  std::uint8_t player = 0;
+  std::uint32_t frame = 0;
+
+  friend constexpr bool operator==(const GoneReport&, const GoneReport&) noexcept = default;
+};
+
+/// The most players a session has, and so gone reports one datagram carries.
+inline constexpr std::size_t max_gone_reports = 8;
+
 struct InputBody {
   std::uint32_t ack_frame = 0;       ///< the sender holds every input of the receiver before it
   std::uint32_t check_ack = 0;       ///< the sender holds every hash check of the receiver up to it
@@ -98,6 +111,9 @@ struct InputBody {
   std::uint8_t count = 0;            ///< inputs carried (0: an ack or keepalive only)
   std::vector<std::uint8_t> deltas;  ///< count * input_size XOR deltas (see the file comment)
   std::vector<HashCheck> checks;
+  /// The sender holds every player's input (or knows it gone for good) before this frame.
+  std::uint32_t held_frame = 0;
+  std::vector<GoneReport> gone;  ///< every player the sender takes as gone, ascending player
 };
 
 struct PingBody {
