@@ -167,6 +167,21 @@ TEST(DesyncReport, HostileLengthsAreRefusedBeforeAllocating) {
       << r.message();
 }
 
+TEST(DesyncReport, ConfirmedFramesMustCoverEveryStepBeforeTheDivergentFrame) {
+  // What bounds the divergent frame (and what a reader allocates for it) by the file's size.
+  replay::DesyncReport short_log = sample_report();
+  const std::size_t unit = 1 + std::size_t{short_log.fingerprint.players} * 3;
+  std::vector<std::uint8_t>& log = short_log.confirmed_frames;
+  log.erase(log.end() - static_cast<std::ptrdiff_t>(unit), log.end());  // the last frame
+  ASSERT_TRUE(replay::write_desync_report(temp_path("short"), short_log).ok());
+  auto r = replay::read_desync_report(temp_path("short"));
+  std::remove(temp_path("short").c_str());
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.message().find("confirmed frames: expected one frame per step before the divergent"),
+            std::string::npos)
+      << r.message();
+}
+
 TEST(DesyncReport, VersionOneReportsAreStillRead) {
   // Version 1 ends after the divergent bodies: no origin, no intermediate states.
   ASSERT_TRUE(replay::write_desync_report(temp_path("v1"), sample_report()).ok());

@@ -109,7 +109,7 @@ Status load_report(Side& side) {
   DesyncReport& r = read.value();
   side.kind = "desync report";
   side.fp = r.fingerprint;
-  side.last = r.divergent_frame;
+  side.last = r.divergent_frame;  // the reader checked: one confirmed frame per step before it
   side.hashes.assign(side.last + 1, StateHashes{});
   side.known.assign(side.last + 1, 0);
   side.hashes[0].total = side.fp.initial_hash;
@@ -121,10 +121,6 @@ Status load_report(Side& side) {
                        r.confirmed_frames.begin() + static_cast<std::ptrdiff_t>(at) + 1,
                        r.confirmed_frames.begin() + static_cast<std::ptrdiff_t>(at + 1 + unit));
   }
-  if (side.gone.size() < side.last)
-    return Status::error("desync report " + side.path + ": holds the inputs of " +
-                         std::to_string(side.gone.size()) + " steps, not the " +
-                         std::to_string(side.last) + " before its divergent frame");
   side.states[r.agreed_frame] = std::move(r.agreed_state);
   for (FrameState& f : r.intermediate_states)
     side.states[f.frame] = std::move(f.state);

@@ -193,6 +193,8 @@ Expected<DesyncReport> parse_desync_report(std::span<const std::uint8_t> bytes,
       1 + std::uint64_t{report.fingerprint.players} * report.fingerprint.input_size;
   if (r.ok() && report.confirmed_frames.size() % unit != 0)
     r.fail_at(frames_at, "confirmed frames", "whole frames of 1 + players * input size bytes");
+  if (r.ok() && report.confirmed_frames.size() / unit != report.divergent_frame)
+    r.fail_at(frames_at, "confirmed frames", "one frame per step before the divergent frame");
   report.agreed_state = read_bytes(r, "agreed state");
   report.divergent_state = read_bytes(r, "divergent state");
   report.agreed_bodies = read_bodies(r, "agreed body hashes");
