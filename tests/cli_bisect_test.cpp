@@ -128,6 +128,7 @@ TEST(CliBisect, BadUsageExitsWithTwoAndNamesTheProblem) {
       {"verify " + a.path() + " --inject 5:17:position.q:1", "unknown field \"position.q\""},
       {"verify " + a.path() + " --inject 5:17:position.x", "FRAME:BODY:FIELD:DELTA"},
       {"run --scenario arena --frames 100 --inject 500:3:position.x:1", "beyond the run"},
+      {"verify " + a.path() + " --inject 2001:3:position.x:1", "beyond the replay's 2000 frames"},
       {"run --scenario arena --frames 100 --inject 50:999:position.x:1", "no body with ID 999"},
   };
   for (const auto& c : cases) {

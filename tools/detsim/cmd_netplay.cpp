@@ -118,6 +118,10 @@ Status Netplay::start() {
   game_.emplace(*scenario_);
   auto injections = parse_injections(args_.injections);
   if (!injections) return injections.status();
+  for (const Injection& i : injections.value())
+    if (i.frame > args_.frames)
+      return Status::error("--inject " + i.text() + ": frame " + std::to_string(i.frame) +
+                           " is beyond the match's " + std::to_string(args_.frames) + " frames");
   if (!injections->empty()) {
     game_->set_after_step([list = std::move(injections).value()](Scenario& s) {
       return apply_injections(s.world(), list);

@@ -44,6 +44,11 @@ int verify_command(const VerifyArgs& args) {
   auto reader = replay::ReplayReader::open(args.file);
   if (!reader) return usage_error("verify", reader.message());
   const replay::Fingerprint& fp = reader->fingerprint();
+  for (const Injection& i : injections.value())
+    if (i.frame > reader->frame_count())
+      return usage_error("verify", "--inject " + i.text() + ": frame " + std::to_string(i.frame) +
+                                       " is beyond the replay's " +
+                                       std::to_string(reader->frame_count()) + " frames");
   if (args.at > reader->frame_count())
     return usage_error("verify", "--at " + std::to_string(args.at) + ": " + args.file +
                                      " holds frames 1 to " + std::to_string(reader->frame_count()));
