@@ -77,6 +77,8 @@ int verify_command(const VerifyArgs& args) {
       return usage_error("verify", s.message());
     report_line = "this machine's state at frame " + std::to_string(v.report->divergent_frame) +
                   " written to " + args.report;
+  } else if (!args.report.empty() && v.first_mismatch == std::optional<std::uint64_t>{0}) {
+    report_line = "the initial states differ (different runs, not a desync): no report written";
   } else if (!args.report.empty()) {
     report_line =
         "no mismatch, so no report written (--at FRAME writes this machine's state at "
