@@ -41,7 +41,18 @@ struct Side {
   std::map<std::uint64_t, State> states;  ///< a report's states by frame
   std::optional<ReplayReader> replay;     ///< for keyframes
 
-  [[nodiscard]] bool has(std::uint64_t f) const { return f <= last && known[f] != 0; }
+  // Frames index vectors: a frame count is bounded by the bytes read, so it fits size_t.
+  [[nodiscard]] static std::size_t at(std::uint64_t f) { return static_cast<std::size_t>(f); }
+  [[nodiscard]] bool has(std::uint64_t f) const { return f <= last && known[at(f)] != 0; }
+  [[nodiscard]] const StateHashes& hash(std::uint64_t f) const { return hashes[at(f)]; }
+  void set_hash(std::uint64_t f, const StateHashes& h) {
+    hashes[at(f)] = h;
+    known[at(f)] = 1;
+  }
+  /// The "disconnected" byte of a report's step (0 for a replay).
+  [[nodiscard]] std::uint8_t gone_at(std::uint64_t step) const {
+    return gone.empty() ? std::uint8_t{0} : gone[at(step)];
+  }
   [[nodiscard]] std::size_t unit() const { return std::size_t{fp.players} * fp.input_size; }
 
   /// The state this side stored at frame f (a report's, or a replay's keyframe), if any.
@@ -89,12 +100,12 @@ Status load_replay(Side& side) {
   side.kind = "replay";
   side.fp = reader->fingerprint();
   side.last = reader->frame_count();
-  side.hashes.assign(side.last + 1, StateHashes{});
-  side.known.assign(side.last + 1, 1);
+  side.hashes.assign(Side::at(side.last) + 1, StateHashes{});
+  side.known.assign(Side::at(side.last) + 1, 1);
   side.hashes[0].total = side.fp.initial_hash;
-  side.inputs.reserve(side.last * side.unit());
+  side.inputs.reserve(Side::at(side.last) * side.unit());
   Status read = reader->for_each_frame(1, side.last, [&](const FrameRecord& r) {
-    side.hashes[r.frame] = r.hashes;
+    side.hashes[Side::at(r.frame)] = r.hashes;
     side.inputs.insert(side.inputs.end(), r.inputs.begin(), r.inputs.end());
     return true;
   });
@@ -110,8 +121,8 @@ Status load_report(Side& side) {
   side.kind = "desync report";
   side.fp = r.fingerprint;
   side.last = r.divergent_frame;  // the reader checked: one confirmed frame per step before it
-  side.hashes.assign(side.last + 1, StateHashes{});
-  side.known.assign(side.last + 1, 0);
+  side.hashes.assign(Side::at(side.last) + 1, StateHashes{});
+  side.known.assign(Side::at(side.last) + 1, 0);
   side.hashes[0].total = side.fp.initial_hash;
   side.known[0] = 1;
   const std::size_t unit = side.unit();
@@ -133,8 +144,7 @@ Status load_report(Side& side) {
     if (world.frame() != frame)
       return Status::error("desync report " + side.path + ": the state stored for frame " +
                            std::to_string(frame) + " is of frame " + std::to_string(world.frame()));
-    side.hashes[frame] = world.hashes();
-    side.known[frame] = 1;
+    side.set_hash(frame, world.hashes());
   }
   return Status::success();
 }
@@ -221,8 +231,8 @@ std::vector<AgreementSpan> timeline(const Side& a, const Side& b) {
   for (std::uint64_t f = 0; f <= end; ++f) {
     AgreementSpan::State s = AgreementSpan::State::unknown;
     if (a.has(f) && b.has(f))
-      s = a.hashes[f].total == b.hashes[f].total ? AgreementSpan::State::agree
-                                                 : AgreementSpan::State::differ;
+      s = a.hash(f).total == b.hash(f).total ? AgreementSpan::State::agree
+                                             : AgreementSpan::State::differ;
     if (!out.empty() && out.back().state == s && out.back().last + 1 == f) {
       out.back().last = f;
     } else {
@@ -277,7 +287,8 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
   const std::size_t unit = a.unit();
   for (std::uint64_t step = 0; step < common; ++step) {
     const std::size_t at = static_cast<std::size_t>(step) * unit;
-    const bool gone_differs = !a.gone.empty() && !b.gone.empty() && a.gone[step] != b.gone[step];
+    const bool gone_differs =
+        !a.gone.empty() && !b.gone.empty() && a.gone_at(step) != b.gone_at(step);
     const std::span<const std::uint8_t> step_a(a.inputs.data() + at, unit);
     const std::span<const std::uint8_t> step_b(b.inputs.data() + at, unit);
     if (!gone_differs && std::equal(step_a.begin(), step_a.end(), step_b.begin())) continue;
@@ -287,11 +298,11 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
       const std::size_t pa = at + std::size_t{p} * a.fp.input_size;
       const std::span<const std::uint8_t> ia(a.inputs.data() + pa, a.fp.input_size);
       const std::span<const std::uint8_t> ib(b.inputs.data() + pa, a.fp.input_size);
-      const bool flag = gone_differs && (((a.gone[step] ^ b.gone[step]) >> p) & 1U) != 0;
+      const bool flag = gone_differs && (((a.gone_at(step) ^ b.gone_at(step)) >> p) & 1U) != 0;
       if (!flag && std::equal(ia.begin(), ia.end(), ib.begin())) continue;
       r.input_player = p;
-      r.input_a = hex_bytes(ia) + (!a.gone.empty() && ((a.gone[step] >> p) & 1U) ? " (gone)" : "");
-      r.input_b = hex_bytes(ib) + (!b.gone.empty() && ((b.gone[step] >> p) & 1U) ? " (gone)" : "");
+      r.input_a = hex_bytes(ia) + (((a.gone_at(step) >> p) & 1U) != 0 ? " (gone)" : "");
+      r.input_b = hex_bytes(ib) + (((b.gone_at(step) >> p) & 1U) != 0 ? " (gone)" : "");
       break;
     }
     r.timeline = timeline(a, b);
@@ -303,7 +314,7 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
   std::optional<std::uint64_t> divergent;
   for (std::uint64_t f = 1; f <= common; ++f) {
     if (!a.has(f) || !b.has(f)) continue;
-    if (a.hashes[f].total != b.hashes[f].total) {
+    if (a.hash(f).total != b.hash(f).total) {
       divergent = f;
       break;
     }
@@ -354,13 +365,13 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
       keep.insert(f);
     local->step_to(*divergent, keep);
     if (const StateHashes* h = local->hashes(*divergent)) {
-      local_is_a = h->total == a.hashes[*divergent].total;
-      local_is_b = h->total == b.hashes[*divergent].total;
+      local_is_a = h->total == a.hash(*divergent).total;
+      local_is_b = h->total == b.hash(*divergent).total;
       r.local_agrees_with = local_is_a ? "A" : local_is_b ? "B" : "neither";
     }
     // Frames one side has no hash for: that side's hashes are this machine's if it agrees with it.
     const auto hash_of = [&](const Side& s, bool is_local, std::uint64_t f) -> const StateHashes* {
-      if (s.has(f)) return &s.hashes[f];
+      if (s.has(f)) return &s.hash(f);
       return is_local ? local->hashes(f) : nullptr;
     };
     for (std::uint64_t f = last_agreed + 1; f < *divergent; ++f) {
@@ -383,7 +394,7 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
   r.exact = last_agreed + 1 == *divergent;
   candidates.insert(*divergent);
   const auto hashes_at = [&](const Side& s, bool is_local, std::uint64_t f) {
-    if (s.has(f)) return s.hashes[f];
+    if (s.has(f)) return s.hash(f);
     const StateHashes* h = is_local && local ? local->hashes(f) : nullptr;
     return h != nullptr ? *h : StateHashes{};
   };
@@ -411,7 +422,7 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
     local->step_to(f, candidates);
     const State* mine = local->state(f);
     const StateHashes* h = local->hashes(f);
-    if (mine == nullptr || h == nullptr || (s.has(f) && s.hashes[f].total != h->total))
+    if (mine == nullptr || h == nullptr || (s.has(f) && s.hash(f).total != h->total))
       return std::nullopt;
     source = "re-simulated here";
     return *mine;

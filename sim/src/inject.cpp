@@ -22,11 +22,11 @@ constexpr std::string_view kFieldsHelp =
     "its shape 1000 m above); rng.state[0..3] (BODY 0, DELTA an integer, added mod 2^64); "
     "contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2 (DELTA a decimal)";
 
-enum class Kind { fixed, toggle, integer, presence };
+enum class DeltaKind { fixed, toggle, integer, presence };
 
 /// What a field name refers to, once parsed.
 struct Target {
-  Kind kind = Kind::fixed;
+  DeltaKind kind = DeltaKind::fixed;
   enum class Part { body, rng, contact } part = Part::body;
   std::string base;         ///< "position", "sleep_time", "normal_impulse", ...
   int component = -1;       ///< x y z = 0 1 2, w = 3; the RNG word; -1: none
@@ -75,7 +75,7 @@ Expected<Target> parse_field(std::string_view field) {
     auto word = indexed(field.substr(4), "state", rest);
     if (!word || !rest.empty() || *word > 3) return unknown();
     t.part = Target::Part::rng;
-    t.kind = Kind::integer;
+    t.kind = DeltaKind::integer;
     t.component = static_cast<int>(*word);
     return t;
   }
@@ -101,9 +101,9 @@ Expected<Target> parse_field(std::string_view field) {
   }
   if (field == "awake" || field == "user_data" || field == "present") {
     t.base = std::string(field);
-    t.kind = field == "awake"       ? Kind::toggle
-             : field == "user_data" ? Kind::integer
-                                    : Kind::presence;
+    t.kind = field == "awake"       ? DeltaKind::toggle
+             : field == "user_data" ? DeltaKind::integer
+                                    : DeltaKind::presence;
     return t;
   }
   const std::size_t dot = field.rfind('.');
@@ -124,19 +124,19 @@ Expected<Target> parse_field(std::string_view field) {
 
 Status check_delta(const Target& t, std::string_view delta) {
   switch (t.kind) {
-    case Kind::fixed: {
+    case DeltaKind::fixed: {
       const ParseResult r = Fixed::parse(delta);
       if (!r) return Status::error("DELTA \"" + std::string(delta) + "\": " + describe(r.error));
       return Status::success();
     }
-    case Kind::toggle:
+    case DeltaKind::toggle:
       if (delta != "1") return Status::error("DELTA for awake must be 1 (toggle the flag)");
       return Status::success();
-    case Kind::integer:
+    case DeltaKind::integer:
       if (!parse_i64(delta))
         return Status::error("DELTA \"" + std::string(delta) + "\" is not a 64-bit integer");
       return Status::success();
-    case Kind::presence:
+    case DeltaKind::presence:
       if (delta != "-1" && delta != "+1" && delta != "1")
         return Status::error("DELTA for present must be -1 (remove the body) or +1 (add a copy)");
       return Status::success();
@@ -144,22 +144,22 @@ Status check_delta(const Target& t, std::string_view delta) {
   return Status::success();
 }
 
-Fixed& component(Vec3& v, int c) {
+Fixed& field_ref(Vec3& v, int c) {
   return c == 0 ? v.x : c == 1 ? v.y : v.z;
 }
-Fixed& component(Quat& q, int c) {
+Fixed& field_ref(Quat& q, int c) {
   return c == 0 ? q.x : c == 1 ? q.y : c == 2 ? q.z : q.w;
 }
 
 Status change_body(BodyState& b, const Target& t, std::string_view delta) {
   const Fixed d = Fixed::parse(delta).value;
-  if (t.base == "position") component(b.position, t.component) += d;
-  if (t.base == "linear_velocity") component(b.linear_velocity, t.component) += d;
-  if (t.base == "angular_velocity") component(b.angular_velocity, t.component) += d;
-  if (t.base == "force") component(b.force, t.component) += d;
-  if (t.base == "torque") component(b.torque, t.component) += d;
+  if (t.base == "position") field_ref(b.position, t.component) += d;
+  if (t.base == "linear_velocity") field_ref(b.linear_velocity, t.component) += d;
+  if (t.base == "angular_velocity") field_ref(b.angular_velocity, t.component) += d;
+  if (t.base == "force") field_ref(b.force, t.component) += d;
+  if (t.base == "torque") field_ref(b.torque, t.component) += d;
   if (t.base == "orientation") {
-    component(b.orientation, t.component) += d;
+    field_ref(b.orientation, t.component) += d;
     if (auto e = sim_detail::check_orientation(b.orientation); !e.empty())
       return Status::error("the change would leave an invalid state: " + e);
   }
@@ -296,7 +296,7 @@ Status apply_injection(World& world, const Injection& injection) {
     return Status::success();
   }
 
-  if (t.kind == Kind::presence) {
+  if (t.kind == DeltaKind::presence) {
     if (injection.delta != "-1") {
       if (Status st = add_copy(world, body); !st) return Status::error(where + st.message());
       return Status::success();
