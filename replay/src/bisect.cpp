@@ -200,18 +200,11 @@ class Local {
   /// the states of the frames in `keep`.
   void step_to(std::uint64_t to, const std::set<std::uint64_t>& keep) {
     const std::size_t unit = in_.unit();
-    std::vector<PlayerInput> inputs(in_.fp.players);
+    std::vector<PlayerInput> inputs;
     State bytes;
     while (frame() < to && frame() < in_.last) {
-      const std::size_t at = static_cast<std::size_t>(frame()) * unit;
-      const std::uint8_t gone = in_.gone.empty() ? 0 : in_.gone[static_cast<std::size_t>(frame())];
-      for (std::size_t p = 0; p < inputs.size(); ++p) {
-        inputs[p] = (p < 8 && ((gone >> p) & 1U) != 0)
-                        ? PlayerInput{}
-                        : decode_input(std::span<const std::uint8_t, PlayerInput::encoded_size>(
-                              in_.inputs.data() + at + p * PlayerInput::encoded_size,
-                              PlayerInput::encoded_size));
-      }
+      const std::span<const std::uint8_t> step(in_.inputs.data() + Side::at(frame()) * unit, unit);
+      detail::decode_inputs(step, inputs, in_.gone_at(frame()));
       scenario_.step(inputs);
       hashes_[frame()] = scenario_.world().save(bytes);
       if (keep.count(frame()) != 0) states_[frame()] = bytes;

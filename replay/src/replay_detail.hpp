@@ -3,7 +3,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
+#include <vector>
 
 #include <detsim/replay/replay.hpp>
 #include <detsim/sim/bytes.hpp>
@@ -37,6 +39,11 @@ std::string chunk_name(std::uint32_t type);
 void write_fingerprint(const Fingerprint& f, ByteWriter& w);
 /// Reads and validates a fingerprint payload; false with the reader's error set.
 bool read_fingerprint(ByteReader& r, Fingerprint& f);
+/// One frame's inputs of a scenario (players * PlayerInput::encoded_size bytes) decoded into `out`;
+/// a player whose bit is set in `gone` (a desync report's "disconnected" byte) gets the neutral
+/// input.
+void decode_inputs(std::span<const std::uint8_t> bytes, std::vector<PlayerInput>& out,
+                   std::uint8_t gone = 0);
 void encode_hashes(const StateHashes& h, ByteWriter& w);
 StateHashes decode_hashes(ByteReader& r);
 

@@ -14,6 +14,7 @@
 
 namespace detsim::replay {
 
+using detail::decode_inputs;
 using detail::hex64;
 
 namespace {
@@ -24,14 +25,6 @@ void encode_inputs(std::span<const PlayerInput> inputs, std::vector<std::uint8_t
     encode_input(inputs[i],
                  std::span<std::uint8_t, PlayerInput::encoded_size>(
                      out.data() + i * PlayerInput::encoded_size, PlayerInput::encoded_size));
-  }
-}
-
-void decode_inputs(std::span<const std::uint8_t> bytes, std::vector<PlayerInput>& out) {
-  out.resize(bytes.size() / PlayerInput::encoded_size);
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    out[i] = decode_input(std::span<const std::uint8_t, PlayerInput::encoded_size>(
-        bytes.data() + i * PlayerInput::encoded_size, PlayerInput::encoded_size));
   }
 }
 
@@ -95,6 +88,17 @@ std::string fixed_text(Fixed v) {
 }
 
 }  // namespace
+
+void detail::decode_inputs(std::span<const std::uint8_t> bytes, std::vector<PlayerInput>& out,
+                           std::uint8_t gone) {
+  out.resize(bytes.size() / PlayerInput::encoded_size);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = i < 8 && ((gone >> i) & 1U) != 0
+                 ? PlayerInput{}
+                 : decode_input(std::span<const std::uint8_t, PlayerInput::encoded_size>(
+                       bytes.data() + i * PlayerInput::encoded_size, PlayerInput::encoded_size));
+  }
+}
 
 Fingerprint fingerprint_of(const Scenario& scenario, std::uint32_t keyframe_interval) {
   Fingerprint f;
