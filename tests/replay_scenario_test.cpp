@@ -212,6 +212,15 @@ TEST(ScenarioReplay, FingerprintsThisBuildCannotReproduceAreRefused) {
   f.fixed_fraction_bits = 16;
   EXPECT_NE(error_for(f).find("recorded with Q48.16 numbers"), std::string::npos);
   f = good;
+  f.state_version = state_encoding_version - 1;
+  EXPECT_NE(error_for(f).find("recorded with state encoding " +
+                              std::to_string(state_encoding_version - 1) +
+                              " (its hashes and keyframes are of it), this build writes and reads "
+                              "encoding " +
+                              std::to_string(state_encoding_version)),
+            std::string::npos)
+      << error_for(f);
+  f = good;
   f.input_size = 4;
   EXPECT_NE(error_for(f).find("inputs of 4 bytes"), std::string::npos);
   f = good;

@@ -281,5 +281,120 @@ TEST(ByteReader, EveryTruncationOfAMultiFieldRecordFails) {
   }
 }
 
+// ---- Vars: LEB128 and zigzag, canonical only ----
+//
+// Expected bytes from the definition: seven bits per byte, lowest group first, top bit = more
+// follows; a Fixed is the var of (raw << 1) ^ (raw >> 63).
+
+TEST(ByteWriter, VarIsLeb128) {
+  EXPECT_EQ(written([](ByteWriter& w) { w.var(0); }), (Bytes{0x00}));
+  EXPECT_EQ(written([](ByteWriter& w) { w.var(127); }), (Bytes{0x7F}));
+  EXPECT_EQ(written([](ByteWriter& w) { w.var(128); }), (Bytes{0x80, 0x01}));
+  EXPECT_EQ(written([](ByteWriter& w) { w.var(300); }), (Bytes{0xAC, 0x02}));
+  EXPECT_EQ(written([](ByteWriter& w) { w.var(0xFFFFFFFFU); }),
+            (Bytes{0xFF, 0xFF, 0xFF, 0xFF, 0x0F}));
+  EXPECT_EQ(written([](ByteWriter& w) { w.var(~std::uint64_t{0}); }),
+            (Bytes{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x01}));
+}
+
+TEST(ByteWriter, VarFixedIsTheVarOfItsZigzagRaw) {
+  EXPECT_EQ(written([](ByteWriter& w) { w.var_fixed(Fixed::zero()); }), (Bytes{0x00}));
+  EXPECT_EQ(written([](ByteWriter& w) { w.var_fixed(Fixed::from_raw(-1)); }), (Bytes{0x01}));
+  EXPECT_EQ(written([](ByteWriter& w) { w.var_fixed(Fixed::from_raw(1)); }), (Bytes{0x02}));
+  EXPECT_EQ(written([](ByteWriter& w) { w.var_fixed(Fixed::from_raw(-64)); }), (Bytes{0x7F}));
+  EXPECT_EQ(written([](ByteWriter& w) { w.var_fixed(Fixed::from_raw(64)); }), (Bytes{0x80, 0x01}));
+  // 1.0 = 2^32 -> 2^33: 33 bits in five groups of seven, the last holding bits 28..32 (= 2).
+  EXPECT_EQ(written([](ByteWriter& w) { w.var_fixed(1_fx); }),
+            (Bytes{0x80, 0x80, 0x80, 0x80, 0x20}));
+  // The extremes: max -> 2^64 - 2, min -> 2^64 - 1; ten bytes each.
+  EXPECT_EQ(written([](ByteWriter& w) { w.var_fixed(Fixed::max()); }),
+            (Bytes{0xFE, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x01}));
+  EXPECT_EQ(written([](ByteWriter& w) { w.var_fixed(Fixed::min()); }),
+            (Bytes{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x01}));
+}
+
+TEST(ByteReader, VarsReadBackEveryValueTheyWrite) {
+  const std::vector<std::int64_t> raws = {0,
+                                          1,
+                                          -1,
+                                          63,
+                                          -64,
+                                          64,
+                                          -65,
+                                          Fixed::one_raw,
+                                          -Fixed::one_raw,
+                                          std::numeric_limits<std::int64_t>::max(),
+                                          std::numeric_limits<std::int64_t>::min(),
+                                          0x123456789ABCDEF0,
+                                          -0x123456789ABCDEF0};
+  ByteWriter w;
+  for (const std::int64_t raw : raws) {
+    w.var_fixed(Fixed::from_raw(raw));
+    w.var(static_cast<std::uint64_t>(raw));
+  }
+  w.var(0xFFFFFFFFU);
+  w.var_vec3({1_fx, -2_fx, 0.5_fx});
+  w.var_quat(Quat{});
+  ByteReader r(w.bytes());
+  for (const std::int64_t raw : raws) {
+    EXPECT_EQ(r.var_fixed("f").raw(), raw);
+    EXPECT_EQ(r.var("u"), static_cast<std::uint64_t>(raw));
+  }
+  EXPECT_EQ(r.var32("u32"), 0xFFFFFFFFU);
+  EXPECT_EQ(r.var_vec3("v"), (Vec3{1_fx, -2_fx, 0.5_fx}));
+  EXPECT_EQ(r.var_quat("q"), Quat{});
+  EXPECT_TRUE(r.ok()) << r.error();
+  EXPECT_TRUE(r.at_end());
+}
+
+// Every value has one encoding: longer forms of the same number, and numbers too wide for the
+// field, are refused at the var's first byte.
+TEST(ByteReader, VarRefusesAllButTheShortestFormAndValuesTooWide) {
+  const auto refused = [](const Bytes& bytes, unsigned bits) {
+    ByteReader r(bytes);
+    if (bits == 32)
+      (void)r.var32("count");
+    else
+      (void)r.var("count");
+    return r.ok() ? std::string("accepted") : r.error();
+  };
+  EXPECT_EQ(refused({0x80, 0x00}, 64), "byte 0: count: expected the shortest form of a var");
+  EXPECT_EQ(refused({0x81, 0x80, 0x00}, 64), "byte 0: count: expected the shortest form of a var");
+  EXPECT_EQ(refused({0x80, 0x80, 0x80, 0x80, 0x10}, 32),
+            "byte 0: count: expected a var of at most 32 bits");  // 2^32
+  EXPECT_EQ(refused({0x80, 0x80, 0x80, 0x80, 0x80, 0x01}, 32),
+            "byte 0: count: expected a var of at most 32 bits");  // six bytes
+  EXPECT_EQ(refused({0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x02}, 64),
+            "byte 0: count: expected a var of at most 64 bits");  // 2^64
+  EXPECT_EQ(refused({0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x80, 0x00}, 64),
+            "byte 0: count: expected a var of at most 64 bits");  // eleven bytes
+  EXPECT_EQ(refused({0x80}, 64), "byte 1: count: expected more bytes (the data ends here)");
+  EXPECT_EQ(refused({0xFF, 0xFF, 0xFF, 0xFF, 0x0F}, 32), "accepted");
+  EXPECT_EQ(refused({0x00}, 32), "accepted");
+}
+
+// Every encoding the writer can produce for a var of one or two bytes, and every two-byte input:
+// the reader accepts exactly the writer's outputs.
+TEST(ByteReader, AcceptedTwoByteVarsAreExactlyTheWritersOutputs) {
+  for (unsigned b0 = 0; b0 < 256; ++b0) {
+    for (unsigned b1 = 0; b1 < 256; ++b1) {
+      const Bytes bytes{static_cast<std::uint8_t>(b0), static_cast<std::uint8_t>(b1)};
+      ByteReader r(bytes);
+      const std::uint64_t v = r.var("v");
+      const bool one_byte = b0 < 0x80;
+      if (one_byte) {
+        ASSERT_TRUE(r.ok());
+        ASSERT_EQ(r.offset(), 1U);
+        ASSERT_EQ(v, b0);
+        continue;
+      }
+      if (!r.ok()) continue;
+      ByteWriter w;
+      w.var(v);
+      ASSERT_EQ(w.bytes(), bytes) << b0 << " " << b1;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace detsim

@@ -2,9 +2,12 @@
 //
 // - A restored world is the saved world: the same bytes, the same hashes, and the same hash on
 //   every later frame as a run that never saved.
-// - The bytes are canonical: the v1 layout is decoded here by an independent reader and compared
-//   field by field with what the public API reports; the hashes are recomputed with xxHash itself.
-// - Bad bytes are refused (sim_state_restore_test.cpp).
+// - The bytes are canonical: the v2 layout is decoded here by an independent codec
+//   (support/state_codec.hpp) and compared field by field with what the public API reports, and
+//   the bytes the accessors imply are encoded and compared with save(); the hashes are recomputed
+//   with xxHash itself.
+// - Bad bytes are refused (sim_state_restore_test.cpp); what version 2 adds to the layout (vars,
+//   property sets, flags, steps) is tested in sim_state_v2_codec_test.cpp.
 //
 // Worlds are built through the public API only.
 #include <cstdint>
@@ -34,18 +37,25 @@ TEST(StateFormat, DefaultWorldStartsWithMagicAndVersion) {
   EXPECT_EQ(bytes[1], 'S');
   EXPECT_EQ(bytes[2], 'I');
   EXPECT_EQ(bytes[3], 'M');
-  EXPECT_EQ((Bytes(bytes.begin() + 4, bytes.begin() + 8)), (Bytes{1, 0, 0, 0}));
+  EXPECT_EQ((Bytes(bytes.begin() + 4, bytes.begin() + 8)), (Bytes{2, 0, 0, 0}));
+  EXPECT_EQ(state_encoding_version, 2U);
   // Then frame 0 (u64) and the next body ID, 1 (u32).
   EXPECT_EQ((Bytes(bytes.begin() + 8, bytes.begin() + 20)),
             (Bytes{0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0}));
-  // magic 4 + version 4 + frame 8 + next ID 4 + definition 137 + RNG 32 + two empty counts 8.
-  EXPECT_EQ(bytes.size(), 197U);
-  EXPECT_EQ((Bytes(bytes.end() - 8, bytes.end())), (Bytes{0, 0, 0, 0, 0, 0, 0, 0}));
+  // magic 4 + version 4 + frame 8 + next ID 4 + definition 137 + RNG 32 + three empty counts
+  // (property sets, bodies, contacts) 12.
+  EXPECT_EQ(bytes.size(), 4U + 4 + 8 + 4 + kDefinitionBytes + 32 + 12);
+  EXPECT_EQ(bytes.size(), 201U);
+  EXPECT_EQ((Bytes(bytes.end() - 12, bytes.end())), Bytes(12, 0));
 
   const Decoded d = decode(bytes);
   ASSERT_TRUE(d.ok) << d.error;
   EXPECT_EQ(d.def, WorldDef{});
   EXPECT_EQ(d.rng, Rng(0).state());
+  EXPECT_EQ(d.rng_at, 20 + kDefinitionBytes);
+  EXPECT_EQ(d.property_count_at, d.rng_at + 32);
+  EXPECT_TRUE(d.sets.empty() && d.bodies.empty() && d.contacts.empty());
+  EXPECT_EQ(encode(d), bytes);
 }
 
 TEST(StateFormat, DecodesToExactlyWhatTheWorldReports) {
@@ -64,35 +74,78 @@ TEST(StateFormat, DecodesToExactlyWhatTheWorldReports) {
   for (std::size_t i = 0; i < ids.size(); ++i) {
     const Expected<BodyState> b = w.body(ids[i]);
     ASSERT_TRUE(b.ok());
-    EXPECT_TRUE(d.bodies[i] == b.value()) << "body " << ids[i].value << " decodes differently";
-    if (i > 0) {
-      EXPECT_LT(d.bodies[i - 1].id, d.bodies[i].id);
-    }
+    EXPECT_EQ(d.bodies[i].id, ids[i]);
+    EXPECT_TRUE(body_state(d, i) == b.value()) << "body " << ids[i].value << " decodes differently";
+  }
+  // Bodies that differ only in their motion share a set: of the three stacked boxes only the top
+  // one has CCD, so the playground's 11 bodies use 10 sets.
+  ASSERT_EQ(d.bodies.size(), 11U);
+  EXPECT_EQ(d.sets.size(), 10U);
+  EXPECT_EQ(d.bodies[4].set, d.bodies[5].set);
+  EXPECT_NE(d.bodies[5].set, d.bodies[6].set);
+
+  // The contacts, as contacts() reports them (touching is "has points").
+  const std::vector<ContactState> cache = w.contacts();
+  ASSERT_EQ(d.contacts.size(), cache.size());
+  for (std::size_t i = 0; i < cache.size(); ++i) {
+    SCOPED_TRACE(testing::Message() << "contact " << cache[i].a.value << "-" << cache[i].b.value);
+    const ContactState c = contact_state(d.contacts[i]);
+    EXPECT_EQ(c.a, cache[i].a);
+    EXPECT_EQ(c.b, cache[i].b);
+    EXPECT_EQ(c.touching, cache[i].touching);
+    EXPECT_EQ(c.reported, cache[i].reported);
+    ASSERT_EQ(c.point_count, cache[i].point_count);
+    for (std::size_t p = 0; p < c.point_count; ++p)
+      EXPECT_EQ(c.points[p], cache[i].points[p]) << "point " << p;
   }
   // The scene must exercise what the state carries: contacts (touching, with points), sleeping
-  // bodies, and a kinematic body in motion.
+  // bodies, a kinematic body in motion, and user data.
   ASSERT_FALSE(d.contacts.empty());
   std::size_t touching = 0;
   std::size_t reported = 0;
-  for (std::size_t i = 0; i < d.contacts.size(); ++i) {
-    const DecodedContact& c = d.contacts[i];
-    EXPECT_LT(c.a, c.b);
-    EXPECT_TRUE(w.contains(BodyId{c.a}) && w.contains(BodyId{c.b}));
-    if (i > 0) {
-      const DecodedContact& p = d.contacts[i - 1];
-      EXPECT_TRUE(p.a < c.a || (p.a == c.a && p.b < c.b)) << "contacts not in ascending order";
-    }
-    touching += c.touching ? 1 : 0;
-    reported += c.reported ? 1 : 0;
-    EXPECT_EQ(c.touching, c.point_count > 0);
-    EXPECT_TRUE(c.touching || !c.reported);
+  for (const DecodedContact& c : d.contacts) {
+    touching += c.point_count() > 0 ? 1U : 0U;
+    reported += c.reported() ? 1U : 0U;
   }
   EXPECT_GE(touching, 5U);
   EXPECT_GE(reported, 5U);
-  const auto asleep = std::count_if(d.bodies.begin(), d.bodies.end(), [](const BodyState& b) {
-    return b.type == BodyType::dynamic && !b.awake;
-  });
-  EXPECT_GE(asleep, 3) << "the scene should have sleeping bodies by frame 300";
+  std::size_t asleep = 0;
+  std::size_t moving_kinematic = 0;
+  for (std::size_t i = 0; i < d.bodies.size(); ++i) {
+    const BodyState b = body_state(d, i);
+    asleep += b.type == BodyType::dynamic && !b.awake ? 1U : 0U;
+    moving_kinematic += b.type == BodyType::kinematic && b.linear_velocity != Vec3{} ? 1U : 0U;
+  }
+  EXPECT_GE(asleep, 3U) << "the scene should have sleeping bodies by frame 300";
+  EXPECT_EQ(moving_kinematic, 1U);
+  EXPECT_EQ(d.bodies[2].user_data, 0xDEADBEEFCAFEF00DU);
+  EXPECT_EQ(d.bodies[2].flags & kHasUserData, kHasUserData);
+}
+
+TEST(StateFormat, SavesExactlyWhatTheAccessorsImply) {
+  // The encoding built from body(), contacts(), rng(), def() and frame() by the test codec (sets
+  // deduplicated in first-use order, flags from the values, steps from the IDs) is save()'s.
+  std::vector<World> worlds;
+  worlds.emplace_back();
+  worlds.push_back(playground(1));
+  worlds.push_back(played_once(2, 60));
+  worlds.push_back(settled());
+  World destroyed = settled();
+  ASSERT_TRUE(destroyed.destroy_body(BodyId{2}).ok());  // the first user of the second set
+  worlds.push_back(destroyed);
+  World pushed = settled();
+  ASSERT_TRUE(pushed.apply_force(BodyId{3}, {1_fx, -2_fx, 0_fx}).ok());
+  ASSERT_TRUE(pushed.apply_torque(BodyId{4}, {0_fx, 0_fx, -0.5_fx}).ok());
+  worlds.push_back(pushed);
+  for (std::size_t i = 0; i < worlds.size(); ++i) {
+    SCOPED_TRACE(testing::Message() << "world " << i);
+    const Bytes bytes = worlds[i].save();
+    const Decoded d = decode(bytes);
+    ASSERT_TRUE(d.ok) << d.error;
+    const Bytes expected = encode(expected_encoding(worlds[i], d.next_id));
+    EXPECT_TRUE(expected == bytes) << "save() differs from the encoding its accessors imply ("
+                                   << bytes.size() << " bytes, expected " << expected.size() << ")";
+  }
 }
 
 TEST(StateFormat, HashesAreXxh3OfTheCanonicalSections) {
@@ -105,17 +158,28 @@ TEST(StateFormat, HashesAreXxh3OfTheCanonicalSections) {
   const std::span<const std::uint8_t> all(bytes);
   const StateHashes h = w.hashes();
   EXPECT_EQ(h.total, xxh3(all));
+  // globals: from the frame to the end of the definition; rng; bodies: from the property-set
+  // count to the end of the last body; contacts: from the contact count to the end.
+  EXPECT_EQ(d.globals_at, 8U);
   EXPECT_EQ(h.globals, xxh3(all.subspan(d.globals_at, d.rng_at - d.globals_at)));
-  EXPECT_EQ(h.rng, xxh3(all.subspan(d.rng_at, d.body_count_at - d.rng_at)));
-  EXPECT_EQ(h.bodies, xxh3(all.subspan(d.body_count_at, d.contact_count_at - d.body_count_at)));
+  EXPECT_EQ(h.rng, xxh3(all.subspan(d.rng_at, d.property_count_at - d.rng_at)));
+  EXPECT_EQ(d.bodies.back().end, d.contact_count_at);
+  EXPECT_EQ(h.bodies,
+            xxh3(all.subspan(d.property_count_at, d.contact_count_at - d.property_count_at)));
   EXPECT_EQ(h.contacts, xxh3(all.subspan(d.contact_count_at)));
+  // body_hash: the body's set, then its record as if it were the only body.
   for (std::size_t i = 0; i < d.bodies.size(); ++i) {
-    const std::size_t end = i + 1 < d.bodies.size() ? d.body_at[i + 1] : d.contact_count_at;
     const Expected<std::uint64_t> bh = w.body_hash(d.bodies[i].id);
     ASSERT_TRUE(bh.ok());
-    EXPECT_EQ(bh.value(), xxh3(all.subspan(d.body_at[i], end - d.body_at[i])))
-        << "body " << d.bodies[i].id.value;
+    EXPECT_EQ(bh.value(), expected_body_hash(d, i)) << "body " << d.bodies[i].id.value;
   }
+  // For the first body, "as if alone" is what is written: its set and record are in the bytes.
+  ASSERT_EQ(d.bodies[0].set, 0U);
+  Bytes first(all.begin() + static_cast<std::ptrdiff_t>(d.sets[0].at),
+              all.begin() + static_cast<std::ptrdiff_t>(d.sets[0].end));
+  first.insert(first.end(), all.begin() + static_cast<std::ptrdiff_t>(d.bodies[0].at),
+               all.begin() + static_cast<std::ptrdiff_t>(d.bodies[0].end));
+  EXPECT_EQ(w.body_hash(d.bodies[0].id).value(), xxh3(first));
 }
 
 // ======================================================================================
@@ -330,15 +394,15 @@ TEST(StateHashes, EachPartHasItsOwnHash) {
   }
   {
     // The contacts: one warm-start impulse changed (through the bytes; no API edits contacts).
-    Bytes bytes = base.save();
-    const Decoded d = decode(bytes);
-    ASSERT_TRUE(d.ok);
+    Decoded d = decode(base.save());
+    ASSERT_TRUE(d.ok) << d.error;
     const auto touching = std::find_if(d.contacts.begin(), d.contacts.end(),
-                                       [](const DecodedContact& c) { return c.point_count > 0; });
+                                       [](const DecodedContact& c) { return c.point_count() > 0; });
     ASSERT_NE(touching, d.contacts.end());
-    bytes[touching->first_impulse_at] ^= 1;
+    touching->points[0].normal_impulse += Fixed::epsilon();
     World w;
-    ASSERT_TRUE(w.restore(bytes).ok());
+    const Status st = w.restore(encode(d));
+    ASSERT_TRUE(st.ok()) << st.message();
     const HashSnapshot after = snapshot(w);
     EXPECT_NE(after.world.total, before.world.total);
     EXPECT_NE(after.world.contacts, before.world.contacts);
@@ -354,6 +418,45 @@ TEST(StateHashes, EachPartHasItsOwnHash) {
     EXPECT_NE(w.hashes().globals, before.world.globals);
     EXPECT_NE(w.hashes().total, before.world.total);
   }
+}
+
+TEST(StateHashes, BodyHashDoesNotDependOnTheOtherBodies) {
+  // Boxes 2, 3 and 4 share a set. Making box 2 kinematic gives it a set of its own, listed first,
+  // which moves the others' set index from 0 to 1 in the bytes; destroying the plane moves every
+  // body's ID step. Neither may change the other bodies' hashes.
+  World w = make_world(WorldDef{});
+  const BodyId plane = add(w, {.type = BodyType::static_body, .shape = Shape::plane()});
+  std::vector<BodyId> boxes;
+  for (int i = 0; i < 3; ++i) {
+    boxes.push_back(add(w, {.shape = Shape::box({0.5_fx, 0.5_fx, 0.5_fx}),
+                            .position = {Fixed::from_int(3 * i), 2_fx, 0_fx}}));
+  }
+  const auto hash = [&](BodyId id) { return w.body_hash(id).value(); };
+  const std::uint64_t box3 = hash(boxes[1]);
+  const std::uint64_t box4 = hash(boxes[2]);
+  Decoded d = decode(w.save());
+  ASSERT_TRUE(d.ok) << d.error;
+  ASSERT_EQ(d.sets.size(), 2U);
+  EXPECT_EQ(d.bodies[3].set, 1U);
+
+  ASSERT_TRUE(w.set_type(boxes[0], BodyType::kinematic).ok());
+  d = decode(w.save());
+  ASSERT_TRUE(d.ok) << d.error;
+  ASSERT_EQ(d.sets.size(), 3U);
+  EXPECT_EQ(d.sets[1].type, BodyType::kinematic);
+  EXPECT_EQ(d.bodies[3].set, 2U);
+  EXPECT_EQ(hash(boxes[1]), box3);
+  EXPECT_EQ(hash(boxes[2]), box4);
+
+  ASSERT_TRUE(w.destroy_body(plane).ok());
+  d = decode(w.save());
+  ASSERT_TRUE(d.ok) << d.error;
+  EXPECT_EQ(d.bodies[0].id_step, 2U);
+  EXPECT_EQ(d.bodies[0].set, 0U);
+  EXPECT_EQ(hash(boxes[1]), box3);
+  EXPECT_EQ(hash(boxes[2]), box4);
+  for (std::size_t i = 0; i < d.bodies.size(); ++i)
+    EXPECT_EQ(hash(d.bodies[i].id), expected_body_hash(d, i)) << "body " << d.bodies[i].id.value;
 }
 
 TEST(StateHashes, BodyHashOfAnUnknownIdIsAnError) {

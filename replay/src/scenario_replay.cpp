@@ -128,6 +128,11 @@ Expected<Scenario> scenario_of(const Fingerprint& f, const std::string& name) {
     return Status::error(where + "recorded with Q" + std::to_string(64 - f.fixed_fraction_bits) +
                          "." + std::to_string(f.fixed_fraction_bits) +
                          " numbers, this build computes in Q32.32");
+  if (f.state_version != state_encoding_version)
+    return Status::error(
+        where + "recorded with state encoding " + std::to_string(f.state_version) +
+        " (its hashes and keyframes are of it), " + "this build writes and reads encoding " +
+        std::to_string(state_encoding_version) + "; detsim " + f.detsim_version + " recorded it");
   if (find_scenario(f.scenario) == nullptr)
     return Status::error(where + "scenario \"" + f.scenario +
                          "\" is not one of this build's scenarios (detsim scenarios lists them)");

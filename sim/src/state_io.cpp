@@ -1,11 +1,16 @@
 // The canonical state encoding (docs/STATE.md): save, restore and the hashes.
 //
 // Writer and reader of each part sit side by side so that a field added to one is seen missing
-// from the other. Every integer is little-endian and of a fixed width; Fixed is its raw int64; bool
-// is one byte 0/1; enums are one byte. The restore reads into a scratch WorldState and validates
-// every field before the world is replaced, so bad bytes change nothing.
+// from the other. The globals and the RNG are fixed-width little-endian; the bodies and contacts,
+// which are most of a snapshot, use vars (bytes.hpp) and write what bodies share once, in property
+// sets. The restore reads into a scratch WorldState and validates every field before the world is
+// replaced, so bad bytes change nothing; it accepts only canonical bytes (the shortest vars, sets
+// in first-use order, flags that match their values), so a state has exactly one encoding.
 #include <xxhash.h>
 #include <algorithm>
+#include <string_view>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "world_state.hpp"
 
@@ -19,8 +24,21 @@ constexpr std::uint32_t kMagic = 0x4D495344;  // "DSIM" read as little-endian by
 constexpr std::uint32_t kVersion = state_encoding_version;
 
 // Smallest encodings, to bound counts by the bytes that remain before allocating.
-constexpr std::size_t kMinBodyBytes = 4 + 1 + 1 + 8 * 2 + 8 * 3;
-constexpr std::size_t kMinContactBytes = 4 + 4 + 1 + 1;
+constexpr std::size_t kMinPropertyBytes = 1 + 1 + 1 + 3 + 4 + 4 + 4 + 1;
+constexpr std::size_t kMinBodyBytes = 1 + 1 + 1 + 3 + 4 + 3 + 3 + 1;
+constexpr std::size_t kMinContactBytes = 1 + 1 + 1;
+
+// Body flags.
+constexpr std::uint8_t kAwake = 1;
+constexpr std::uint8_t kHasUserData = 2;
+constexpr std::uint8_t kHasForce = 4;
+constexpr std::uint8_t kHasTorque = 8;
+// Property-set flags.
+constexpr std::uint8_t kSensor = 1;
+constexpr std::uint8_t kCcd = 2;
+// A contact's point byte: the count in bits 0-2, then the reported flag.
+constexpr std::uint8_t kPointCountMask = 7;
+constexpr std::uint8_t kReported = 8;
 
 std::uint64_t xxh3(const std::vector<std::uint8_t>& bytes) {
   return XXH3_64bits(bytes.data(), bytes.size());
@@ -72,14 +90,14 @@ void write_shape(const Shape& s, ByteWriter& w) {
   w.u8(static_cast<std::uint8_t>(s.type));
   switch (s.type) {
     case ShapeType::sphere:
-      w.fixed(s.radius);
+      w.var_fixed(s.radius);
       break;
     case ShapeType::box:
-      w.vec3(s.half_extents);
+      w.var_vec3(s.half_extents);
       break;
     case ShapeType::capsule:
-      w.fixed(s.radius);
-      w.fixed(s.half_height);
+      w.var_fixed(s.radius);
+      w.var_fixed(s.half_height);
       break;
     case ShapeType::plane:
       break;
@@ -87,91 +105,193 @@ void write_shape(const Shape& s, ByteWriter& w) {
 }
 
 Shape read_shape(ByteReader& r) {
+  const std::size_t type_at = r.offset();
   const std::uint8_t type = r.u8("shape type");
   switch (type) {
     case static_cast<std::uint8_t>(ShapeType::sphere):
-      return Shape::sphere(r.fixed("sphere radius"));
+      return Shape::sphere(r.var_fixed("sphere radius"));
     case static_cast<std::uint8_t>(ShapeType::box):
-      return Shape::box(r.vec3("box half extents"));
+      return Shape::box(r.var_vec3("box half extents"));
     case static_cast<std::uint8_t>(ShapeType::capsule): {
-      const Fixed radius = r.fixed("capsule radius");
-      return Shape::capsule(radius, r.fixed("capsule half height"));
+      const Fixed radius = r.var_fixed("capsule radius");
+      return Shape::capsule(radius, r.var_fixed("capsule half height"));
     }
     case static_cast<std::uint8_t>(ShapeType::plane):
       return Shape::plane();
     default:
-      r.fail("shape type", "1 (sphere), 2 (box), 3 (capsule) or 4 (plane)");
+      r.fail_at(type_at, "shape type", "1 (sphere), 2 (box), 3 (capsule) or 4 (plane)");
       return {};
   }
 }
 
-BodyState read_body(ByteReader& r) {
-  BodyState b;
-  b.id = BodyId{r.u32("body id")};
+// ---- Property sets: what a body has that the simulation never changes by itself ----
+
+bool same_properties(const BodyState& a, const BodyState& b) noexcept {
+  return a.type == b.type && a.shape == b.shape && a.mass == b.mass && a.inertia == b.inertia &&
+         a.friction == b.friction && a.restitution == b.restitution &&
+         a.linear_damping == b.linear_damping && a.angular_damping == b.angular_damping &&
+         a.layer == b.layer && a.mask == b.mask && a.sensor == b.sensor && a.ccd == b.ccd;
+}
+
+void write_properties(const BodyState& b, ByteWriter& w) {
+  w.u8(static_cast<std::uint8_t>(b.type));
+  write_shape(b.shape, w);
+  w.var_fixed(b.mass);
+  w.var_vec3(b.inertia);
+  w.var_fixed(b.friction);
+  w.var_fixed(b.restitution);
+  w.var_fixed(b.linear_damping);
+  w.var_fixed(b.angular_damping);
+  w.u32(b.layer);
+  w.u32(b.mask);
+  w.u8(static_cast<std::uint8_t>((b.sensor ? kSensor : 0U) | (b.ccd ? kCcd : 0U)));
+}
+
+/// Reads a property set into the property fields of `b`.
+void read_properties(ByteReader& r, BodyState& b) {
+  const std::size_t type_at = r.offset();
   const std::uint8_t type = r.u8("body type");
   if (type > static_cast<std::uint8_t>(BodyType::dynamic))
-    r.fail("body type", "0 (static), 1 (kinematic) or 2 (dynamic)");
+    r.fail_at(type_at, "body type", "0 (static), 1 (kinematic) or 2 (dynamic)");
   b.type = static_cast<BodyType>(type);
   b.shape = read_shape(r);
-  b.position = r.vec3("body position");
-  b.orientation = r.quat("body orientation");
-  b.linear_velocity = r.vec3("body linear velocity");
-  b.angular_velocity = r.vec3("body angular velocity");
-  b.mass = r.fixed("body mass");
-  b.inertia = r.vec3("body inertia");
-  b.friction = r.fixed("body friction");
-  b.restitution = r.fixed("body restitution");
-  b.linear_damping = r.fixed("body linear damping");
-  b.angular_damping = r.fixed("body angular damping");
+  b.mass = r.var_fixed("body mass");
+  b.inertia = r.var_vec3("body inertia");
+  b.friction = r.var_fixed("body friction");
+  b.restitution = r.var_fixed("body restitution");
+  b.linear_damping = r.var_fixed("body linear damping");
+  b.angular_damping = r.var_fixed("body angular damping");
   b.layer = r.u32("body layer");
   b.mask = r.u32("body mask");
-  b.sensor = r.boolean("body sensor flag");
-  b.ccd = r.boolean("body ccd flag");
-  b.user_data = r.u64("body user data");
-  b.awake = r.boolean("body awake flag");
-  b.sleep_time = r.fixed("body sleep time");
-  b.force = r.vec3("body force");
-  b.torque = r.vec3("body torque");
-  return b;
-}
-
-Contact read_contact(ByteReader& r) {
-  Contact c;
-  c.a = r.u32("contact body a");
-  c.b = r.u32("contact body b");
   const std::size_t flags_at = r.offset();
-  const std::uint8_t flags = r.u8("contact flags");
-  if (flags > 3) r.fail_at(flags_at, "contact flags", "only bits 0 (touching) and 1 (reported)");
-  c.touching = (flags & 1U) != 0;
-  c.reported = (flags & 2U) != 0;
-  c.point_count = r.u8("contact point count");
-  if (c.point_count > 4) {
-    r.fail("contact point count", "at most 4");
-    return c;
-  }
-  for (std::size_t p = 0; p < c.point_count; ++p) {
-    c.cached[p].feature = r.u32("contact feature");
-    c.cached[p].normal_impulse = r.fixed("contact normal impulse");
-    c.cached[p].tangent_impulse_1 = r.fixed("contact tangent impulse");
-    c.cached[p].tangent_impulse_2 = r.fixed("contact tangent impulse");
-  }
-  return c;
+  const std::uint8_t flags = r.u8("property flags");
+  if (flags > (kSensor | kCcd))
+    r.fail_at(flags_at, "property flags", "only bits 0 (sensor), 1 (CCD)");
+  b.sensor = (flags & kSensor) != 0;
+  b.ccd = (flags & kCcd) != 0;
 }
 
-// Semantic checks of a body read from bytes; "" when valid.
-std::string check_body(const BodyState& b) {
+// Semantic checks of a property set read from bytes; "" when valid.
+std::string check_properties(const BodyState& b) {
   if (auto e = check_shape(b.shape, b.type); !e.empty()) return e;
-  if (auto e = check_orientation(b.orientation); !e.empty()) return e;
   if (b.mass < Fixed::zero()) return "mass must be >= 0";
   if (b.type == BodyType::dynamic && (b.mass <= Fixed::zero() || b.inertia.x <= Fixed::zero() ||
                                       b.inertia.y <= Fixed::zero() || b.inertia.z <= Fixed::zero()))
     return "a dynamic body needs a positive mass and moments of inertia";
   if (b.friction < Fixed::zero() || b.restitution < Fixed::zero() || b.restitution > Fixed::one() ||
-      b.linear_damping < Fixed::zero() || b.angular_damping < Fixed::zero() ||
-      b.sleep_time < Fixed::zero())
+      b.linear_damping < Fixed::zero() || b.angular_damping < Fixed::zero())
     return "material or damping out of range";
+  return {};
+}
+
+// ---- Bodies: the ID step, the property set, then what moves ----
+
+/// Writes the record of `b`, whose ID follows `previous_id` and whose property set is `set`.
+void write_record(const BodyState& b, std::uint32_t previous_id, std::uint32_t set, ByteWriter& w) {
+  const bool has_force = b.force != Vec3{};
+  const bool has_torque = b.torque != Vec3{};
+  w.var(b.id.value - previous_id);
+  w.var(set);
+  w.u8(static_cast<std::uint8_t>((b.awake ? kAwake : 0U) | (b.user_data != 0 ? kHasUserData : 0U) |
+                                 (has_force ? kHasForce : 0U) | (has_torque ? kHasTorque : 0U)));
+  w.var_vec3(b.position);
+  w.var_quat(b.orientation);
+  w.var_vec3(b.linear_velocity);
+  w.var_vec3(b.angular_velocity);
+  w.var_fixed(b.sleep_time);
+  if (b.user_data != 0) w.var(b.user_data);
+  if (has_force) w.var_vec3(b.force);
+  if (has_torque) w.var_vec3(b.torque);
+}
+
+/// Reads a body record into `b` (not its property fields); `id_step` and `set` are returned for
+/// the caller to check against the bodies and sets before it.
+void read_record(ByteReader& r, BodyState& b, std::uint32_t& id_step, std::uint32_t& set) {
+  id_step = r.var32("body id step");
+  set = r.var32("body property set");
+  const std::size_t flags_at = r.offset();
+  const std::uint8_t flags = r.u8("body flags");
+  if (flags > (kAwake | kHasUserData | kHasForce | kHasTorque))
+    r.fail_at(flags_at, "body flags", "only bits 0 (awake), 1 (user data), 2 (force), 3 (torque)");
+  b.awake = (flags & kAwake) != 0;
+  b.position = r.var_vec3("body position");
+  b.orientation = r.var_quat("body orientation");
+  b.linear_velocity = r.var_vec3("body linear velocity");
+  b.angular_velocity = r.var_vec3("body angular velocity");
+  b.sleep_time = r.var_fixed("body sleep time");
+  // A value flagged present must not be zero: zero is written by leaving the flag clear.
+  const auto present = [&](const char* what, bool nonzero) {
+    if (!nonzero) r.fail_at(flags_at, what, "a value that is not zero when its flag is set");
+  };
+  b.user_data = 0;
+  b.force = {};
+  b.torque = {};
+  if ((flags & kHasUserData) != 0) {
+    b.user_data = r.var("body user data");
+    present("body user data", b.user_data != 0);
+  }
+  if ((flags & kHasForce) != 0) {
+    b.force = r.var_vec3("body force");
+    present("body force", b.force != Vec3{});
+  }
+  if ((flags & kHasTorque) != 0) {
+    b.torque = r.var_vec3("body torque");
+    present("body torque", b.torque != Vec3{});
+  }
+}
+
+// Semantic checks of a body's moving part; "" when valid.
+std::string check_record(const BodyState& b) {
+  if (auto e = check_orientation(b.orientation); !e.empty()) return e;
+  if (b.sleep_time < Fixed::zero()) return "sleep time must be >= 0";
   if (b.type == BodyType::static_body && b.awake) return "a static body cannot be awake";
   return {};
+}
+
+// ---- Contacts ----
+
+// A feature (collide_util.hpp: kind << 8 | index, kind < 4) is written as index * 4 + kind.
+std::uint32_t pack_feature(std::uint32_t f) noexcept {
+  return ((f & 0xFFU) << 2) | ((f >> 8) & 3U);
+}
+std::uint32_t unpack_feature(std::uint32_t v) noexcept {
+  return ((v & 3U) << 8) | (v >> 2);
+}
+constexpr std::uint32_t kMaxPackedFeature = (0xFFU << 2) | 3U;
+
+Contact read_contact(ByteReader& r, std::uint32_t previous_a) {
+  Contact c;
+  const std::size_t a_at = r.offset();
+  const std::uint32_t a_step = r.var32("contact body a step");
+  if (r.ok() && a_step > 0xFFFFFFFFU - previous_a)
+    r.fail_at(a_at, "contact body a step", "an ID below 2^32");
+  c.a = previous_a + a_step;
+  const std::size_t b_at = r.offset();
+  const std::uint32_t b_step = r.var32("contact body b - a");
+  if (r.ok() && (b_step == 0 || b_step > 0xFFFFFFFFU - c.a))
+    r.fail_at(b_at, "contact body b - a", "at least 1 (a < b) and an ID below 2^32");
+  c.b = c.a + b_step;
+  const std::size_t points_at = r.offset();
+  const std::uint8_t points = r.u8("contact points");
+  if ((points & ~(kPointCountMask | kReported)) != 0 || (points & kPointCountMask) > 4)
+    r.fail_at(points_at, "contact points", "a count of 0-4 in bits 0-2 and bit 3 (reported)");
+  c.point_count = points & kPointCountMask;
+  c.touching = c.point_count > 0;
+  c.reported = (points & kReported) != 0;
+  for (std::size_t p = 0; p < c.point_count && r.ok(); ++p) {
+    std::uint32_t feature = 0;
+    for (int side = 0; side < 2; ++side) {
+      const std::size_t at = r.offset();
+      const std::uint32_t v = r.var32("contact feature");
+      if (v > kMaxPackedFeature) r.fail_at(at, "contact feature", "index * 4 + kind, index < 256");
+      feature |= unpack_feature(v) << (16 * side);
+    }
+    c.cached[p].feature = feature;
+    c.cached[p].normal_impulse = r.var_fixed("contact normal impulse");
+    c.cached[p].tangent_impulse_1 = r.var_fixed("contact tangent impulse");
+    c.cached[p].tangent_impulse_2 = r.var_fixed("contact tangent impulse");
+  }
+  return c;
 }
 
 }  // namespace
@@ -183,40 +303,21 @@ void write_globals(const WorldState& s, ByteWriter& w) {
 }
 
 void write_body(const BodyState& b, ByteWriter& w) {
-  w.u32(b.id.value);
-  w.u8(static_cast<std::uint8_t>(b.type));
-  write_shape(b.shape, w);
-  w.vec3(b.position);
-  w.quat(b.orientation);
-  w.vec3(b.linear_velocity);
-  w.vec3(b.angular_velocity);
-  w.fixed(b.mass);
-  w.vec3(b.inertia);
-  w.fixed(b.friction);
-  w.fixed(b.restitution);
-  w.fixed(b.linear_damping);
-  w.fixed(b.angular_damping);
-  w.u32(b.layer);
-  w.u32(b.mask);
-  w.boolean(b.sensor);
-  w.boolean(b.ccd);
-  w.u64(b.user_data);
-  w.boolean(b.awake);
-  w.fixed(b.sleep_time);
-  w.vec3(b.force);
-  w.vec3(b.torque);
+  write_properties(b, w);
+  write_record(b, 0, 0, w);
 }
 
-void write_contact(const Contact& c, ByteWriter& w) {
-  w.u32(c.a);
-  w.u32(c.b);
-  w.u8(static_cast<std::uint8_t>((c.touching ? 1U : 0U) | (c.reported ? 2U : 0U)));
-  w.u8(c.point_count);
+void write_contact(const Contact& c, std::uint32_t previous_a, ByteWriter& w) {
+  w.var(c.a - previous_a);
+  w.var(c.b - c.a);
+  w.u8(static_cast<std::uint8_t>(c.point_count | (c.reported ? kReported : 0U)));
   for (std::size_t p = 0; p < c.point_count; ++p) {
-    w.u32(c.cached[p].feature);
-    w.fixed(c.cached[p].normal_impulse);
-    w.fixed(c.cached[p].tangent_impulse_1);
-    w.fixed(c.cached[p].tangent_impulse_2);
+    const std::uint32_t f = c.cached[p].feature;
+    w.var(pack_feature(f & 0xFFFFU));
+    w.var(pack_feature(f >> 16));
+    w.var_fixed(c.cached[p].normal_impulse);
+    w.var_fixed(c.cached[p].tangent_impulse_1);
+    w.var_fixed(c.cached[p].tangent_impulse_2);
   }
 }
 
@@ -227,16 +328,47 @@ void write_rng(const Rng& rng, ByteWriter& w) {
     w.u64(word);
 }
 
+// The property sets, in order of first use, then the bodies. A body usually shares its set with
+// the body before it (scenes create alike bodies together), which is compared field by field;
+// otherwise its set's bytes are looked up among the sets written so far.
 void write_bodies(const WorldState& s, ByteWriter& w) {
+  ByteWriter sets;
+  std::uint32_t set_count = 0;
+  std::unordered_map<std::string, std::uint32_t> index_of;
+  std::vector<std::uint32_t> set_of(s.bodies.size());
+  ByteWriter key;
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    if (i > 0 && same_properties(s.bodies[i], s.bodies[i - 1])) {
+      set_of[i] = set_of[i - 1];
+      continue;
+    }
+    key.clear();
+    write_properties(s.bodies[i], key);
+    const auto [it, added] =
+        index_of.try_emplace(std::string(key.bytes().begin(), key.bytes().end()), set_count);
+    if (added) {
+      sets.raw(key.bytes());
+      ++set_count;
+    }
+    set_of[i] = it->second;
+  }
+  w.u32(set_count);
+  w.raw(sets.bytes());
   w.u32(static_cast<std::uint32_t>(s.bodies.size()));
-  for (const BodyState& b : s.bodies)
-    write_body(b, w);
+  std::uint32_t previous_id = 0;
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    write_record(s.bodies[i], previous_id, set_of[i], w);
+    previous_id = s.bodies[i].id.value;
+  }
 }
 
 void write_contacts(const WorldState& s, ByteWriter& w) {
   w.u32(static_cast<std::uint32_t>(s.contacts.size()));
-  for (const Contact& c : s.contacts)
-    write_contact(c, w);
+  std::uint32_t previous_a = 0;
+  for (const Contact& c : s.contacts) {
+    write_contact(c, previous_a, w);
+    previous_a = c.a;
+  }
 }
 
 // Reads and validates a whole state; on failure returns false with `error` set.
@@ -271,6 +403,29 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
     word = r.u64("rng state");
   if (r.ok() && !s.rng.set_state(rng)) return failed_at(rng_at, "rng state is all zero");
 
+  const std::size_t set_count_at = r.offset();
+  const std::uint32_t set_count = r.u32("property set count");
+  if (r.ok() && set_count > r.remaining() / kMinPropertyBytes)
+    return failed_at(set_count_at, "property set count " + std::to_string(set_count) +
+                                       " exceeds what the data can hold");
+  // Each set keeps its property fields in a BodyState; its bytes must differ from every other's.
+  std::vector<BodyState> sets;
+  sets.reserve(set_count);
+  std::unordered_set<std::string_view> seen;
+  for (std::uint32_t i = 0; i < set_count && r.ok(); ++i) {
+    const std::size_t at = r.offset();
+    BodyState b;
+    read_properties(r, b);
+    if (!r.ok()) break;
+    const std::string where = "property set " + std::to_string(i) + ": ";
+    if (auto e = check_properties(b); !e.empty()) return failed_at(at, where + e);
+    const std::string_view set_bytes(reinterpret_cast<const char*>(bytes.data() + at),
+                                     r.offset() - at);
+    if (!seen.insert(set_bytes).second) return failed_at(at, where + "the same as an earlier set");
+    sets.push_back(b);
+  }
+  if (!r.ok()) return failed(r.error());
+
   const std::size_t body_count_at = r.offset();
   const std::uint32_t body_count = r.u32("body count");
   if (r.ok() && body_count > r.remaining() / kMinBodyBytes)
@@ -278,19 +433,49 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
                                         " exceeds what the data can hold");
   s.bodies.clear();
   s.bodies.reserve(body_count);
+  std::uint32_t sets_used = 0;  // sets are numbered in order of first use
+  std::uint32_t previous_id = 0;
   for (std::uint32_t i = 0; i < body_count && r.ok(); ++i) {
     const std::size_t at = r.offset();
-    BodyState b = read_body(r);
+    BodyState b;
+    std::uint32_t id_step = 0;
+    std::uint32_t set = 0;
+    read_record(r, b, id_step, set);
     if (!r.ok()) break;
-    const std::string where = "body " + std::to_string(b.id.value) + ": ";
-    if (b.id.value == 0 || b.id.value >= s.next_id)
+    const std::uint64_t id = std::uint64_t{previous_id} + id_step;
+    const std::string where = "body " + std::to_string(id) + ": ";
+    if (id_step == 0) return failed_at(at, where + "IDs must be unique and ascending");
+    if (id >= s.next_id)
       return failed_at(at, where + "ID must be in 1.." + std::to_string(s.next_id - 1));
-    if (!s.bodies.empty() && b.id <= s.bodies.back().id)
-      return failed_at(at, where + "IDs must be unique and ascending");
-    if (auto e = check_body(b); !e.empty()) return failed_at(at, where + e);
+    if (set > sets_used || set >= set_count)
+      return failed_at(at,
+                       where + "property set " + std::to_string(set) +
+                           (set >= set_count ? " does not exist"
+                                             : " is used before set " + std::to_string(sets_used) +
+                                                   " (sets are listed in order of first use)"));
+    if (set == sets_used) ++sets_used;
+    const BodyState& p = sets[set];
+    b.id = BodyId{static_cast<std::uint32_t>(id)};
+    b.type = p.type;
+    b.shape = p.shape;
+    b.mass = p.mass;
+    b.inertia = p.inertia;
+    b.friction = p.friction;
+    b.restitution = p.restitution;
+    b.linear_damping = p.linear_damping;
+    b.angular_damping = p.angular_damping;
+    b.layer = p.layer;
+    b.mask = p.mask;
+    b.sensor = p.sensor;
+    b.ccd = p.ccd;
+    if (auto e = check_record(b); !e.empty()) return failed_at(at, where + e);
     s.bodies.push_back(b);
+    previous_id = b.id.value;
   }
   if (!r.ok()) return failed(r.error());
+  if (sets_used != set_count)
+    return failed_at(set_count_at,
+                     "property set " + std::to_string(sets_used) + " is used by no body");
 
   const std::size_t contact_count_at = r.offset();
   const std::uint32_t contact_count = r.u32("contact count");
@@ -299,23 +484,21 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
                                            " exceeds what the data can hold");
   s.contacts.clear();
   s.contacts.reserve(contact_count);
+  std::uint32_t previous_a = 0;
   for (std::uint32_t i = 0; i < contact_count && r.ok(); ++i) {
     const std::size_t at = r.offset();
-    Contact c = read_contact(r);
+    Contact c = read_contact(r, previous_a);
     if (!r.ok()) break;
     const std::string where =
         "contact (" + std::to_string(c.a) + ", " + std::to_string(c.b) + "): ";
-    if (c.a >= c.b) return failed_at(at, where + "body IDs must be ascending within a pair");
     if (s.find(c.a) < 0 || s.find(c.b) < 0)
       return failed_at(at, where + "names a body that does not exist");
-    if (!s.contacts.empty() &&
-        (c.a < s.contacts.back().a || (c.a == s.contacts.back().a && c.b <= s.contacts.back().b)))
+    if (!s.contacts.empty() && c.a == s.contacts.back().a && c.b <= s.contacts.back().b)
       return failed_at(at, where + "pairs must be unique and ascending");
-    if (c.touching != (c.point_count > 0))
-      return failed_at(at, where + "touching flag disagrees with the point count");
     if (c.reported && !c.touching)
       return failed_at(at, where + "reported as touching without contact points");
     s.contacts.push_back(c);
+    previous_a = c.a;
   }
   if (!r.ok()) return failed(r.error());
   if (!r.at_end())
@@ -338,7 +521,7 @@ struct Encoded {
 };
 
 void encode(const WorldState& s, Encoded& e) {
-  e.w.reserve(64 + s.bodies.size() * 300 + s.contacts.size() * 64);
+  e.w.reserve(256 + s.bodies.size() * 96 + s.contacts.size() * 72);
   e.w.u32(kMagic);
   e.w.u32(kVersion);
   e.globals = e.w.size();

@@ -108,9 +108,10 @@ void report_contacts(WorldState& s);       // contact and sensor events, in pair
 /// Appends the end event of a contact that is reported as touching (a pair that stops existing).
 void report_end(WorldState& s, const Contact& c);
 
-/// Canonical bytes (state_io.cpp).
+/// Canonical bytes (state_io.cpp). write_body writes a body on its own: its property set, then its
+/// record as if it were the only body (what body_hash hashes).
 void write_globals(const WorldState& s, ByteWriter& w);
 void write_body(const BodyState& b, ByteWriter& w);
-void write_contact(const Contact& c, ByteWriter& w);
+void write_contact(const Contact& c, std::uint32_t previous_a, ByteWriter& w);
 
 }  // namespace detsim::sim_detail

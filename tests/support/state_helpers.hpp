@@ -1,5 +1,6 @@
-// Shared helpers of the world-state tests (sim_state_test.cpp, sim_state_restore_test.cpp): scenes
-// built through the public API, an independent reader of the v1 state layout, byte patching, and
+// Shared helpers of the world-state tests (sim_state_test.cpp, sim_state_restore_test.cpp,
+// sim_state_v2_codec_test.cpp): scenes built through the public API, the independent codec of the
+// v2 state layout (state_codec.hpp) and what the world's accessors say its encoding must be, and
 // the check that a refused restore changes nothing.
 //
 // It also replaces the global operator new with one that records the largest request (rule 7:
@@ -10,6 +11,7 @@
 #include <atomic>
 #include <cstdint>
 #include <cstdlib>
+#include <initializer_list>
 #include <map>
 #include <new>
 #include <span>
@@ -27,6 +29,7 @@
 #include <detsim/sim/bytes.hpp>
 #include <detsim/sim/world.hpp>
 
+#include "support/state_codec.hpp"
 #include "support/vector_print.hpp"
 
 // ---- Allocation probe ----
@@ -63,7 +66,6 @@ inline void PrintTo(const StateHashes& h, std::ostream* os) {
 namespace state_test {
 
 using namespace detsim::literals;
-using Bytes = std::vector<std::uint8_t>;
 
 // ---- Scenes, built through the public API ----
 
@@ -190,150 +192,136 @@ inline World settled() {
   return played_once(7, 300);
 }
 
-// ---- An independent reader of the v1 layout ----
-//
-// The canonical encoding, version 1, as a compatibility contract (state_io.cpp writes it):
-//   "DSIM" u32 version=1 | u64 frame | u32 next_id | WorldDef | 4 x u64 rng |
-//   u32 body count, bodies ascending by ID | u32 contact count, contacts ascending by (a, b).
-// Integers little-endian, Fixed = raw i64, bool = one byte 0/1, enums one byte, Vec3 = x y z,
-// Quat = w x y z. A body: id u32, type u8, shape (type u8, then radius | half extents | radius and
-// half height | nothing), position, orientation, linear and angular velocity, mass, inertia,
-// friction, restitution, linear and angular damping, layer u32, mask u32, sensor, ccd, user data
-// u64, awake, sleep time, force, torque. A contact: a u32, b u32, flags u8 (bit 0 touching, bit 1
-// reported by events, no other bit), point count u8, then per point: feature u32, normal impulse,
-// two tangent impulses.
+// ---- The v2 codec and the world ----
 
-struct DecodedContact {
-  std::uint32_t a = 0;
-  std::uint32_t b = 0;
-  bool touching = false;
-  bool reported = false;
-  std::uint8_t point_count = 0;
-  std::size_t at = 0;  // offset of the record
-  std::size_t first_impulse_at = 0;
-};
+/// A body as the world reports it, from its record and its set.
+inline BodyState body_state(const DecodedSet& s, const DecodedBody& b) {
+  BodyState out;
+  out.id = b.id;
+  out.type = s.type;
+  out.shape = s.shape;
+  out.position = b.position;
+  out.orientation = b.orientation;
+  out.linear_velocity = b.linear_velocity;
+  out.angular_velocity = b.angular_velocity;
+  out.mass = s.mass;
+  out.inertia = s.inertia;
+  out.friction = s.friction;
+  out.restitution = s.restitution;
+  out.linear_damping = s.linear_damping;
+  out.angular_damping = s.angular_damping;
+  out.layer = s.layer;
+  out.mask = s.mask;
+  out.sensor = (s.flags & kSensor) != 0;
+  out.ccd = (s.flags & kCcd) != 0;
+  out.user_data = b.user_data;
+  out.awake = (b.flags & kAwake) != 0;
+  out.sleep_time = b.sleep_time;
+  out.force = b.force;
+  out.torque = b.torque;
+  return out;
+}
 
-struct Decoded {
-  bool ok = false;
-  std::string error;
-  std::uint64_t frame = 0;
-  std::uint32_t next_id = 0;
-  WorldDef def;
-  std::size_t globals_at = 0;  // = 8: frame, next ID, definition
-  std::size_t rng_at = 0;
-  Rng::State rng{};
-  std::size_t body_count_at = 0;
-  std::vector<BodyState> bodies;
-  std::vector<std::size_t> body_at;
-  std::size_t contact_count_at = 0;
-  std::vector<DecodedContact> contacts;
-  std::size_t end = 0;
-};
+inline BodyState body_state(const Decoded& d, std::size_t i) {
+  return body_state(d.sets.at(static_cast<std::size_t>(d.bodies.at(i).set)), d.bodies[i]);
+}
 
-inline Decoded decode(std::span<const std::uint8_t> bytes) {
+/// A contact as the world reports it (the used points only; the others stay zero).
+inline ContactState contact_state(const DecodedContact& c) {
+  ContactState out;
+  out.a = BodyId{c.a};
+  out.b = BodyId{c.b};
+  out.point_count = static_cast<std::uint8_t>(c.point_count());
+  out.touching = c.point_count() > 0;
+  out.reported = c.reported();
+  for (std::size_t p = 0; p < c.points.size() && p < out.points.size(); ++p) {
+    const DecodedPoint& in = c.points[p];
+    out.points[p].feature = std::uint32_t{feature_of_wire(in.feature_a)} |
+                            (std::uint32_t{feature_of_wire(in.feature_b)} << 16U);
+    out.points[p].normal_impulse = in.normal_impulse;
+    out.points[p].tangent_impulse_1 = in.tangent_impulse_1;
+    out.points[p].tangent_impulse_2 = in.tangent_impulse_2;
+  }
+  return out;
+}
+
+inline DecodedSet set_of(const BodyState& b) {
+  DecodedSet s;
+  s.type = b.type;
+  s.shape = b.shape;
+  s.mass = b.mass;
+  s.inertia = b.inertia;
+  s.friction = b.friction;
+  s.restitution = b.restitution;
+  s.linear_damping = b.linear_damping;
+  s.angular_damping = b.angular_damping;
+  s.layer = b.layer;
+  s.mask = b.mask;
+  s.flags = static_cast<std::uint8_t>((b.sensor ? kSensor : 0) | (b.ccd ? kCcd : 0));
+  return s;
+}
+
+/// The body's record (ID step and set index left to the caller).
+inline DecodedBody record_of(const BodyState& b) {
+  DecodedBody r;
+  r.id = b.id;
+  r.flags = static_cast<std::uint8_t>(
+      (b.awake ? kAwake : 0) | (b.user_data != 0 ? kHasUserData : 0) |
+      (b.force != Vec3{} ? kHasForce : 0) | (b.torque != Vec3{} ? kHasTorque : 0));
+  r.position = b.position;
+  r.orientation = b.orientation;
+  r.linear_velocity = b.linear_velocity;
+  r.angular_velocity = b.angular_velocity;
+  r.sleep_time = b.sleep_time;
+  r.user_data = b.user_data;
+  r.force = b.force;
+  r.torque = b.torque;
+  return r;
+}
+
+/// What save() must write for `w`, built from body(), contacts() and the other accessors: sets
+/// deduplicated in first-use order, flags from the values. The ID counter is not public: the
+/// caller passes it.
+inline Decoded expected_encoding(const World& w, std::uint32_t next_id) {
   Decoded d;
-  ByteReader r(bytes);
-  const std::uint32_t magic = r.u32("magic");
-  const std::uint32_t version = r.u32("version");
-  if (magic != 0x4D495344U || version != 1) {
-    d.error = "not a v1 state";
-    return d;
+  d.frame = w.frame();
+  d.next_id = next_id;
+  d.def = w.def();
+  d.rng = w.rng().state();
+  std::uint32_t previous_id = 0;
+  for (const BodyId id : w.body_ids()) {
+    const BodyState b = w.body(id).value();
+    const DecodedSet s = set_of(b);
+    const auto found = std::find_if(d.sets.begin(), d.sets.end(),
+                                    [&](const DecodedSet& x) { return same_properties(x, s); });
+    DecodedBody r = record_of(b);
+    r.id_step = id.value - previous_id;
+    r.set = static_cast<std::uint64_t>(found - d.sets.begin());
+    if (found == d.sets.end()) d.sets.push_back(s);
+    d.bodies.push_back(r);
+    previous_id = id.value;
   }
-  d.globals_at = r.offset();
-  d.frame = r.u64("frame");
-  d.next_id = r.u32("next id");
-  WorldDef& def = d.def;
-  def.gravity = r.vec3("gravity");
-  def.dt = r.fixed("dt");
-  def.substeps = r.u32("substeps");
-  def.iterations = r.u32("iterations");
-  def.seed = r.u64("seed");
-  def.max_linear_speed = r.fixed("max linear speed");
-  def.max_angular_speed = r.fixed("max angular speed");
-  def.contact_hertz = r.fixed("contact hertz");
-  def.contact_damping_ratio = r.fixed("contact damping ratio");
-  def.contact_push_max = r.fixed("contact push max");
-  def.restitution_threshold = r.fixed("restitution threshold");
-  def.linear_slop = r.fixed("linear slop");
-  def.speculative_distance = r.fixed("speculative distance");
-  def.enable_sleep = r.boolean("enable sleep");
-  def.sleep_linear_speed = r.fixed("sleep linear speed");
-  def.sleep_angular_speed = r.fixed("sleep angular speed");
-  def.time_to_sleep = r.fixed("time to sleep");
-  d.rng_at = r.offset();
-  for (std::uint64_t& word : d.rng)
-    word = r.u64("rng");
-  d.body_count_at = r.offset();
-  const std::uint32_t bodies = r.u32("body count");
-  for (std::uint32_t i = 0; i < bodies && r.ok(); ++i) {
-    d.body_at.push_back(r.offset());
-    BodyState b;
-    b.id = BodyId{r.u32("id")};
-    b.type = static_cast<BodyType>(r.u8("type"));
-    b.shape.type = static_cast<ShapeType>(r.u8("shape type"));
-    switch (b.shape.type) {
-      case ShapeType::sphere:
-        b.shape.radius = r.fixed("radius");
-        break;
-      case ShapeType::box:
-        b.shape.half_extents = r.vec3("half extents");
-        break;
-      case ShapeType::capsule:
-        b.shape.radius = r.fixed("radius");
-        b.shape.half_height = r.fixed("half height");
-        break;
-      case ShapeType::plane:
-        break;
-      default:
-        r.fail("shape type", "known");
+  std::uint32_t previous_a = 0;
+  for (const ContactState& c : w.contacts()) {
+    DecodedContact out;
+    out.a = c.a.value;
+    out.b = c.b.value;
+    out.a_step = c.a.value - previous_a;
+    out.b_minus_a = c.b.value - c.a.value;
+    out.points_byte = static_cast<std::uint8_t>(c.point_count | (c.reported ? kReported : 0));
+    for (std::size_t p = 0; p < c.point_count && p < c.points.size(); ++p) {
+      const ContactPointState& in = c.points[p];
+      DecodedPoint point;
+      point.feature_a = wire_feature(static_cast<std::uint16_t>(in.feature & 0xFFFFU));
+      point.feature_b = wire_feature(static_cast<std::uint16_t>(in.feature >> 16U));
+      point.normal_impulse = in.normal_impulse;
+      point.tangent_impulse_1 = in.tangent_impulse_1;
+      point.tangent_impulse_2 = in.tangent_impulse_2;
+      out.points.push_back(point);
     }
-    b.position = r.vec3("position");
-    b.orientation = r.quat("orientation");
-    b.linear_velocity = r.vec3("linear velocity");
-    b.angular_velocity = r.vec3("angular velocity");
-    b.mass = r.fixed("mass");
-    b.inertia = r.vec3("inertia");
-    b.friction = r.fixed("friction");
-    b.restitution = r.fixed("restitution");
-    b.linear_damping = r.fixed("linear damping");
-    b.angular_damping = r.fixed("angular damping");
-    b.layer = r.u32("layer");
-    b.mask = r.u32("mask");
-    b.sensor = r.boolean("sensor");
-    b.ccd = r.boolean("ccd");
-    b.user_data = r.u64("user data");
-    b.awake = r.boolean("awake");
-    b.sleep_time = r.fixed("sleep time");
-    b.force = r.vec3("force");
-    b.torque = r.vec3("torque");
-    d.bodies.push_back(b);
+    d.contacts.push_back(out);
+    previous_a = c.a.value;
   }
-  d.contact_count_at = r.offset();
-  const std::uint32_t contacts = r.u32("contact count");
-  for (std::uint32_t i = 0; i < contacts && r.ok(); ++i) {
-    DecodedContact c;
-    c.at = r.offset();
-    c.a = r.u32("a");
-    c.b = r.u32("b");
-    const std::uint8_t flags = r.u8("flags");
-    if (flags > 3) r.fail("flags", "bits 0 and 1 only");
-    c.touching = (flags & 1U) != 0;
-    c.reported = (flags & 2U) != 0;
-    c.point_count = r.u8("point count");
-    if (c.point_count > 4) r.fail("point count", "<= 4");
-    c.first_impulse_at = r.offset() + 4;
-    for (std::uint8_t p = 0; p < c.point_count && r.ok(); ++p) {
-      (void)r.u32("feature");
-      (void)r.fixed("normal impulse");
-      (void)r.fixed("tangent impulse 1");
-      (void)r.fixed("tangent impulse 2");
-    }
-    d.contacts.push_back(c);
-  }
-  d.end = r.offset();
-  d.ok = r.ok() && r.at_end();
-  if (!r.ok()) d.error = r.error();
-  if (r.ok() && !r.at_end()) d.error = "trailing bytes";
   return d;
 }
 
@@ -341,26 +329,42 @@ inline std::uint64_t xxh3(std::span<const std::uint8_t> bytes) {
   return XXH3_64bits(bytes.data(), bytes.size());
 }
 
-inline void put_u32(Bytes& bytes, std::size_t at, std::uint32_t v) {
-  for (std::size_t i = 0; i < 4; ++i)
-    bytes[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-
-inline void put_i64(Bytes& bytes, std::size_t at, std::int64_t value) {
-  const auto v = static_cast<std::uint64_t>(value);
-  for (std::size_t i = 0; i < 8; ++i)
-    bytes[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+/// body_hash(id) as docs/STATE.md defines it: the body's set, then its record as if it were the
+/// only body (ID step = its ID, set index 0).
+inline std::uint64_t expected_body_hash(const Decoded& d, std::size_t i) {
+  DecodedBody alone = d.bodies.at(i);
+  alone.id_step = alone.id.value;
+  alone.set = 0;
+  Bytes bytes = encode_set(d.sets.at(static_cast<std::size_t>(d.bodies[i].set)));
+  const Bytes record = encode_body(alone);
+  bytes.insert(bytes.end(), record.begin(), record.end());
+  return xxh3(bytes);
 }
 
 inline bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
-// Field offsets inside a body record, from the layout above (shape payload of a sphere: 8 bytes).
-inline constexpr std::size_t kBodyTypeAt = 4;
-inline constexpr std::size_t kShapeTypeAt = 5;
-inline constexpr std::size_t kSpherePositionAt = 14;
-inline constexpr std::size_t kSphereOrientationAt = kSpherePositionAt + 24;
+/// Whether `message` names the byte of one of `offsets` (docs/STATE.md: "the message names the
+/// byte offset and the field"; the offset of the record the field is in is accepted too).
+inline bool names_one_of(const std::string& message, std::initializer_list<std::size_t> offsets) {
+  return std::any_of(offsets.begin(), offsets.end(), [&](std::size_t at) {
+    return contains(message, "byte " + std::to_string(at));
+  });
+}
+
+/// Whether `text` has the number `n` as a whole decimal token.
+inline bool mentions_number(const std::string& text, std::uint64_t n) {
+  const std::string digits = std::to_string(n);
+  for (std::size_t at = text.find(digits); at != std::string::npos;
+       at = text.find(digits, at + 1)) {
+    const bool starts = at == 0 || text[at - 1] < '0' || text[at - 1] > '9';
+    const std::size_t after = at + digits.size();
+    const bool ends = after == text.size() || text[after] < '0' || text[after] > '9';
+    if (starts && ends) return true;
+  }
+  return false;
+}
 
 // ---- Rejection checks ----
 

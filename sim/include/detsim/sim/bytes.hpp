@@ -1,5 +1,10 @@
 // Canonical bytes: explicit little-endian, field by field, never a memcpy of a struct.
 //
+// Two kinds of number: fixed-width little-endian integers, and `var`s — unsigned LEB128 (seven bits
+// per byte, lowest first, top bit = more follows), with Fixed written as the var of its zigzag form
+// (v << 1) ^ (v >> 63) so that small magnitudes of either sign are short. The reader accepts only
+// the shortest form of a var, so every value has exactly one encoding.
+//
 // ByteWriter appends; ByteReader reads with bounds checks and remembers the first failure (offset
 // and what was expected), after which every read returns zero and fails. Callers read a whole
 // record, then check `ok()` once — and check counts against `remaining()` before allocating.
@@ -43,6 +48,32 @@ class ByteWriter {
     fixed(q.y);
     fixed(q.z);
   }
+  /// Unsigned LEB128: 1 byte below 2^7, 2 below 2^14, ..., 10 for the top of the 64-bit range.
+  void var(std::uint64_t v) {
+    std::uint8_t buf[10];
+    std::size_t n = 0;
+    while (v >= 0x80U) {
+      buf[n++] = static_cast<std::uint8_t>(v | 0x80U);
+      v >>= 7;
+    }
+    buf[n++] = static_cast<std::uint8_t>(v);
+    bytes_.insert(bytes_.end(), buf, buf + n);
+  }
+  void var_fixed(Fixed v) { var(zigzag(v.raw())); }
+  void var_vec3(Vec3 v) {
+    var_fixed(v.x);
+    var_fixed(v.y);
+    var_fixed(v.z);
+  }
+  void var_quat(Quat q) {
+    var_fixed(q.w);
+    var_fixed(q.x);
+    var_fixed(q.y);
+    var_fixed(q.z);
+  }
+  static constexpr std::uint64_t zigzag(std::int64_t v) noexcept {
+    return (static_cast<std::uint64_t>(v) << 1) ^ static_cast<std::uint64_t>(v >> 63);
+  }
   void raw(std::span<const std::uint8_t> data) {
     bytes_.insert(bytes_.end(), data.begin(), data.end());
   }
@@ -83,6 +114,48 @@ class ByteReader {
     return v == 1;
   }
   Fixed fixed(const char* what) noexcept { return Fixed::from_raw(i64(what)); }
+  /// A var of at most `bits` bits (32 or 64): refused when longer than its shortest form or when
+  /// the value does not fit.
+  std::uint64_t var(const char* what, unsigned bits = 64) noexcept {
+    if (!ok_) return 0;
+    const std::size_t at = offset_;
+    std::uint64_t v = 0;
+    for (unsigned shift = 0;; shift += 7) {
+      if (offset_ == data_.size()) {
+        fail(what, "more bytes (the data ends here)");
+        return 0;
+      }
+      const std::uint8_t byte = data_[offset_++];
+      const std::uint64_t group = byte & 0x7FU;
+      if (shift >= bits || (shift > 0 && (group >> (bits - shift)) != 0 && bits - shift < 7)) {
+        fail_at(at, what, bits == 32 ? "a var of at most 32 bits" : "a var of at most 64 bits");
+        return 0;
+      }
+      v |= group << shift;
+      if ((byte & 0x80U) == 0) {
+        if (byte == 0 && shift > 0) fail_at(at, what, "the shortest form of a var");
+        return ok_ ? v : 0;
+      }
+    }
+  }
+  std::uint32_t var32(const char* what) noexcept {
+    return static_cast<std::uint32_t>(var(what, 32));
+  }
+  Fixed var_fixed(const char* what) noexcept {
+    const std::uint64_t z = var(what);
+    return Fixed::from_raw(static_cast<std::int64_t>((z >> 1) ^ (~(z & 1U) + 1U)));
+  }
+  Vec3 var_vec3(const char* what) noexcept {
+    const Fixed x = var_fixed(what);
+    const Fixed y = var_fixed(what);
+    return {x, y, var_fixed(what)};
+  }
+  Quat var_quat(const char* what) noexcept {
+    const Fixed w = var_fixed(what);
+    const Fixed x = var_fixed(what);
+    const Fixed y = var_fixed(what);
+    return {w, x, y, var_fixed(what)};
+  }
   Vec3 vec3(const char* what) noexcept {
     const Fixed x = fixed(what);
     const Fixed y = fixed(what);

@@ -54,7 +54,7 @@ struct BodyState {
 
 /// The version of the canonical state encoding that save() writes and restore() reads
 /// (docs/STATE.md). Replays record it: a keyframe can be restored only by a build that reads it.
-inline constexpr std::uint32_t state_encoding_version = 1;
+inline constexpr std::uint32_t state_encoding_version = 2;
 
 /// Hashes of the state after a step (XXH3-64 of the canonical bytes of each part).
 struct StateHashes {

@@ -1,0 +1,683 @@
+// An independent codec of the v2 world-state layout (docs/STATE.md), for the world-state tests
+// (support/state_helpers.hpp includes it).
+//
+// Written from docs/STATE.md, not from state_io.cpp, so that the two can disagree. In brief:
+//   "DSIM" u32 version=2 | u64 frame | u32 next ID | definition (fixed width) | 4 x u64 RNG |
+//   u32 property-set count, sets in first-use order | u32 body count, bodies ascending by ID |
+//   u32 contact count, contacts ascending by (a, b).
+// `var` is canonical LEB128 (at most 5 bytes for a 32-bit field, 10 for a 64-bit one); `vfixed` a
+// var of the zigzag raw value. A set: type u8, shape (type u8, then its vfixed sizes), mass,
+// inertia, friction, restitution, linear and angular damping (vfixed), layer u32, mask u32, flags
+// u8 (sensor, CCD). A body: ID step var, set index var, flags u8 (awake, user data, force, torque
+// follow), position, orientation, velocities, sleep time (vfixed), then the flagged values. A
+// contact: a step var, b - a var, point byte (count in bits 0-2, reported in bit 3), then per
+// point: feature on a, feature on b (var: index * 4 + kind), three impulses (vfixed).
+//
+// decode() is strict about what the layout itself says (canonical vars, enum values, flag bits,
+// zero values flagged present, set order and use, ID and pair order, point bytes, features) and
+// reports the first error with its byte offset; it does not repeat the simulation's own checks
+// (unit quaternions, masses, the definition's ranges): it is a test oracle, not the validator.
+// encode() writes the wire fields of a Decoded as they are, valid or not, so a test can decode a
+// real state, change one field and re-encode.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <detsim/fixed/fixed.hpp>
+#include <detsim/fixed/quat.hpp>
+#include <detsim/fixed/vec3.hpp>
+#include <detsim/sim/world.hpp>
+
+namespace detsim::state_test {
+
+using Bytes = std::vector<std::uint8_t>;
+
+inline constexpr std::uint32_t kStateMagic = 0x4D495344U;
+inline constexpr std::uint32_t kStateVersion = 2;
+
+// Body flags.
+inline constexpr std::uint8_t kAwake = 1;
+inline constexpr std::uint8_t kHasUserData = 2;
+inline constexpr std::uint8_t kHasForce = 4;
+inline constexpr std::uint8_t kHasTorque = 8;
+// Property-set flags.
+inline constexpr std::uint8_t kSensor = 1;
+inline constexpr std::uint8_t kCcd = 2;
+// A contact's point byte.
+inline constexpr std::uint8_t kPointCountBits = 7;
+inline constexpr std::uint8_t kReported = 8;
+
+// The bytes of the world definition (fixed width) and the offsets of two of its fields.
+inline constexpr std::size_t kDefinitionBytes = 137;
+inline constexpr std::size_t kDtInDefinition = 24;
+inline constexpr std::size_t kSubstepsInDefinition = 32;
+
+// ---- Raw LEB128, for tests that craft (possibly non-canonical) vars ----
+
+inline std::uint64_t zigzag(Fixed v) {
+  const std::int64_t raw = v.raw();
+  return (static_cast<std::uint64_t>(raw) << 1) ^ static_cast<std::uint64_t>(raw >> 63);
+}
+
+inline Fixed unzigzag(std::uint64_t z) {
+  return Fixed::from_raw(static_cast<std::int64_t>((z >> 1) ^ (0 - (z & 1))));
+}
+
+/// LEB128 of `value` in at least `min_bytes` bytes: beyond the shortest form, continuation bytes
+/// carrying zero groups are added, which makes an overlong (non-canonical) var.
+inline Bytes leb128(std::uint64_t value, std::size_t min_bytes = 1) {
+  Bytes out;
+  do {
+    out.push_back(static_cast<std::uint8_t>(value & 0x7FU));
+    value >>= 7;
+  } while (value != 0 || out.size() < min_bytes);
+  for (std::size_t i = 0; i + 1 < out.size(); ++i)
+    out[i] |= 0x80U;
+  return out;
+}
+
+/// The length of the canonical var of `value`.
+inline std::size_t var_size(std::uint64_t value) {
+  return leb128(value).size();
+}
+inline std::size_t vfixed_size(Fixed v) {
+  return var_size(zigzag(v));
+}
+inline std::size_t vec3_size(Vec3 v) {
+  return vfixed_size(v.x) + vfixed_size(v.y) + vfixed_size(v.z);
+}
+inline std::size_t quat_size(Quat q) {
+  return vfixed_size(q.w) + vfixed_size(q.x) + vfixed_size(q.y) + vfixed_size(q.z);
+}
+
+/// The length of the var (canonical or not) that starts at `at`.
+inline std::size_t var_length_at(std::span<const std::uint8_t> bytes, std::size_t at) {
+  std::size_t n = 0;
+  while (at + n < bytes.size() && (bytes[at + n] & 0x80U) != 0)
+    ++n;
+  return n + 1;
+}
+
+/// Replaces the var that starts at `at` with the bytes `with` (what follows shifts).
+inline void replace_var(Bytes& bytes, std::size_t at, std::span<const std::uint8_t> with) {
+  const auto first = bytes.begin() + static_cast<std::ptrdiff_t>(at);
+  bytes.erase(first, first + static_cast<std::ptrdiff_t>(var_length_at(bytes, at)));
+  bytes.insert(bytes.begin() + static_cast<std::ptrdiff_t>(at), with.begin(), with.end());
+}
+
+inline void put_u32(Bytes& bytes, std::size_t at, std::uint32_t v) {
+  for (std::size_t i = 0; i < 4; ++i)
+    bytes[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
+inline void put_i64(Bytes& bytes, std::size_t at, std::int64_t value) {
+  const auto v = static_cast<std::uint64_t>(value);
+  for (std::size_t i = 0; i < 8; ++i)
+    bytes[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
+// ---- Features: the 16-bit feature (kind * 256 + index) and its wire form (index * 4 + kind) ----
+
+inline std::uint64_t wire_feature(std::uint16_t feature) {
+  return std::uint64_t{feature & 0xFFU} * 4 + (feature >> 8U);
+}
+inline std::uint16_t feature_of_wire(std::uint64_t wire) {
+  return static_cast<std::uint16_t>(((wire & 3U) << 8U) | (wire >> 2U));
+}
+
+// ---- The decoded state ----
+
+/// What bodies share. `type` and `shape.type` may hold any byte value (the enums have a fixed
+/// underlying type); encode() then writes no shape payload for an unknown shape type.
+struct DecodedSet {
+  BodyType type = BodyType::dynamic;
+  Shape shape{};
+  Fixed mass{};
+  Vec3 inertia{};
+  Fixed friction{};
+  Fixed restitution{};
+  Fixed linear_damping{};
+  Fixed angular_damping{};
+  std::uint32_t layer = 1;
+  std::uint32_t mask = 0xFFFFFFFFU;
+  std::uint8_t flags = 0;  // kSensor, kCcd
+  // Filled by decode(), ignored by encode():
+  std::size_t at = 0;
+  std::size_t mass_at = 0;
+  std::size_t end = 0;
+};
+
+inline bool same_properties(const DecodedSet& a, const DecodedSet& b) {
+  return a.type == b.type && a.shape == b.shape && a.mass == b.mass && a.inertia == b.inertia &&
+         a.friction == b.friction && a.restitution == b.restitution &&
+         a.linear_damping == b.linear_damping && a.angular_damping == b.angular_damping &&
+         a.layer == b.layer && a.mask == b.mask && a.flags == b.flags;
+}
+
+struct DecodedBody {
+  std::uint64_t id_step = 0;  // the ID minus the previous body's
+  std::uint64_t set = 0;      // index into Decoded::sets
+  std::uint8_t flags = 0;     // kAwake, kHasUserData, kHasForce, kHasTorque
+  Vec3 position{};
+  Quat orientation{};
+  Vec3 linear_velocity{};
+  Vec3 angular_velocity{};
+  Fixed sleep_time{};
+  // Written only when `flags` says so (and then whatever their value).
+  std::uint64_t user_data = 0;
+  Vec3 force{};
+  Vec3 torque{};
+  // Filled by decode(), ignored by encode():
+  BodyId id{};
+  std::size_t at = 0;  // the record, = its ID step
+  std::size_t set_at = 0;
+  std::size_t flags_at = 0;
+  std::size_t position_at = 0;
+  std::size_t orientation_at = 0;
+  std::size_t linear_velocity_at = 0;
+  std::size_t end = 0;
+};
+
+struct DecodedPoint {
+  std::uint64_t feature_a = 0;  // wire form: index * 4 + kind
+  std::uint64_t feature_b = 0;
+  Fixed normal_impulse{};
+  Fixed tangent_impulse_1{};
+  Fixed tangent_impulse_2{};
+  // Filled by decode(), ignored by encode():
+  std::size_t at = 0;  // = feature on a
+  std::size_t feature_b_at = 0;
+  std::size_t normal_impulse_at = 0;
+};
+
+struct DecodedContact {
+  std::uint64_t a_step = 0;     // a minus the previous contact's a
+  std::uint64_t b_minus_a = 0;  // b minus a, at least 1
+  std::uint8_t points_byte = 0;
+  std::vector<DecodedPoint> points;  // encode() writes all of them, whatever points_byte says
+  // Filled by decode(), ignored by encode():
+  std::uint32_t a = 0;
+  std::uint32_t b = 0;
+  std::size_t at = 0;  // the record, = its a step
+  std::size_t b_at = 0;
+  std::size_t points_at = 0;  // the point byte
+  std::size_t end = 0;
+
+  [[nodiscard]] unsigned point_count() const { return points_byte & kPointCountBits; }
+  [[nodiscard]] bool reported() const { return (points_byte & kReported) != 0; }
+};
+
+struct Decoded {
+  bool ok = false;
+  std::string error;  // "byte N: what", the first error
+  std::uint32_t magic = kStateMagic;
+  std::uint32_t version = kStateVersion;
+  std::uint64_t frame = 0;
+  std::uint32_t next_id = 1;
+  WorldDef def;
+  Rng::State rng{};
+  std::vector<DecodedSet> sets;
+  std::vector<DecodedBody> bodies;
+  std::vector<DecodedContact> contacts;
+  // Offsets, filled by decode():
+  std::size_t globals_at = 0;  // = 8: the frame
+  std::size_t next_id_at = 0;
+  std::size_t def_at = 0;
+  std::size_t rng_at = 0;
+  std::size_t property_count_at = 0;
+  std::size_t body_count_at = 0;
+  std::size_t contact_count_at = 0;
+  std::size_t end = 0;
+};
+
+// ---- Reading ----
+
+class StateReader {
+ public:
+  explicit StateReader(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
+
+  [[nodiscard]] bool ok() const { return error_.empty(); }
+  [[nodiscard]] const std::string& error() const { return error_; }
+  [[nodiscard]] std::size_t at() const { return at_; }
+  [[nodiscard]] bool at_end() const { return at_ == bytes_.size(); }
+
+  /// Records the first error only.
+  void fail(std::size_t at, const std::string& what) {
+    if (ok()) error_ = "byte " + std::to_string(at) + ": " + what;
+  }
+
+  std::uint8_t u8(const char* what) { return static_cast<std::uint8_t>(little_endian(1, what)); }
+  std::uint32_t u32(const char* what) { return static_cast<std::uint32_t>(little_endian(4, what)); }
+  std::uint64_t u64(const char* what) { return little_endian(8, what); }
+  Fixed fixed(const char* what) {
+    return Fixed::from_raw(static_cast<std::int64_t>(little_endian(8, what)));
+  }
+  bool boolean(const char* what) {
+    const std::size_t start = at_;
+    const std::uint8_t v = u8(what);
+    if (v > 1) fail(start, std::string(what) + ": not 0 or 1");
+    return v == 1;
+  }
+
+  /// A canonical LEB128 var of a `bits`-bit field (32 or 64).
+  std::uint64_t var(const char* what, unsigned bits) {
+    if (!ok()) return 0;
+    const std::size_t start = at_;
+    const std::size_t max_bytes = bits == 32 ? 5 : 10;
+    std::uint64_t value = 0;
+    for (std::size_t i = 0;; ++i) {
+      if (i == max_bytes) {
+        fail(start,
+             std::string(what) + ": a var longer than " + std::to_string(max_bytes) + " bytes");
+        return 0;
+      }
+      if (at_ == bytes_.size()) {
+        fail(start, std::string(what) + ": the data ends inside a var");
+        return 0;
+      }
+      const std::uint8_t byte = bytes_[at_++];
+      const std::uint64_t group = byte & 0x7FU;
+      if (i == 9 && group > 1) {
+        fail(start, std::string(what) + ": a var beyond 64 bits");
+        return 0;
+      }
+      value |= group << (7 * i);
+      if ((byte & 0x80U) == 0) {
+        if (byte == 0 && i > 0) fail(start, std::string(what) + ": an overlong var");
+        break;
+      }
+    }
+    if (bits == 32 && value > 0xFFFFFFFFU)
+      fail(start, std::string(what) + ": a var beyond 32 bits");
+    return ok() ? value : 0;
+  }
+  Fixed vfixed(const char* what) { return unzigzag(var(what, 64)); }
+  Vec3 vvec3(const char* what) {
+    const Fixed x = vfixed(what);
+    const Fixed y = vfixed(what);
+    return {x, y, vfixed(what)};
+  }
+  Quat vquat(const char* what) {
+    const Fixed w = vfixed(what);
+    const Fixed x = vfixed(what);
+    const Fixed y = vfixed(what);
+    return {w, x, y, vfixed(what)};
+  }
+
+ private:
+  std::uint64_t little_endian(std::size_t n, const char* what) {
+    if (!ok()) return 0;
+    if (bytes_.size() - at_ < n) {
+      fail(at_, std::string(what) + ": the data ends here");
+      return 0;
+    }
+    std::uint64_t v = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      v |= std::uint64_t{bytes_[at_ + i]} << (8 * i);
+    at_ += n;
+    return v;
+  }
+
+  std::span<const std::uint8_t> bytes_;
+  std::size_t at_ = 0;
+  std::string error_;
+};
+
+inline WorldDef read_definition(StateReader& r) {
+  WorldDef def;
+  const Fixed gx = r.fixed("gravity");
+  const Fixed gy = r.fixed("gravity");
+  def.gravity = {gx, gy, r.fixed("gravity")};
+  def.dt = r.fixed("dt");
+  def.substeps = r.u32("substeps");
+  def.iterations = r.u32("iterations");
+  def.seed = r.u64("seed");
+  def.max_linear_speed = r.fixed("max linear speed");
+  def.max_angular_speed = r.fixed("max angular speed");
+  def.contact_hertz = r.fixed("contact hertz");
+  def.contact_damping_ratio = r.fixed("contact damping ratio");
+  def.contact_push_max = r.fixed("contact push max");
+  def.restitution_threshold = r.fixed("restitution threshold");
+  def.linear_slop = r.fixed("linear slop");
+  def.speculative_distance = r.fixed("speculative distance");
+  def.enable_sleep = r.boolean("enable sleep");
+  def.sleep_linear_speed = r.fixed("sleep linear speed");
+  def.sleep_angular_speed = r.fixed("sleep angular speed");
+  def.time_to_sleep = r.fixed("time to sleep");
+  return def;
+}
+
+inline DecodedSet read_set(StateReader& r) {
+  DecodedSet s;
+  s.at = r.at();
+  const std::uint8_t type = r.u8("set type");
+  if (type > 2) r.fail(s.at, "set type: not 0, 1 or 2");
+  s.type = static_cast<BodyType>(type);
+  const std::size_t shape_at = r.at();
+  s.shape.type = static_cast<ShapeType>(r.u8("shape type"));
+  switch (s.shape.type) {
+    case ShapeType::sphere:
+      s.shape.radius = r.vfixed("radius");
+      break;
+    case ShapeType::box:
+      s.shape.half_extents = r.vvec3("half extents");
+      break;
+    case ShapeType::capsule:
+      s.shape.radius = r.vfixed("radius");
+      s.shape.half_height = r.vfixed("half height");
+      break;
+    case ShapeType::plane:
+      break;
+    default:
+      r.fail(shape_at, "shape type: not 1 to 4");
+  }
+  s.mass_at = r.at();
+  s.mass = r.vfixed("mass");
+  s.inertia = r.vvec3("inertia");
+  s.friction = r.vfixed("friction");
+  s.restitution = r.vfixed("restitution");
+  s.linear_damping = r.vfixed("linear damping");
+  s.angular_damping = r.vfixed("angular damping");
+  s.layer = r.u32("layer");
+  s.mask = r.u32("mask");
+  const std::size_t flags_at = r.at();
+  s.flags = r.u8("set flags");
+  if ((s.flags & ~(kSensor | kCcd)) != 0) r.fail(flags_at, "set flags: an unknown bit");
+  s.end = r.at();
+  return s;
+}
+
+inline void read_body(StateReader& r, Decoded& d, std::uint64_t& previous_id, std::size_t& used) {
+  DecodedBody b;
+  b.at = r.at();
+  b.id_step = r.var("body ID step", 32);
+  if (r.ok() && b.id_step == 0) r.fail(b.at, "body ID step: zero");
+  const std::uint64_t id = previous_id + b.id_step;
+  if (r.ok() && id >= d.next_id) r.fail(b.at, "body ID: not below the next ID");
+  previous_id = id;
+  b.id = BodyId{static_cast<std::uint32_t>(id)};
+  b.set_at = r.at();
+  b.set = r.var("property set", 32);
+  if (r.ok() && b.set >= d.sets.size()) r.fail(b.set_at, "property set: out of range");
+  if (r.ok() && b.set > used) r.fail(b.set_at, "property set: not in first-use order");
+  if (r.ok() && b.set == used) ++used;
+  b.flags_at = r.at();
+  b.flags = r.u8("body flags");
+  if ((b.flags & ~(kAwake | kHasUserData | kHasForce | kHasTorque)) != 0)
+    r.fail(b.flags_at, "body flags: an unknown bit");
+  if (r.ok() && (b.flags & kAwake) != 0 &&
+      d.sets[static_cast<std::size_t>(b.set)].type == BodyType::static_body)
+    r.fail(b.flags_at, "body flags: a static body is awake");
+  b.position_at = r.at();
+  b.position = r.vvec3("position");
+  b.orientation_at = r.at();
+  b.orientation = r.vquat("orientation");
+  b.linear_velocity_at = r.at();
+  b.linear_velocity = r.vvec3("linear velocity");
+  b.angular_velocity = r.vvec3("angular velocity");
+  b.sleep_time = r.vfixed("sleep time");
+  if ((b.flags & kHasUserData) != 0) {
+    const std::size_t at = r.at();
+    b.user_data = r.var("user data", 64);
+    if (r.ok() && b.user_data == 0) r.fail(at, "user data: flagged present but zero");
+  }
+  if ((b.flags & kHasForce) != 0) {
+    const std::size_t at = r.at();
+    b.force = r.vvec3("force");
+    if (r.ok() && b.force == Vec3{}) r.fail(at, "force: flagged present but zero");
+  }
+  if ((b.flags & kHasTorque) != 0) {
+    const std::size_t at = r.at();
+    b.torque = r.vvec3("torque");
+    if (r.ok() && b.torque == Vec3{}) r.fail(at, "torque: flagged present but zero");
+  }
+  b.end = r.at();
+  d.bodies.push_back(b);
+}
+
+inline bool has_body(const Decoded& d, std::uint64_t id) {
+  const auto it = std::lower_bound(
+      d.bodies.begin(), d.bodies.end(), id,
+      [](const DecodedBody& b, std::uint64_t value) { return b.id.value < value; });
+  return it != d.bodies.end() && it->id.value == id;
+}
+
+inline void read_contact(StateReader& r, Decoded& d, std::uint64_t& previous_a,
+                         std::uint64_t& previous_b) {
+  DecodedContact c;
+  c.at = r.at();
+  c.a_step = r.var("contact a step", 32);
+  c.b_at = r.at();
+  c.b_minus_a = r.var("contact b - a", 32);
+  const std::uint64_t a = previous_a + c.a_step;
+  const std::uint64_t b = a + c.b_minus_a;
+  if (r.ok() && c.b_minus_a == 0) r.fail(c.b_at, "contact b - a: zero");
+  if (r.ok() && !d.contacts.empty() && a == previous_a && b <= previous_b)
+    r.fail(c.at, "contact: not in ascending (a, b) order");
+  if (r.ok() && (!has_body(d, a) || !has_body(d, b))) r.fail(c.at, "contact: no such body");
+  previous_a = a;
+  previous_b = b;
+  c.a = static_cast<std::uint32_t>(a);
+  c.b = static_cast<std::uint32_t>(b);
+  c.points_at = r.at();
+  c.points_byte = r.u8("contact points");
+  if ((c.points_byte & ~(kPointCountBits | kReported)) != 0)
+    r.fail(c.points_at, "contact points: an unknown bit");
+  if (c.point_count() > 4) r.fail(c.points_at, "contact points: more than four");
+  if (c.reported() && c.point_count() == 0)
+    r.fail(c.points_at, "contact points: reported without points");
+  for (unsigned p = 0; p < c.point_count() && r.ok(); ++p) {
+    DecodedPoint point;
+    point.at = r.at();
+    point.feature_a = r.var("feature on a", 32);
+    if (point.feature_a > 1023) r.fail(point.at, "feature on a: beyond 1023");
+    point.feature_b_at = r.at();
+    point.feature_b = r.var("feature on b", 32);
+    if (point.feature_b > 1023) r.fail(point.feature_b_at, "feature on b: beyond 1023");
+    point.normal_impulse_at = r.at();
+    point.normal_impulse = r.vfixed("normal impulse");
+    point.tangent_impulse_1 = r.vfixed("tangent impulse 1");
+    point.tangent_impulse_2 = r.vfixed("tangent impulse 2");
+    c.points.push_back(point);
+  }
+  c.end = r.at();
+  d.contacts.push_back(c);
+}
+
+/// Decodes a whole v2 state; `ok` is false and `error` names the first problem otherwise (what was
+/// decoded up to there is kept).
+inline Decoded decode(std::span<const std::uint8_t> bytes) {
+  Decoded d;
+  StateReader r(bytes);
+  d.magic = r.u32("magic");
+  if (r.ok() && d.magic != kStateMagic) r.fail(0, "magic");
+  d.version = r.u32("version");
+  if (r.ok() && d.version != kStateVersion) r.fail(4, "version");
+  d.globals_at = r.at();
+  d.frame = r.u64("frame");
+  d.next_id_at = r.at();
+  d.next_id = r.u32("next ID");
+  d.def_at = r.at();
+  d.def = read_definition(r);
+  d.rng_at = r.at();
+  for (std::uint64_t& word : d.rng)
+    word = r.u64("rng");
+
+  d.property_count_at = r.at();
+  const std::uint32_t set_count = r.u32("property-set count");
+  for (std::uint32_t i = 0; i < set_count && r.ok(); ++i) {
+    const DecodedSet s = read_set(r);
+    for (const DecodedSet& other : d.sets) {
+      if (r.ok() && same_properties(s, other)) r.fail(s.at, "property set: a duplicate");
+    }
+    d.sets.push_back(s);
+  }
+
+  d.body_count_at = r.at();
+  const std::uint32_t body_count = r.u32("body count");
+  std::uint64_t previous_id = 0;
+  std::size_t used = 0;
+  for (std::uint32_t i = 0; i < body_count && r.ok(); ++i)
+    read_body(r, d, previous_id, used);
+  if (r.ok() && used != d.sets.size()) r.fail(d.property_count_at, "property set: unused");
+
+  d.contact_count_at = r.at();
+  const std::uint32_t contact_count = r.u32("contact count");
+  std::uint64_t previous_a = 0;
+  std::uint64_t previous_b = 0;
+  for (std::uint32_t i = 0; i < contact_count && r.ok(); ++i)
+    read_contact(r, d, previous_a, previous_b);
+
+  d.end = r.at();
+  if (r.ok() && !r.at_end()) r.fail(r.at(), "trailing bytes");
+  d.ok = r.ok();
+  d.error = r.error();
+  return d;
+}
+
+// ---- Writing ----
+
+class StateWriter {
+ public:
+  void u8(std::uint8_t v) { bytes_.push_back(v); }
+  void u32(std::uint32_t v) { little_endian(v, 4); }
+  void u64(std::uint64_t v) { little_endian(v, 8); }
+  void fixed(Fixed v) { little_endian(static_cast<std::uint64_t>(v.raw()), 8); }
+  void var(std::uint64_t v) {
+    const Bytes b = leb128(v);
+    bytes_.insert(bytes_.end(), b.begin(), b.end());
+  }
+  void vfixed(Fixed v) { var(zigzag(v)); }
+  void vvec3(Vec3 v) {
+    vfixed(v.x);
+    vfixed(v.y);
+    vfixed(v.z);
+  }
+  void vquat(Quat q) {
+    vfixed(q.w);
+    vfixed(q.x);
+    vfixed(q.y);
+    vfixed(q.z);
+  }
+  [[nodiscard]] Bytes take() { return std::move(bytes_); }
+
+ private:
+  void little_endian(std::uint64_t v, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i)
+      bytes_.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  }
+  Bytes bytes_;
+};
+
+inline void write_set(StateWriter& w, const DecodedSet& s) {
+  w.u8(static_cast<std::uint8_t>(s.type));
+  w.u8(static_cast<std::uint8_t>(s.shape.type));
+  switch (s.shape.type) {
+    case ShapeType::sphere:
+      w.vfixed(s.shape.radius);
+      break;
+    case ShapeType::box:
+      w.vvec3(s.shape.half_extents);
+      break;
+    case ShapeType::capsule:
+      w.vfixed(s.shape.radius);
+      w.vfixed(s.shape.half_height);
+      break;
+    default:
+      break;
+  }
+  w.vfixed(s.mass);
+  w.vvec3(s.inertia);
+  w.vfixed(s.friction);
+  w.vfixed(s.restitution);
+  w.vfixed(s.linear_damping);
+  w.vfixed(s.angular_damping);
+  w.u32(s.layer);
+  w.u32(s.mask);
+  w.u8(s.flags);
+}
+
+inline void write_body(StateWriter& w, const DecodedBody& b) {
+  w.var(b.id_step);
+  w.var(b.set);
+  w.u8(b.flags);
+  w.vvec3(b.position);
+  w.vquat(b.orientation);
+  w.vvec3(b.linear_velocity);
+  w.vvec3(b.angular_velocity);
+  w.vfixed(b.sleep_time);
+  if ((b.flags & kHasUserData) != 0) w.var(b.user_data);
+  if ((b.flags & kHasForce) != 0) w.vvec3(b.force);
+  if ((b.flags & kHasTorque) != 0) w.vvec3(b.torque);
+}
+
+inline void write_contact(StateWriter& w, const DecodedContact& c) {
+  w.var(c.a_step);
+  w.var(c.b_minus_a);
+  w.u8(c.points_byte);
+  for (const DecodedPoint& p : c.points) {
+    w.var(p.feature_a);
+    w.var(p.feature_b);
+    w.vfixed(p.normal_impulse);
+    w.vfixed(p.tangent_impulse_1);
+    w.vfixed(p.tangent_impulse_2);
+  }
+}
+
+/// The v2 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
+/// sizes of the vectors).
+inline Bytes encode(const Decoded& d) {
+  StateWriter w;
+  w.u32(d.magic);
+  w.u32(d.version);
+  w.u64(d.frame);
+  w.u32(d.next_id);
+  const WorldDef& def = d.def;
+  w.fixed(def.gravity.x);
+  w.fixed(def.gravity.y);
+  w.fixed(def.gravity.z);
+  w.fixed(def.dt);
+  w.u32(def.substeps);
+  w.u32(def.iterations);
+  w.u64(def.seed);
+  for (const Fixed f :
+       {def.max_linear_speed, def.max_angular_speed, def.contact_hertz, def.contact_damping_ratio,
+        def.contact_push_max, def.restitution_threshold, def.linear_slop, def.speculative_distance})
+    w.fixed(f);
+  w.u8(def.enable_sleep ? 1 : 0);
+  w.fixed(def.sleep_linear_speed);
+  w.fixed(def.sleep_angular_speed);
+  w.fixed(def.time_to_sleep);
+  for (const std::uint64_t word : d.rng)
+    w.u64(word);
+  w.u32(static_cast<std::uint32_t>(d.sets.size()));
+  for (const DecodedSet& s : d.sets)
+    write_set(w, s);
+  w.u32(static_cast<std::uint32_t>(d.bodies.size()));
+  for (const DecodedBody& b : d.bodies)
+    write_body(w, b);
+  w.u32(static_cast<std::uint32_t>(d.contacts.size()));
+  for (const DecodedContact& c : d.contacts)
+    write_contact(w, c);
+  return w.take();
+}
+
+inline Bytes encode_set(const DecodedSet& s) {
+  StateWriter w;
+  write_set(w, s);
+  return w.take();
+}
+
+inline Bytes encode_body(const DecodedBody& b) {
+  StateWriter w;
+  write_body(w, b);
+  return w.take();
+}
+
+}  // namespace detsim::state_test
