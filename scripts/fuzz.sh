@@ -5,6 +5,8 @@
 #           short replays), findings build-fuzz/findings
 #   packet  fuzz/net_packet_fuzz.cpp, the session wire protocol decoder: corpus
 #           build-fuzz/corpus-packet (seeded with valid datagrams), findings build-fuzz/findings-packet
+#   state   fuzz/state_restore_fuzz.cpp, World::restore (refusals change nothing, accepted bytes are
+#           canonical and step): corpus build-fuzz/corpus-state (seeded with saved scenario states)
 # DETSIM_FUZZ_BUILD names another build directory than build-fuzz. Exit status: 0 no finding,
 # non-zero a crash, leak, timeout or OOM was found (libFuzzer prints the reproducer's path).
 set -euo pipefail
@@ -15,7 +17,8 @@ build="${DETSIM_FUZZ_BUILD:-build-fuzz}"
 case "$target" in
   replay) fuzzer=replay_reader_fuzz seeds=make_seeds suffix="" max_len=65536 ;;
   packet) fuzzer=net_packet_fuzz seeds=make_packet_seeds suffix=-packet max_len=1300 ;;
-  *) echo "usage: scripts/fuzz.sh [SECONDS] [replay|packet]" >&2; exit 2 ;;
+  state) fuzzer=state_restore_fuzz seeds=make_state_seeds suffix=-state max_len=16384 ;;
+  *) echo "usage: scripts/fuzz.sh [SECONDS] [replay|packet|state]" >&2; exit 2 ;;
 esac
 flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
 cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
