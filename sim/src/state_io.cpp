@@ -126,60 +126,93 @@ Shape read_shape(ByteReader& r) {
 
 // ---- Property sets: what a body has that the simulation never changes by itself ----
 
-bool same_properties(const BodyState& a, const BodyState& b) noexcept {
-  return a.type == b.type && a.shape == b.shape && a.mass == b.mass && a.inertia == b.inertia &&
-         a.friction == b.friction && a.restitution == b.restitution &&
-         a.linear_damping == b.linear_damping && a.angular_damping == b.angular_damping &&
-         a.layer == b.layer && a.mask == b.mask && a.sensor == b.sensor && a.ccd == b.ccd;
+/// The property fields of a BodyState. Comparing and writing go through this one struct, so that
+/// two bodies share a set exactly when their sets' bytes would be equal.
+struct Properties {
+  BodyType type = BodyType::dynamic;
+  Shape shape{};
+  Fixed mass{};
+  Vec3 inertia{};
+  Fixed friction{};
+  Fixed restitution{};
+  Fixed linear_damping{};
+  Fixed angular_damping{};
+  std::uint32_t layer = 0;
+  std::uint32_t mask = 0;
+  bool sensor = false;
+  bool ccd = false;
+
+  friend bool operator==(const Properties&, const Properties&) noexcept = default;
+};
+
+Properties properties_of(const BodyState& b) noexcept {
+  return {b.type,           b.shape,           b.mass,  b.inertia, b.friction, b.restitution,
+          b.linear_damping, b.angular_damping, b.layer, b.mask,    b.sensor,   b.ccd};
 }
 
-void write_properties(const BodyState& b, ByteWriter& w) {
-  w.u8(static_cast<std::uint8_t>(b.type));
-  write_shape(b.shape, w);
-  w.var_fixed(b.mass);
-  w.var_vec3(b.inertia);
-  w.var_fixed(b.friction);
-  w.var_fixed(b.restitution);
-  w.var_fixed(b.linear_damping);
-  w.var_fixed(b.angular_damping);
-  w.u32(b.layer);
-  w.u32(b.mask);
-  w.u8(static_cast<std::uint8_t>((b.sensor ? kSensor : 0U) | (b.ccd ? kCcd : 0U)));
+void set_properties(BodyState& b, const Properties& p) noexcept {
+  b.type = p.type;
+  b.shape = p.shape;
+  b.mass = p.mass;
+  b.inertia = p.inertia;
+  b.friction = p.friction;
+  b.restitution = p.restitution;
+  b.linear_damping = p.linear_damping;
+  b.angular_damping = p.angular_damping;
+  b.layer = p.layer;
+  b.mask = p.mask;
+  b.sensor = p.sensor;
+  b.ccd = p.ccd;
 }
 
-/// Reads a property set into the property fields of `b`.
-void read_properties(ByteReader& r, BodyState& b) {
+void write_properties(const Properties& p, ByteWriter& w) {
+  w.u8(static_cast<std::uint8_t>(p.type));
+  write_shape(p.shape, w);
+  w.var_fixed(p.mass);
+  w.var_vec3(p.inertia);
+  w.var_fixed(p.friction);
+  w.var_fixed(p.restitution);
+  w.var_fixed(p.linear_damping);
+  w.var_fixed(p.angular_damping);
+  w.u32(p.layer);
+  w.u32(p.mask);
+  w.u8(static_cast<std::uint8_t>((p.sensor ? kSensor : 0U) | (p.ccd ? kCcd : 0U)));
+}
+
+Properties read_properties(ByteReader& r) {
+  Properties p;
   const std::size_t type_at = r.offset();
   const std::uint8_t type = r.u8("body type");
   if (type > static_cast<std::uint8_t>(BodyType::dynamic))
     r.fail_at(type_at, "body type", "0 (static), 1 (kinematic) or 2 (dynamic)");
-  b.type = static_cast<BodyType>(type);
-  b.shape = read_shape(r);
-  b.mass = r.var_fixed("body mass");
-  b.inertia = r.var_vec3("body inertia");
-  b.friction = r.var_fixed("body friction");
-  b.restitution = r.var_fixed("body restitution");
-  b.linear_damping = r.var_fixed("body linear damping");
-  b.angular_damping = r.var_fixed("body angular damping");
-  b.layer = r.u32("body layer");
-  b.mask = r.u32("body mask");
+  p.type = static_cast<BodyType>(type);
+  p.shape = read_shape(r);
+  p.mass = r.var_fixed("body mass");
+  p.inertia = r.var_vec3("body inertia");
+  p.friction = r.var_fixed("body friction");
+  p.restitution = r.var_fixed("body restitution");
+  p.linear_damping = r.var_fixed("body linear damping");
+  p.angular_damping = r.var_fixed("body angular damping");
+  p.layer = r.u32("body layer");
+  p.mask = r.u32("body mask");
   const std::size_t flags_at = r.offset();
   const std::uint8_t flags = r.u8("property flags");
   if (flags > (kSensor | kCcd))
     r.fail_at(flags_at, "property flags", "only bits 0 (sensor), 1 (CCD)");
-  b.sensor = (flags & kSensor) != 0;
-  b.ccd = (flags & kCcd) != 0;
+  p.sensor = (flags & kSensor) != 0;
+  p.ccd = (flags & kCcd) != 0;
+  return p;
 }
 
 // Semantic checks of a property set read from bytes; "" when valid.
-std::string check_properties(const BodyState& b) {
-  if (auto e = check_shape(b.shape, b.type); !e.empty()) return e;
-  if (b.mass < Fixed::zero()) return "mass must be >= 0";
-  if (b.type == BodyType::dynamic && (b.mass <= Fixed::zero() || b.inertia.x <= Fixed::zero() ||
-                                      b.inertia.y <= Fixed::zero() || b.inertia.z <= Fixed::zero()))
+std::string check_properties(const Properties& p) {
+  if (auto e = check_shape(p.shape, p.type); !e.empty()) return e;
+  if (p.mass < Fixed::zero()) return "mass must be >= 0";
+  if (p.type == BodyType::dynamic && (p.mass <= Fixed::zero() || p.inertia.x <= Fixed::zero() ||
+                                      p.inertia.y <= Fixed::zero() || p.inertia.z <= Fixed::zero()))
     return "a dynamic body needs a positive mass and moments of inertia";
-  if (b.friction < Fixed::zero() || b.restitution < Fixed::zero() || b.restitution > Fixed::one() ||
-      b.linear_damping < Fixed::zero() || b.angular_damping < Fixed::zero())
+  if (p.friction < Fixed::zero() || p.restitution < Fixed::zero() || p.restitution > Fixed::one() ||
+      p.linear_damping < Fixed::zero() || p.angular_damping < Fixed::zero())
     return "material or damping out of range";
   return {};
 }
@@ -303,7 +336,7 @@ void write_globals(const WorldState& s, ByteWriter& w) {
 }
 
 void write_body(const BodyState& b, ByteWriter& w) {
-  write_properties(b, w);
+  write_properties(properties_of(b), w);
   write_record(b, 0, 0, w);
 }
 
@@ -337,13 +370,16 @@ void write_bodies(const WorldState& s, ByteWriter& w) {
   std::unordered_map<std::string, std::uint32_t> index_of;
   std::vector<std::uint32_t> set_of(s.bodies.size());
   ByteWriter key;
+  Properties previous;
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
-    if (i > 0 && same_properties(s.bodies[i], s.bodies[i - 1])) {
+    const Properties p = properties_of(s.bodies[i]);
+    if (i > 0 && p == previous) {
       set_of[i] = set_of[i - 1];
       continue;
     }
+    previous = p;
     key.clear();
-    write_properties(s.bodies[i], key);
+    write_properties(p, key);
     const auto [it, added] =
         index_of.try_emplace(std::string(key.bytes().begin(), key.bytes().end()), set_count);
     if (added) {
@@ -408,21 +444,20 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
   if (r.ok() && set_count > r.remaining() / kMinPropertyBytes)
     return failed_at(set_count_at, "property set count " + std::to_string(set_count) +
                                        " exceeds what the data can hold");
-  // Each set keeps its property fields in a BodyState; its bytes must differ from every other's.
-  std::vector<BodyState> sets;
+  // Each set's bytes must differ from every other's.
+  std::vector<Properties> sets;
   sets.reserve(set_count);
   std::unordered_set<std::string_view> seen;
   for (std::uint32_t i = 0; i < set_count && r.ok(); ++i) {
     const std::size_t at = r.offset();
-    BodyState b;
-    read_properties(r, b);
+    const Properties p = read_properties(r);
     if (!r.ok()) break;
     const std::string where = "property set " + std::to_string(i) + ": ";
-    if (auto e = check_properties(b); !e.empty()) return failed_at(at, where + e);
+    if (auto e = check_properties(p); !e.empty()) return failed_at(at, where + e);
     const std::string_view set_bytes(reinterpret_cast<const char*>(bytes.data() + at),
                                      r.offset() - at);
     if (!seen.insert(set_bytes).second) return failed_at(at, where + "the same as an earlier set");
-    sets.push_back(b);
+    sets.push_back(p);
   }
   if (!r.ok()) return failed(r.error());
 
@@ -454,20 +489,8 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
                                              : " is used before set " + std::to_string(sets_used) +
                                                    " (sets are listed in order of first use)"));
     if (set == sets_used) ++sets_used;
-    const BodyState& p = sets[set];
     b.id = BodyId{static_cast<std::uint32_t>(id)};
-    b.type = p.type;
-    b.shape = p.shape;
-    b.mass = p.mass;
-    b.inertia = p.inertia;
-    b.friction = p.friction;
-    b.restitution = p.restitution;
-    b.linear_damping = p.linear_damping;
-    b.angular_damping = p.angular_damping;
-    b.layer = p.layer;
-    b.mask = p.mask;
-    b.sensor = p.sensor;
-    b.ccd = p.ccd;
+    set_properties(b, sets[set]);
     if (auto e = check_record(b); !e.empty()) return failed_at(at, where + e);
     s.bodies.push_back(b);
     previous_id = b.id.value;
