@@ -7,6 +7,7 @@
 #include <utility>
 
 #include <gtest/gtest.h>
+#include <detsim/fixed/exact_sum.hpp>
 #include <detsim/fixed/mat3.hpp>
 #include <detsim/fixed/quat.hpp>
 
@@ -319,6 +320,36 @@ TEST(Mat3, RotateInertiaIsTheExactValueRoundedOnce) {
         ASSERT_TRUE(is_rounded(entry(w, i, j).raw(), exact, 64))
             << testing::PrintToString(r) << "\n"
             << testing::PrintToString(inertia);
+      }
+    }
+  }
+}
+
+// Diagonal and isotropic tensors (every body's inverse inertia; isotropic for spheres and cubes)
+// take shortcuts in rotate_inertia: over the whole raw range, each entry must still be the sum of
+// all nine triple products, zero terms included, rounded once.
+TEST(Mat3, RotateInertiaOfDiagonalAndIsotropicTensorsIsTheExactSumRoundedOnce) {
+  std::mt19937_64 rng(308);
+  for (int n = 0; n < 20000; ++n) {
+    const auto any = [&rng] { return raw(static_cast<std::int64_t>(rng())); };
+    const Mat3 r = n % 3 == 0   ? to_mat3(random_unit(rng))
+                   : n % 3 == 1 ? random_mat(rng, n % 31)
+                                : Mat3{{Vec3{any(), any(), any()}, Vec3{any(), any(), any()},
+                                        Vec3{any(), any(), any()}}};
+    const Fixed d = raw(static_cast<std::int64_t>(rng()) >> (rng() % 64));
+    const Mat3 inertia = n % 2 == 0 ? Mat3::diagonal(d, d, d)
+                                    : Mat3::diagonal(d, raw(static_cast<std::int64_t>(rng())), d);
+    const Mat3 w = rotate_inertia(r, inertia);
+    for (std::size_t i = 0; i < 3; ++i) {
+      for (std::size_t j = 0; j < 3; ++j) {
+        detail::TripleProductSum exact;
+        for (std::size_t k = 0; k < 3; ++k) {
+          for (std::size_t l = 0; l < 3; ++l)
+            exact.add_product(entry(r, i, k).raw(), entry(inertia, k, l).raw(),
+                              entry(r, j, l).raw());
+        }
+        ASSERT_EQ(entry(w, i, j).raw(), exact.round_to_raw(64)) << testing::PrintToString(r) << "\n"
+                                                                << testing::PrintToString(inertia);
       }
     }
   }

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <detsim/fixed/fixed.hpp>
 #include <detsim/fixed/math.hpp>
+#include <detsim/fixed/vec3.hpp>
 #include <detsim/fixed/wide.hpp>
 
 #include "../fixed/src/isqrt.hpp"
@@ -476,6 +477,63 @@ TEST(FixedHypot, LogUniformIsCorrectlyRounded) {
   for (int i = 0; i < kRandomSamples; ++i) {
     const std::int64_t x = random_sign(rng, log_uniform_positive(rng));
     check.hypot(x, random_sign(rng, log_uniform_positive(rng)));
+  }
+}
+
+// ---- hypot_exceeds and length_exceeds: the comparison without the root -------------------------
+
+/// Limits around a root's raw value h, and the fixed ones where the comparison's cases change.
+std::vector<std::int64_t> limits_around(std::int64_t h, std::mt19937_64& rng) {
+  std::vector<std::int64_t> l = {0, -1, kMin, kMax, kMax - 1, static_cast<std::int64_t>(rng())};
+  for (const std::int64_t d : {-2, -1, 0, 1, 2}) {
+    if ((d < 0 && h >= kMin - d) || (d >= 0 && h <= kMax - d)) l.push_back(h + d);
+  }
+  return l;
+}
+
+TEST(FixedHypot, ExceedsAgreesWithTheRoundedRoot) {
+  std::mt19937_64 rng = seeded(17);
+  std::vector<std::pair<std::int64_t, std::int64_t>> inputs;
+  const std::vector<std::int64_t> edges = edge_raws();
+  for (const std::int64_t x : edges) {
+    for (const std::int64_t y : {std::int64_t{0}, std::int64_t{1}, kOne, kMax, kMin})
+      inputs.emplace_back(x, y);
+  }
+  for (int i = 0; i < 300000; ++i) {
+    inputs.emplace_back(random_sign(rng, log_uniform_positive(rng)),
+                        random_sign(rng, log_uniform_positive(rng)));
+  }
+  for (int i = 0; i < 100000; ++i)  // near saturation
+    inputs.emplace_back(kMax - static_cast<std::int64_t>(rng() >> (1 + rng() % 63)),
+                        static_cast<std::int64_t>(rng() >> (1 + rng() % 63)));
+  for (const auto& [x, y] : inputs) {
+    const Fixed h = hypot(raw(x), raw(y));
+    for (const std::int64_t l : limits_around(h.raw(), rng)) {
+      ASSERT_EQ(hypot_exceeds(raw(x), raw(y), raw(l)), h > raw(l))
+          << show(raw(x)) << ", " << show(raw(y)) << " against " << show(raw(l));
+    }
+  }
+}
+
+TEST(FixedHypot, LengthExceedsAgreesWithTheRoundedLength) {
+  std::mt19937_64 rng = seeded(18);
+  std::vector<Vec3> inputs;
+  for (const std::int64_t x : edge_raws()) {
+    for (const std::int64_t y : {std::int64_t{0}, std::int64_t{-1}, kOne, kMax, kMin})
+      inputs.push_back({raw(x), raw(y), raw(x == kMin ? 0 : -x)});
+  }
+  for (int i = 0; i < 300000; ++i) {
+    inputs.push_back({raw(random_sign(rng, log_uniform_positive(rng))),
+                      raw(random_sign(rng, log_uniform_positive(rng))),
+                      raw(i % 2 == 0 ? static_cast<std::int64_t>(rng())
+                                     : random_sign(rng, log_uniform_positive(rng)))});
+  }
+  for (const Vec3& v : inputs) {
+    const Fixed h = length(v);
+    for (const std::int64_t l : limits_around(h.raw(), rng)) {
+      ASSERT_EQ(length_exceeds(v, raw(l)), h > raw(l))
+          << show(v.x) << ", " << show(v.y) << ", " << show(v.z) << " against " << show(raw(l));
+    }
   }
 }
 

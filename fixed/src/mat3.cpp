@@ -140,17 +140,30 @@ Mat3 rotate_inertia(const Mat3& rotation, const Mat3& inertia) noexcept {
   // (R I R^T)_ij = sum_kl R_ik I_kl R_jl. With I symmetric, the terms k != l pair up:
   // sum_k I_kk R_ik R_jk + sum_{k<l} I_kl (R_ik R_jl + R_il R_jk). Each pair is exact in Q64.64
   // (at most 2^127), each term at most 2^190 in Q96.96, and the six terms sum below 2^193.
+  // Zero pairs are skipped (a diagonal tensor has none), and an isotropic tensor d 1 (a sphere's,
+  // a cube's) takes its common factor out: d sum_k R_ik R_jk, one product by d instead of three.
+  // Either way the exact sum is the same, and so is its one rounding.
+  const bool isotropic =
+      t[0][1] == 0 && t[0][2] == 0 && t[1][2] == 0 && t[0][0] == t[1][1] && t[1][1] == t[2][2];
   Raws w{};
   for (std::size_t i = 0; i < 3; ++i) {
     for (std::size_t j = i; j < 3; ++j) {
       detail::TripleProductSum s;
-      for (std::size_t k = 0; k < 3; ++k) {
-        s.add_product(r[i][k], r[j][k], t[k][k]);
-        for (std::size_t l = k + 1; l < 3; ++l) {
-          detail::ProductSum pair;
-          pair.add_product(r[i][k], r[j][l]);
-          pair.add_product(r[i][l], r[j][k]);
-          s.add_product(pair.negative(), pair.magnitude_128(), t[k][l]);
+      if (isotropic) {
+        detail::ProductSum rr;  // |sum| < 3 * 2^126: fits in 128 bits
+        for (std::size_t k = 0; k < 3; ++k)
+          rr.add_product(r[i][k], r[j][k]);
+        s.add_product(rr.negative(), rr.magnitude_128(), t[0][0]);
+      } else {
+        for (std::size_t k = 0; k < 3; ++k) {
+          s.add_product(r[i][k], r[j][k], t[k][k]);
+          for (std::size_t l = k + 1; l < 3; ++l) {
+            if (t[k][l] == 0) continue;
+            detail::ProductSum pair;
+            pair.add_product(r[i][k], r[j][l]);
+            pair.add_product(r[i][l], r[j][k]);
+            s.add_product(pair.negative(), pair.magnitude_128(), t[k][l]);
+          }
         }
       }
       w[i][j] = s.round_to_raw(2 * Fixed::fraction_bits);

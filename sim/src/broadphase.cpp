@@ -15,8 +15,11 @@ namespace detsim::sim_detail {
 
 namespace {
 
+// A body's bounding box, copied out of Derived so that the sweep's inner loop reads a compact
+// array instead of the whole derived record of every active body.
 struct SweepItem {
-  Fixed min_x;
+  Vec3 min;
+  Vec3 max;
   std::uint32_t index;  // into bodies; bodies are ID-sorted, so index order is ID order
 };
 
@@ -32,72 +35,104 @@ bool may_interact(const BodyState& a, const BodyState& b) {
   return layers_match(a, b);
 }
 
-bool overlap_yz(const Derived& a, const Derived& b) {
-  return a.aabb_min.y <= b.aabb_max.y && b.aabb_min.y <= a.aabb_max.y &&
-         a.aabb_min.z <= b.aabb_max.z && b.aabb_min.z <= a.aabb_max.z;
+bool overlap_yz(const SweepItem& a, const SweepItem& b) {
+  return a.min.y <= b.max.y && b.min.y <= a.max.y && a.min.z <= b.max.z && b.min.z <= a.max.z;
 }
 
 // Whether the box [lo, hi] reaches the half-space below the plane through `p` with unit normal n.
-bool below_plane(const Derived& box, Vec3 p, Vec3 n) {
+bool below_plane(const SweepItem& box, Vec3 p, Vec3 n) {
   const auto halve = [](Vec3 v) { return Vec3{v.x >> 1, v.y >> 1, v.z >> 1}; };
-  const Vec3 c = halve(box.aabb_min + box.aabb_max);
-  const Vec3 e = halve(box.aabb_max - box.aabb_min);
+  const Vec3 c = halve(box.min + box.max);
+  const Vec3 e = halve(box.max - box.min);
   const Fixed radius = abs(n.x) * e.x + abs(n.y) * e.y + abs(n.z) * e.z;
   return dot(c - p, n) <= radius;
 }
 
-}  // namespace
+// Sweep order: min x, then index (a total order, so every correct sort gives the same sequence).
+bool sweeps_before(const SweepItem& a, const SweepItem& b) {
+  return a.min.x != b.min.x ? a.min.x < b.min.x : a.index < b.index;
+}
 
-void update_contacts(WorldState& s) {
+// Insertion sort that gives up (leaving a permutation of the input) after `budget` moves: linear
+// on the nearly sorted input a moving scene gives from one step to the next.
+bool insertion_sort(std::vector<SweepItem>& v, std::size_t budget) {
+  for (std::size_t i = 1; i < v.size(); ++i) {
+    const SweepItem x = v[i];
+    std::size_t j = i;
+    for (; j > 0 && sweeps_before(x, v[j - 1]); --j) {
+      if (budget-- == 0) {
+        v[j] = x;
+        return false;
+      }
+      v[j] = v[j - 1];
+    }
+    v[j] = x;
+  }
+  return true;
+}
+
+// The bounded bodies' boxes in sweep order; the planes' indices go to `planes`. The sort starts
+// from the last step's order (WorldState::sweep_order) when that is still a permutation of the
+// bounded bodies.
+std::vector<SweepItem> sorted_sweep_items(WorldState& s, std::vector<std::uint32_t>& planes) {
   const std::size_t n = s.bodies.size();
-  std::vector<SweepItem> items;
-  items.reserve(n);
-  std::vector<std::uint32_t> planes;
   for (std::size_t i = 0; i < n; ++i) {
-    if (s.derived[i].infinite) {
-      planes.push_back(static_cast<std::uint32_t>(i));
-    } else {
-      items.push_back({s.derived[i].aabb_min.x, static_cast<std::uint32_t>(i)});
-    }
+    if (s.derived[i].infinite) planes.push_back(static_cast<std::uint32_t>(i));
   }
-  std::sort(items.begin(), items.end(), [](const SweepItem& a, const SweepItem& b) {
-    return a.min_x != b.min_x ? a.min_x < b.min_x : a.index < b.index;
-  });
-
-  // Pairs as (lower index, higher index) packed into 64 bits: sorting them sorts by ID pair.
-  std::vector<std::uint64_t> pairs;
-  const auto add_pair = [&](std::uint32_t i, std::uint32_t j) {
-    const BodyState& a = s.bodies[i];
-    const BodyState& b = s.bodies[j];
-    if (!may_interact(a, b)) return;
-    const std::uint32_t lo = std::min(i, j);
-    const std::uint32_t hi = std::max(i, j);
-    pairs.push_back((std::uint64_t{lo} << 32) | hi);
+  const auto item = [&s](std::uint32_t i) {
+    return SweepItem{s.derived[i].aabb_min, s.derived[i].aabb_max, i};
   };
-  std::vector<std::uint32_t> active;
-  for (const SweepItem& item : items) {
-    const Derived& d = s.derived[item.index];
-    std::erase_if(active, [&](std::uint32_t j) { return s.derived[j].aabb_max.x < item.min_x; });
-    for (const std::uint32_t j : active) {
-      if (overlap_yz(d, s.derived[j])) add_pair(item.index, j);
-    }
-    active.push_back(item.index);
+  std::vector<SweepItem> items;
+  items.reserve(n - planes.size());
+  bool hinted = s.sweep_order.size() == n - planes.size();
+  std::vector<bool> seen(hinted ? n : 0, false);
+  for (std::size_t k = 0; hinted && k < s.sweep_order.size(); ++k) {
+    const std::uint32_t i = s.sweep_order[k];
+    hinted = i < n && !s.derived[i].infinite && !seen[i];
+    if (hinted) seen[i] = true;
   }
-  for (const std::uint32_t p : planes) {
-    const Vec3 normal = s.derived[p].pose.rotation.column(1);
-    for (const SweepItem& item : items) {
-      if (below_plane(s.derived[item.index], s.bodies[p].position, normal)) add_pair(p, item.index);
+  if (hinted) {
+    for (const std::uint32_t i : s.sweep_order)
+      items.push_back(item(i));
+  } else {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!s.derived[i].infinite) items.push_back(item(static_cast<std::uint32_t>(i)));
     }
   }
-  std::sort(pairs.begin(), pairs.end());
+  if (!hinted || !insertion_sort(items, 4 * items.size()))
+    std::sort(items.begin(), items.end(), sweeps_before);
+  s.sweep_order.clear();
+  for (const SweepItem& it : items)
+    s.sweep_order.push_back(it.index);
+  return items;
+}
 
-  // Merge: keep the contacts whose pair persists (with their cached impulses), add new ones.
+// The new contact list: the contacts whose pair persists (with their cached impulses) and new ones
+// for the new pairs; the pairs that ended report their end.
+void merge_contacts(WorldState& s, const std::vector<std::uint64_t>& pairs) {
+  const auto index_a = [](std::uint64_t pair) { return static_cast<std::uint32_t>(pair >> 32); };
+  const auto index_b = [](std::uint64_t pair) {
+    return static_cast<std::uint32_t>(pair & 0xFFFFFFFFU);
+  };
+  // At rest the pairs are the last step's: only the indices need refreshing.
+  bool same = pairs.size() == s.contacts.size();
+  for (std::size_t k = 0; same && k < pairs.size(); ++k) {
+    same = s.contacts[k].a == s.bodies[index_a(pairs[k])].id.value &&
+           s.contacts[k].b == s.bodies[index_b(pairs[k])].id.value;
+  }
+  if (same) {
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      s.contacts[k].index_a = index_a(pairs[k]);
+      s.contacts[k].index_b = index_b(pairs[k]);
+    }
+    return;
+  }
   std::vector<Contact> merged;
   merged.reserve(pairs.size());
   std::size_t old = 0;
   for (const std::uint64_t pair : pairs) {
-    const std::uint32_t a = s.bodies[static_cast<std::size_t>(pair >> 32)].id.value;
-    const std::uint32_t b = s.bodies[static_cast<std::size_t>(pair & 0xFFFFFFFFU)].id.value;
+    const std::uint32_t a = s.bodies[index_a(pair)].id.value;
+    const std::uint32_t b = s.bodies[index_b(pair)].id.value;
     while (old < s.contacts.size() &&
            (s.contacts[old].a < a || (s.contacts[old].a == a && s.contacts[old].b < b)))
       report_end(s, s.contacts[old++]);  // a pair whose boxes parted
@@ -109,10 +144,46 @@ void update_contacts(WorldState& s) {
       c.b = b;
       merged.push_back(c);
     }
+    merged.back().index_a = index_a(pair);
+    merged.back().index_b = index_b(pair);
   }
   for (; old < s.contacts.size(); ++old)
     report_end(s, s.contacts[old]);
   s.contacts = std::move(merged);
+}
+
+}  // namespace
+
+void update_contacts(WorldState& s) {
+  std::vector<std::uint32_t> planes;
+  const std::vector<SweepItem> items = sorted_sweep_items(s, planes);
+
+  // Pairs as (lower index, higher index) packed into 64 bits: sorting them sorts by ID pair.
+  std::vector<std::uint64_t> pairs;
+  const auto add_pair = [&](std::uint32_t i, std::uint32_t j) {
+    const BodyState& a = s.bodies[i];
+    const BodyState& b = s.bodies[j];
+    if (!may_interact(a, b)) return;
+    const std::uint32_t lo = std::min(i, j);
+    const std::uint32_t hi = std::max(i, j);
+    pairs.push_back((std::uint64_t{lo} << 32) | hi);
+  };
+  std::vector<SweepItem> active;
+  for (const SweepItem& item : items) {
+    std::erase_if(active, [&](const SweepItem& other) { return other.max.x < item.min.x; });
+    for (const SweepItem& other : active) {
+      if (overlap_yz(item, other)) add_pair(item.index, other.index);
+    }
+    active.push_back(item);
+  }
+  for (const std::uint32_t p : planes) {
+    const Vec3 normal = s.derived[p].pose.rotation.column(1);
+    for (const SweepItem& item : items) {
+      if (below_plane(item, s.bodies[p].position, normal)) add_pair(p, item.index);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  merge_contacts(s, pairs);
 }
 
 }  // namespace detsim::sim_detail

@@ -30,10 +30,9 @@ bool moving(const BodyState& b) {
 // body's rotation). Speculative contacts over this margin let the solver stop a fast body exactly
 // at the surface instead of resolving a deep overlap a step later, which keeps bounces elastic and
 // thin walls solid; the margin is capped so that a runaway speed cannot make every pair collide.
-Fixed contact_margin(const WorldState& s, const BodyState& a, const BodyState& b) {
-  const Fixed closing = length(a.linear_velocity - b.linear_velocity) +
-                        length(a.angular_velocity) * bounding_radius(a.shape) +
-                        length(b.angular_velocity) * bounding_radius(b.shape);
+Fixed contact_margin(const WorldState& s, std::size_t ia, std::size_t ib) {
+  const Fixed closing = length(s.bodies[ia].linear_velocity - s.bodies[ib].linear_velocity) +
+                        s.derived[ia].rim_speed + s.derived[ib].rim_speed;
   const Fixed cap = Fixed::from_int(20);
   return s.def.speculative_distance + min(closing * s.def.dt, cap);
 }
@@ -43,7 +42,7 @@ void collide_one(WorldState& s, Contact& c, std::size_t ia, std::size_t ib) {
   const BodyState& a = s.bodies[ia];
   const BodyState& b = s.bodies[ib];
   c.manifold =
-      collide(a.shape, s.derived[ia].pose, b.shape, s.derived[ib].pose, contact_margin(s, a, b));
+      collide(a.shape, s.derived[ia].pose, b.shape, s.derived[ib].pose, contact_margin(s, ia, ib));
   std::array<CachedPoint, 4> next{};
   for (std::size_t k = 0; k < c.manifold.count; ++k) {
     next[k].feature = c.manifold.points[k].feature;
@@ -86,8 +85,8 @@ UnionFind islands(const WorldState& s) {
   UnionFind uf(s.bodies.size());
   for (const Contact& c : s.contacts) {
     if (!c.touching) continue;
-    const std::size_t ia = index_of(s, c.a);
-    const std::size_t ib = index_of(s, c.b);
+    const std::size_t ia = c.index_a;
+    const std::size_t ib = c.index_b;
     const BodyState& a = s.bodies[ia];
     const BodyState& b = s.bodies[ib];
     if (a.type == BodyType::dynamic && b.type == BodyType::dynamic && !a.sensor && !b.sensor)
@@ -114,8 +113,8 @@ Fixed bounding_radius(const Shape& shape) noexcept {
 
 void collide_contacts(WorldState& s) {
   for (Contact& c : s.contacts) {
-    const std::size_t ia = index_of(s, c.a);
-    const std::size_t ib = index_of(s, c.b);
+    const std::size_t ia = c.index_a;
+    const std::size_t ib = c.index_b;
     // A pair where nothing moves keeps its manifold and impulses as they were.
     if (!moving(s.bodies[ia]) && !moving(s.bodies[ib])) continue;
     collide_one(s, c, ia, ib);
@@ -131,8 +130,8 @@ void wake_touched_islands(WorldState& s) {
   // A moving kinematic body is in no island but wakes what it touches.
   for (const Contact& c : s.contacts) {
     if (!c.touching) continue;
-    const std::size_t ia = index_of(s, c.a);
-    const std::size_t ib = index_of(s, c.b);
+    const std::size_t ia = c.index_a;
+    const std::size_t ib = c.index_b;
     if (moving(s.bodies[ia]) && s.bodies[ib].type == BodyType::dynamic)
       wake[uf.root(static_cast<std::uint32_t>(ib))] = true;
     if (moving(s.bodies[ib]) && s.bodies[ia].type == BodyType::dynamic)
@@ -144,17 +143,16 @@ void wake_touched_islands(WorldState& s) {
     if (b.type == BodyType::dynamic && !b.awake && wake[uf.root(static_cast<std::uint32_t>(i))]) {
       b.awake = true;
       b.sleep_time = Fixed::zero();
+      prepare_body(s, i);  // the derived data the solver will use for it (no other body changed)
       woke_any = true;
     }
   }
   if (!woke_any) return;
-  // The pairs of bodies that just woke were skipped by collide_contacts: collide them now, and
-  // refresh the derived data the solver will use for them.
-  prepare_bodies(s);
+  // The pairs of bodies that just woke were skipped by collide_contacts: collide them now, with
+  // every other pair it skipped. The pairs it collided would come out the same again (same poses
+  // and speeds, and matching the cache by feature twice is matching it once).
   for (Contact& c : s.contacts) {
-    const std::size_t ia = index_of(s, c.a);
-    const std::size_t ib = index_of(s, c.b);
-    collide_one(s, c, ia, ib);
+    if (!c.collided) collide_one(s, c, c.index_a, c.index_b);
   }
 }
 
@@ -169,8 +167,8 @@ void report_contacts(WorldState& s) {
   for (Contact& c : s.contacts) {
     if (!c.collided) continue;  // neither body moved: the pair is as it was
     c.collided = false;
-    const BodyState& a = s.bodies[index_of(s, c.a)];
-    const BodyState& b = s.bodies[index_of(s, c.b)];
+    const BodyState& a = s.bodies[c.index_a];
+    const BodyState& b = s.bodies[c.index_b];
     // A solid pair is in touch when a point began the step within the speculative distance, or
     // when the solver pushed on it (a fast body that met the surface and bounced within the step
     // never shows a small gap at a step's boundary). The contact margin also holds points that a
@@ -216,8 +214,8 @@ void update_sleep(WorldState& s) {
   }
   for (const Contact& c : s.contacts) {
     if (!c.touching) continue;
-    const std::size_t ia = index_of(s, c.a);
-    const std::size_t ib = index_of(s, c.b);
+    const std::size_t ia = c.index_a;
+    const std::size_t ib = c.index_b;
     if (s.bodies[ia].type == BodyType::kinematic && moving(s.bodies[ia]))
       keep_awake[uf.root(static_cast<std::uint32_t>(ib))] = true;
     if (s.bodies[ib].type == BodyType::kinematic && moving(s.bodies[ib]))

@@ -34,6 +34,7 @@ struct SolverPoint {
   Vec3 anchor_a;  // contact point relative to each body's centre at the start of the step
   Vec3 anchor_b;
   Fixed base_separation;
+  Fixed separation;  // current_separation at the bodies' present motion (refresh_separations)
   Fixed normal_mass;
   Fixed tangent_mass_1;
   Fixed tangent_mass_2;
@@ -53,6 +54,14 @@ struct Constraint {
   Fixed friction;
   Fixed restitution;
   std::uint8_t count;
+  // Whether each body's velocity can change under an impulse, and whether it is still (zero
+  // velocity that nothing changes). An impulse on a body of zero inverse mass and zero inverse
+  // inertia changes nothing, bit for bit, and a still body adds exactly zero to relative
+  // velocities: the solver skips that arithmetic instead of computing zeros.
+  bool takes_impulse_a;
+  bool takes_impulse_b;
+  bool still_a;
+  bool still_b;
   bool pushed;   // some point has pushed in this step
   bool bounced;  // restitution applied this step
   std::array<SolverPoint, 4> points;
@@ -73,6 +82,10 @@ Softness make_soft(Fixed hertz, Fixed zeta, Fixed h) {
   const Fixed a2 = h * omega * a1;
   const Fixed a3 = Fixed::one() / (Fixed::one() + a2);
   return {omega / a1, a2 * a3, a3};
+}
+
+Vec3 halve(Vec3 v) {
+  return {v.x >> 1, v.y >> 1, v.z >> 1};
 }
 
 // A unit vector perpendicular to the unit vector n, chosen by n's components only.
@@ -107,6 +120,8 @@ class Solver {
     const Fixed hertz = min(s.def.contact_hertz, inv_h_ >> 2);
     soft_ = make_soft(hertz, s.def.contact_damping_ratio, h_);
     static_soft_ = make_soft(min(hertz << 1, inv_h_ >> 2), s.def.contact_damping_ratio, h_);
+    gravity_kick_ = s.def.gravity * h_;
+    gravity_half_kick_ = halve(gravity_kick_);
     velocities_.resize(s.bodies.size());
     half_kick_.resize(s.bodies.size());
     in_contact_.assign(s.bodies.size(), false);
@@ -117,7 +132,7 @@ class Solver {
   }
 
   void run() {
-    prepare_constraints();
+    prepare_constraints();  // sets every separation to its base (no motion yet)
     for (std::uint32_t sub = 0; sub < s_.def.substeps; ++sub) {
       integrate_velocities();
       warm_start();
@@ -125,6 +140,7 @@ class Solver {
         solve_contacts(true);
       clamp_speeds();  // contact impulses (a crushed light body) can exceed what gravity could
       integrate_positions();
+      refresh_separations();
       for (std::uint32_t i = 0; i < s_.def.iterations; ++i)
         solve_contacts(false);
       apply_restitution();
@@ -142,13 +158,25 @@ class Solver {
  private:
   bool solvable(const BodyState& b) const { return b.type != BodyType::static_body && b.awake; }
 
+  static bool takes_impulse(const Derived& d) {
+    return d.inverse_mass != Fixed::zero() || d.inverse_inertia_world != Mat3::zero();
+  }
+
+  // Still: no velocity, and none to come (integrate_velocities and clamp_speeds touch only awake
+  // dynamic bodies, apply only bodies that take impulses).
+  bool still(std::size_t i) const {
+    const BodyState& b = s_.bodies[i];
+    return !(b.type == BodyType::dynamic && b.awake) && !takes_impulse(s_.derived[i]) &&
+           velocities_[i].linear == Vec3{} && velocities_[i].angular == Vec3{};
+  }
+
   void prepare_constraints() {
     constraints_.clear();
     for (std::size_t ci = 0; ci < s_.contacts.size(); ++ci) {
       const Contact& c = s_.contacts[ci];
       if (c.point_count == 0) continue;
-      const std::size_t ia = static_cast<std::size_t>(s_.find(c.a));
-      const std::size_t ib = static_cast<std::size_t>(s_.find(c.b));
+      const std::size_t ia = c.index_a;
+      const std::size_t ib = c.index_b;
       const BodyState& a = s_.bodies[ia];
       const BodyState& b = s_.bodies[ib];
       if (a.sensor || b.sensor) continue;
@@ -167,6 +195,10 @@ class Solver {
       k.friction = sqrt(a.friction * b.friction);
       k.restitution = max(a.restitution, b.restitution);
       k.count = c.point_count;
+      k.takes_impulse_a = takes_impulse(da);
+      k.takes_impulse_b = takes_impulse(db);
+      k.still_a = still(ia);
+      k.still_b = still(ib);
       k.pushed = false;
       k.bounced = false;
       Vec3 sum_a;
@@ -178,6 +210,7 @@ class Solver {
         sp.anchor_a = mp.point - a.position;
         sp.anchor_b = mp.point - b.position;
         sp.base_separation = mp.separation;
+        sp.separation = mp.separation;
         sp.normal_mass = effective_mass(da, db, sp.anchor_a, sp.anchor_b, k.normal);
         sp.tangent_mass_1 = effective_mass(da, db, sp.anchor_a, sp.anchor_b, k.tangent_1);
         sp.tangent_mass_2 = effective_mass(da, db, sp.anchor_a, sp.anchor_b, k.tangent_2);
@@ -187,41 +220,57 @@ class Solver {
         sp.tangent_impulse_1 = c.cached[p].tangent_impulse_1;
         sp.tangent_impulse_2 = c.cached[p].tangent_impulse_2;
       }
-      const Fixed count = Fixed::from_int(c.point_count);
       k.centroid = {};
-      k.centroid.anchor_a = sum_a / count;
-      k.centroid.anchor_b = sum_b / count;
-      k.centroid.normal_mass =
-          effective_mass(da, db, k.centroid.anchor_a, k.centroid.anchor_b, k.normal);
-      k.centroid.relative_velocity = dot(relative_velocity(ia, ib, k.centroid), k.normal);
+      if (k.restitution != Fixed::zero()) {  // the centroid serves restitution only
+        const Fixed count = Fixed::from_int(c.point_count);
+        k.centroid.anchor_a = sum_a / count;
+        k.centroid.anchor_b = sum_b / count;
+        k.centroid.normal_mass =
+            effective_mass(da, db, k.centroid.anchor_a, k.centroid.anchor_b, k.normal);
+        k.centroid.relative_velocity = dot(relative_velocity(k, k.centroid), k.normal);
+      }
       in_contact_[ia] = true;
       in_contact_[ib] = true;
       constraints_.push_back(k);
     }
   }
 
-  Vec3 relative_velocity(std::size_t ia, std::size_t ib, const SolverPoint& p) const {
-    const Velocity& va = velocities_[ia];
-    const Velocity& vb = velocities_[ib];
-    return (vb.linear + cross(vb.angular, p.anchor_b)) -
-           (va.linear + cross(va.angular, p.anchor_a));
+  // The velocity of a body's material point at `anchor`; exactly zero for a still body, whose
+  // velocities are zero (0 + cross(0, r) is the zero vector).
+  Vec3 point_velocity(std::size_t i, bool is_still, Vec3 anchor) const {
+    if (is_still) return {};
+    const Velocity& v = velocities_[i];
+    return v.linear + cross(v.angular, anchor);
   }
 
-  void apply(std::size_t ia, std::size_t ib, const SolverPoint& p, Vec3 impulse) {
-    const Derived& da = s_.derived[ia];
-    const Derived& db = s_.derived[ib];
-    Velocity& va = velocities_[ia];
-    Velocity& vb = velocities_[ib];
-    va.linear -= impulse * da.inverse_mass;
-    va.angular -= da.inverse_inertia_world * cross(p.anchor_a, impulse);
-    vb.linear += impulse * db.inverse_mass;
-    vb.angular += db.inverse_inertia_world * cross(p.anchor_b, impulse);
+  Vec3 relative_velocity(const Constraint& k, const SolverPoint& p) const {
+    return point_velocity(k.b, k.still_b, p.anchor_b) - point_velocity(k.a, k.still_a, p.anchor_a);
+  }
+
+  // v * m; for m = 1 (a body of unit mass) that is v itself, bit for bit, without three multiplies.
+  static Vec3 scaled(Vec3 v, Fixed m) { return m == Fixed::one() ? v : v * m; }
+
+  // A zero impulse, or the side of a body that takes no impulses, would add exact zeros to the
+  // velocities (0 * m = 0, M 0 = 0, v - 0 = v): both are skipped, which changes no bit.
+  void apply(const Constraint& k, const SolverPoint& p, Vec3 impulse) {
+    if (impulse == Vec3{}) return;
+    if (k.takes_impulse_a) {
+      const Derived& da = s_.derived[k.a];
+      Velocity& va = velocities_[k.a];
+      va.linear -= scaled(impulse, da.inverse_mass);
+      va.angular -= da.inverse_inertia_world * cross(p.anchor_a, impulse);
+    }
+    if (k.takes_impulse_b) {
+      const Derived& db = s_.derived[k.b];
+      Velocity& vb = velocities_[k.b];
+      vb.linear += scaled(impulse, db.inverse_mass);
+      vb.angular += db.inverse_inertia_world * cross(p.anchor_b, impulse);
+    }
   }
 
   Vec3 clamp_speed(Vec3 v, Fixed limit) const {
-    const Fixed l = length(v);
-    if (l <= limit) return v;
-    return v * (limit / l);
+    if (!length_exceeds(v, limit)) return v;  // length(v) <= limit, most often: no root needed
+    return v * (limit / length(v));
   }
 
   // The speed limits hold for every velocity a body moves with and keeps, not only after forces.
@@ -242,10 +291,17 @@ class Solver {
       if (b.type != BodyType::dynamic || !b.awake) continue;
       const Derived& d = s_.derived[i];
       Velocity& v = velocities_[i];
-      const Vec3 kick = (def.gravity + b.force * d.inverse_mass) * h_;
-      half_kick_[i] = {kick.x >> 1, kick.y >> 1, kick.z >> 1};
-      v.linear += kick;
-      v.angular += (d.inverse_inertia_world * b.torque) * h_;
+      // Without a force, the kick is gravity's (g + 0 m = g exactly), the same for every body; a
+      // zero torque adds exactly zero (M 0 h = 0).
+      if (b.force == Vec3{}) {
+        half_kick_[i] = gravity_half_kick_;
+        v.linear += gravity_kick_;
+      } else {
+        const Vec3 kick = (def.gravity + b.force * d.inverse_mass) * h_;
+        half_kick_[i] = halve(kick);
+        v.linear += kick;
+      }
+      if (b.torque != Vec3{}) v.angular += (d.inverse_inertia_world * b.torque) * h_;
       // Implicit damping, unconditionally stable: v /= 1 + h c.
       if (b.linear_damping > Fixed::zero()) v.linear /= Fixed::one() + h_ * b.linear_damping;
       if (b.angular_damping > Fixed::zero()) v.angular /= Fixed::one() + h_ * b.angular_damping;
@@ -256,11 +312,27 @@ class Solver {
 
   // Where the surfaces of a point are now, from the manifold and the motion since the step began.
   Fixed current_separation(const Constraint& k, const SolverPoint& sp) const {
-    const Derived& da = s_.derived[k.a];
-    const Derived& db = s_.derived[k.b];
-    const Vec3 moved = (db.delta_position + cross(db.delta_angle, sp.anchor_b)) -
-                       (da.delta_position + cross(da.delta_angle, sp.anchor_a));
+    const Vec3 moved =
+        displacement(k.b, k.still_b, sp.anchor_b) - displacement(k.a, k.still_a, sp.anchor_a);
     return sp.base_separation + dot(moved, k.normal);
+  }
+
+  // How far a body's material point at `anchor` has moved since the start of the step; exactly
+  // zero for a still body, which integrate_positions never moves (0 + cross(0, r) = 0).
+  Vec3 displacement(std::size_t i, bool is_still, Vec3 anchor) const {
+    if (is_still) return {};
+    const Derived& d = s_.derived[i];
+    return d.delta_position + cross(d.delta_angle, anchor);
+  }
+
+  // The separations depend only on the bodies' motion since the start of the step, which only
+  // integrate_positions changes: computed once after it (and before the first sub-step), they
+  // serve the warm start, the solve and the relaxation that follow.
+  void refresh_separations() {
+    for (Constraint& k : constraints_) {
+      for (std::size_t p = 0; p < k.count; ++p)
+        k.points[p].separation = current_separation(k, k.points[p]);
+    }
   }
 
   void warm_start() {
@@ -270,7 +342,7 @@ class Solver {
         // A point whose surfaces have come apart (a bounce, a body lifted off) carries no load:
         // re-applying its old impulse would push the bodies apart a second time and feed energy
         // into whatever else they touch before this point's own solve takes it back.
-        if (current_separation(k, sp) > Fixed::zero()) {
+        if (sp.separation > Fixed::zero()) {
           sp.normal_impulse = Fixed::zero();
           sp.tangent_impulse_1 = Fixed::zero();
           sp.tangent_impulse_2 = Fixed::zero();
@@ -278,7 +350,7 @@ class Solver {
         }
         const Vec3 impulse = k.normal * sp.normal_impulse + k.tangent_1 * sp.tangent_impulse_1 +
                              k.tangent_2 * sp.tangent_impulse_2;
-        apply(k.a, k.b, sp, impulse);
+        apply(k, sp, impulse);
       }
     }
   }
@@ -290,43 +362,47 @@ class Solver {
       const Softness& soft = against_static ? static_soft_ : soft_;
       // Until the contact first pushes, its approach speed (at the centroid, before any point is
       // solved) is what restitution must reverse.
-      if (use_bias && !k.pushed)
-        k.centroid.relative_velocity = dot(relative_velocity(k.a, k.b, k.centroid), k.normal);
+      if (use_bias && !k.pushed && k.restitution != Fixed::zero())
+        k.centroid.relative_velocity = dot(relative_velocity(k, k.centroid), k.normal);
       for (std::size_t p = 0; p < k.count; ++p) {
         SolverPoint& sp = k.points[p];
-        const Fixed separation = current_separation(k, sp);
+        const Fixed separation = sp.separation;
         Fixed bias;
-        Fixed mass_scale = Fixed::one();
-        Fixed impulse_scale;
+        bool soft_push = false;  // soft: mass and impulse scaled; else scales 1 and 0
         if (separation > Fixed::zero()) {
           bias = separation * inv_h_;  // speculative: close the gap within this sub-step
         } else if (use_bias) {
           bias = max(soft.bias_rate * min(separation + s_.def.linear_slop, Fixed::zero()),
                      -s_.def.contact_push_max);
-          mass_scale = soft.mass_scale;
-          impulse_scale = soft.impulse_scale;
+          soft_push = true;
         }
-        const Fixed vn = dot(relative_velocity(k.a, k.b, sp), k.normal);
-        Fixed impulse =
-            -sp.normal_mass * mass_scale * (vn + bias) - impulse_scale * sp.normal_impulse;
+        const Fixed vn = dot(relative_velocity(k, sp), k.normal);
+        // Scales 1 and 0 need no arithmetic: x * 1 = x and x - 0 * y = x, bit for bit.
+        Fixed impulse = soft_push ? -sp.normal_mass * soft.mass_scale * (vn + bias) -
+                                        soft.impulse_scale * sp.normal_impulse
+                                  : -sp.normal_mass * (vn + bias);
         const Fixed accumulated = max(sp.normal_impulse + impulse, Fixed::zero());
         impulse = accumulated - sp.normal_impulse;
         sp.normal_impulse = accumulated;
         if (impulse > Fixed::zero()) k.pushed = true;
-        apply(k.a, k.b, sp, k.normal * impulse);
+        apply(k, sp, k.normal * impulse);
       }
       // Coulomb friction, each point limited to the disc of radius friction * normal impulse.
       for (std::size_t p = 0; p < k.count; ++p) {
         SolverPoint& sp = k.points[p];
-        const Vec3 dv = relative_velocity(k.a, k.b, sp);
+        const Fixed limit = k.friction * sp.normal_impulse;
+        // With a zero limit the clamp below gives zero whatever t1 and t2 are (0 / |t| = 0, and
+        // |t| = 0 only for t = 0): a point with no friction impulse keeps none.
+        if (limit == Fixed::zero() && sp.tangent_impulse_1 == Fixed::zero() &&
+            sp.tangent_impulse_2 == Fixed::zero())
+          continue;
+        const Vec3 dv = relative_velocity(k, sp);
         const Fixed t1 = sp.tangent_impulse_1 - sp.tangent_mass_1 * dot(dv, k.tangent_1);
         const Fixed t2 = sp.tangent_impulse_2 - sp.tangent_mass_2 * dot(dv, k.tangent_2);
-        const Fixed limit = k.friction * sp.normal_impulse;
         Fixed n1 = t1;
         Fixed n2 = t2;
-        const Fixed magnitude = hypot(t1, t2);
-        if (magnitude > limit) {
-          const Fixed scale = limit / magnitude;
+        if (hypot_exceeds(t1, t2, limit)) {  // hypot(t1, t2) > limit, most often false: no root
+          const Fixed scale = limit / hypot(t1, t2);
           n1 = t1 * scale;
           n2 = t2 * scale;
         }
@@ -334,7 +410,7 @@ class Solver {
             k.tangent_1 * (n1 - sp.tangent_impulse_1) + k.tangent_2 * (n2 - sp.tangent_impulse_2);
         sp.tangent_impulse_1 = n1;
         sp.tangent_impulse_2 = n2;
-        apply(k.a, k.b, sp, impulse);
+        apply(k, sp, impulse);
       }
     }
   }
@@ -370,9 +446,9 @@ class Solver {
       SolverPoint& c = k.centroid;
       if (c.relative_velocity > -threshold) continue;
       k.bounced = true;
-      const Fixed vn = dot(relative_velocity(k.a, k.b, c), k.normal);
+      const Fixed vn = dot(relative_velocity(k, c), k.normal);
       const Fixed impulse = -c.normal_mass * (vn + k.restitution * c.relative_velocity);
-      if (impulse > Fixed::zero()) apply(k.a, k.b, c, k.normal * impulse);
+      if (impulse > Fixed::zero()) apply(k, c, k.normal * impulse);
     }
   }
 
@@ -391,6 +467,8 @@ class Solver {
   WorldState& s_;
   Fixed h_;
   Fixed inv_h_;
+  Vec3 gravity_kick_;       // gravity * h: the velocity change of a body without forces
+  Vec3 gravity_half_kick_;  // halve(gravity_kick_)
   Softness soft_;
   Softness static_soft_;
   std::vector<Velocity> velocities_;

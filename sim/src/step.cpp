@@ -53,37 +53,44 @@ Vec3 aabb_extent(const Shape& shape, const Mat3& r) {
 
 void prepare_bodies(WorldState& s) {
   s.derived.resize(s.bodies.size());
+  for (std::size_t i = 0; i < s.bodies.size(); ++i)
+    prepare_body(s, i);
+}
+
+void prepare_body(WorldState& s, std::size_t i) {
   const Vec3 margin{s.def.speculative_distance, s.def.speculative_distance,
                     s.def.speculative_distance};
-  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
-    const BodyState& b = s.bodies[i];
-    Derived& d = s.derived[i];
-    d.pose = {b.position, to_mat3(b.orientation)};
-    const bool moving = b.type == BodyType::dynamic && b.awake;
-    d.inverse_mass = moving ? inverse_or_zero(b.mass) : Fixed::zero();
-    d.inverse_inertia_world =
-        moving ? rotate_inertia(d.pose.rotation, Mat3::diagonal(inverse_or_zero(b.inertia.x),
-                                                                inverse_or_zero(b.inertia.y),
-                                                                inverse_or_zero(b.inertia.z)))
-               : Mat3::zero();
-    d.infinite = b.shape.type == ShapeType::plane;
-    const Vec3 e = aabb_extent(b.shape, d.pose.rotation) + margin;
-    d.aabb_min = b.position - e;
-    d.aabb_max = b.position + e;
-    // A moving body's box also covers where its velocity takes it this step, so that speculative
-    // contacts exist before fast bodies meet.
-    if (b.type != BodyType::static_body && b.awake) {
-      const Vec3 travel = b.linear_velocity * s.def.dt;
-      d.aabb_min += Vec3{min(travel.x, Fixed::zero()), min(travel.y, Fixed::zero()),
-                         min(travel.z, Fixed::zero())};
-      d.aabb_max += Vec3{max(travel.x, Fixed::zero()), max(travel.y, Fixed::zero()),
-                         max(travel.z, Fixed::zero())};
-    }
-    d.start_position = b.position;
-    d.start_orientation = b.orientation;
-    d.delta_position = {};
-    d.delta_angle = {};
+  const BodyState& b = s.bodies[i];
+  Derived& d = s.derived[i];
+  d.pose = {b.position, to_mat3(b.orientation)};
+  const bool moving = b.type == BodyType::dynamic && b.awake;
+  d.inverse_mass = moving ? inverse_or_zero(b.mass) : Fixed::zero();
+  d.inverse_inertia_world =
+      moving ? rotate_inertia(d.pose.rotation, Mat3::diagonal(inverse_or_zero(b.inertia.x),
+                                                              inverse_or_zero(b.inertia.y),
+                                                              inverse_or_zero(b.inertia.z)))
+             : Mat3::zero();
+  d.infinite = b.shape.type == ShapeType::plane;
+  // length(0) * r is exactly 0: most bodies at rest skip the two square roots.
+  d.rim_speed = b.angular_velocity == Vec3{}
+                    ? Fixed::zero()
+                    : length(b.angular_velocity) * bounding_radius(b.shape);
+  const Vec3 e = aabb_extent(b.shape, d.pose.rotation) + margin;
+  d.aabb_min = b.position - e;
+  d.aabb_max = b.position + e;
+  // A moving body's box also covers where its velocity takes it this step, so that speculative
+  // contacts exist before fast bodies meet.
+  if (b.type != BodyType::static_body && b.awake) {
+    const Vec3 travel = b.linear_velocity * s.def.dt;
+    d.aabb_min += Vec3{min(travel.x, Fixed::zero()), min(travel.y, Fixed::zero()),
+                       min(travel.z, Fixed::zero())};
+    d.aabb_max += Vec3{max(travel.x, Fixed::zero()), max(travel.y, Fixed::zero()),
+                       max(travel.z, Fixed::zero())};
   }
+  d.start_position = b.position;
+  d.start_orientation = b.orientation;
+  d.delta_position = {};
+  d.delta_angle = {};
 }
 
 }  // namespace sim_detail

@@ -47,6 +47,11 @@ struct Contact {
   // Step scratch, not saved: the narrowphase ran on the pair this step; the solver pushed on it.
   bool collided = false;
   bool pushed = false;
+  /// Step scratch, not saved: where a and b are in WorldState::bodies. Set by the broadphase for
+  /// the stages after it, so that they need not search for the IDs; stale between steps (bodies
+  /// are created and destroyed), so nothing outside the step reads them.
+  std::uint32_t index_a = 0;
+  std::uint32_t index_b = 0;
   std::array<CachedPoint, 4> cached{};
   Manifold manifold;
 };
@@ -61,6 +66,8 @@ struct Derived {
   bool infinite = false;  ///< a plane: bounded by nothing
   Vec3 start_position;    ///< the pose at the start of the step (for the continuous pass)
   Quat start_orientation;
+  /// |angular velocity| * bounding radius: how fast the body's rim moves (for contact margins).
+  Fixed rim_speed;
   // Solver scratch for the current step.
   Vec3 delta_position;  ///< since the start of the step
   Vec3 delta_angle;     ///< small-angle sum of angular velocity * h since the start of the step
@@ -74,6 +81,10 @@ struct WorldState {
   std::vector<BodyState> bodies;  ///< ascending ID
   std::vector<Contact> contacts;  ///< ascending (a, b)
   std::vector<Derived> derived;   ///< rebuilt each step
+  /// The broadphase's sweep order at the last step (body indices): where the next step's sort
+  /// starts. Not saved: the order sorted to is total, so stale or empty content changes nothing
+  /// but the time the sort takes.
+  std::vector<std::uint32_t> sweep_order;
   /// Output of the last step (and of destroy_body since); not saved, cleared by restore.
   std::vector<ContactEvent> events;
 
@@ -104,6 +115,9 @@ void solve(WorldState& s);                 // sub-stepped soft contact solver an
 void continuous(WorldState& s);            // fast and CCD bodies moved back to their first touch
 void update_sleep(WorldState& s);          // sleep timers; islands at rest fall asleep
 void report_contacts(WorldState& s);       // contact and sensor events, in pair order
+
+/// prepare_bodies for body i alone (derived already sized): when a body wakes in mid-step.
+void prepare_body(WorldState& s, std::size_t i);
 
 /// Appends the end event of a contact that is reported as touching (a pair that stops existing).
 void report_end(WorldState& s, const Contact& c);

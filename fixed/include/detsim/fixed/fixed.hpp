@@ -75,6 +75,18 @@ constexpr std::int64_t round_shift_saturate(wide::int128_t v, unsigned shift) no
 }
 #endif
 
+/// Whether min(round(sqrt(n)), raw_max) > l: the comparison of a correctly rounded, saturated root
+/// (sqrt, hypot, length) with a raw value, decided without the root. For 0 <= l < raw_max,
+/// round(sqrt(n)) > l iff sqrt(n) > l + 1/2 (the root of an integer is never halfway between two
+/// integers), iff n > l^2 + l + 1/4, iff n > l (l + 1), as both sides are integers (and l (l + 1) <
+/// 2^126 fits).
+constexpr bool root_exceeds(wide::U128 n, std::int64_t l) noexcept {
+  if (l < 0) return true;          // a root is >= 0
+  if (l == raw_max) return false;  // and saturates at raw_max
+  const auto ul = static_cast<std::uint64_t>(l);
+  return wide::less(wide::Default::mul(ul, ul + 1), n);
+}
+
 template <class Ops>
 constexpr std::int64_t fixed_mul(std::int64_t a, std::int64_t b) noexcept {
 #if DETSIM_HAS_INT128

@@ -75,6 +75,10 @@ namespace detsim {
 
 /// sqrt(x^2 + y^2), correctly rounded, with no intermediate overflow; saturates to Fixed::max().
 [[nodiscard]] Fixed hypot(Fixed x, Fixed y) noexcept;
+/// hypot(x, y) > limit, decided exactly from x^2 + y^2 without taking the root: the same answer as
+/// the comparison of hypot's rounded, saturated result for every input, at the cost of two
+/// multiplies (the friction clamp of the contact solver asks this in every iteration).
+[[nodiscard]] constexpr bool hypot_exceeds(Fixed x, Fixed y, Fixed limit) noexcept;
 
 // ---- Trigonometry (radians) -------------------------------------------------------------------
 
@@ -138,6 +142,13 @@ struct SinCos {
 [[nodiscard]] Fixed pow(Fixed x, Fixed y) noexcept;
 
 // ---- Inline definitions -----------------------------------------------------------------------
+constexpr bool hypot_exceeds(Fixed x, Fixed y, Fixed limit) noexcept {
+  // hypot's raw is the rounded root of n = X^2 + Y^2 (exact: < 2^127), saturated.
+  const std::uint64_t ax = detail::magnitude(x.raw());
+  const std::uint64_t ay = detail::magnitude(y.raw());
+  return detail::root_exceeds(wide::add(wide::Default::mul(ax, ax), wide::Default::mul(ay, ay)),
+                              limit.raw());
+}
 
 constexpr Fixed lerp(Fixed a, Fixed b, Fixed t) noexcept {
   // (b - a) needs 65 bits: carry it as sign + 64-bit magnitude.
