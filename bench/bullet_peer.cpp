@@ -32,12 +32,12 @@ struct BulletPile::Impl {
   std::vector<std::unique_ptr<btDefaultMotionState>> motion_states;
   std::vector<std::unique_ptr<btRigidBody>> bodies;
 
-  Impl(std::uint32_t count, bool spheres) {
+  Impl(std::uint32_t count, bool spheres, double friction) {
     world.setGravity(btVector3(0, btScalar(-9.81), 0));
     world.getSolverInfo().m_numIterations = 10;
 
     btRigidBody::btRigidBodyConstructionInfo ground_info(0, nullptr, &ground_shape);
-    ground_info.m_friction = btScalar(0.5);
+    ground_info.m_friction = static_cast<btScalar>(friction);
     ground = std::make_unique<btRigidBody>(ground_info);
     world.addRigidBody(ground.get());
 
@@ -66,7 +66,7 @@ struct BulletPile::Impl {
           btVector3(centred(x), 1 + static_cast<btScalar>(y) * btScalar(1.1), centred(z)));
       motion_states.push_back(std::make_unique<btDefaultMotionState>(transform));
       btRigidBody::btRigidBodyConstructionInfo info(1, motion_states.back().get(), shape, inertia);
-      info.m_friction = btScalar(0.5);
+      info.m_friction = static_cast<btScalar>(friction);
       info.m_restitution = 0;
       bodies.push_back(std::make_unique<btRigidBody>(info));
       world.addRigidBody(bodies.back().get());
@@ -84,8 +84,8 @@ struct BulletPile::Impl {
   Impl& operator=(const Impl&) = delete;
 };
 
-BulletPile::BulletPile(std::uint32_t count, bool spheres)
-    : impl_(std::make_unique<Impl>(count, spheres)) {}
+BulletPile::BulletPile(std::uint32_t count, bool spheres, double friction)
+    : impl_(std::make_unique<Impl>(count, spheres, friction)) {}
 
 BulletPile::~BulletPile() = default;
 

@@ -15,9 +15,17 @@ namespace detsim_bench {
 /// lattice of side ceil(cbrt(N)), spacing 1.1 m, lowest layer at y = 1, centred on x/z, above a
 /// static plane at y = 0 (friction 0.5). g = -9.81, 60 Hz, 10 solver iterations: the set-up of the
 /// project's Bullet anchor.
+///
+/// `friction` replaces the 0.5 of every body and of the plane. Bullet combines two frictions by
+/// their product and detsim by their geometric mean, so the anchor's 0.5 gives 0.25 at a Bullet
+/// contact and 0.5 at a detsim one; kMatchedFriction (sqrt 0.5) gives Bullet's contacts detsim's
+/// 0.5, for a cross-check on the same physical scene.
 class BulletPile {
  public:
-  BulletPile(std::uint32_t count, bool spheres);
+  static constexpr double kAnchorFriction = 0.5;
+  static constexpr double kMatchedFriction = 0.70710678118654752;
+
+  BulletPile(std::uint32_t count, bool spheres, double friction = kAnchorFriction);
   ~BulletPile();
   BulletPile(const BulletPile&) = delete;
   BulletPile& operator=(const BulletPile&) = delete;
@@ -35,6 +43,13 @@ class BulletPile {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+/// The same pile with kMatchedFriction.
+class BulletPileMatched : public BulletPile {
+ public:
+  BulletPileMatched(std::uint32_t count, bool spheres)
+      : BulletPile(count, spheres, kMatchedFriction) {}
 };
 
 }  // namespace detsim_bench

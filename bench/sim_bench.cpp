@@ -8,6 +8,9 @@
 //   default): building the scene is untimed, every step is timed. Each step's thread CPU time is
 //   also read, so one run gives the mean over the first and the last `window` steps as well, and
 //   each step's best time over the repetitions (a load-filtered cross-check of the whole run).
+//   "<scene>/bullet_matched" runs the peer with friction sqrt(0.5) per body, so that Bullet's
+//   product combine gives its contacts detsim's 0.5 (the anchor's 0.5 gives 0.25): the same
+//   physical scene, as a cross-check of the anchor's comparison.
 // - state/*: the box pile after `state_frame` steps (taken once, by running the scene): save,
 //   restore (full validation included) and the state hash, each per call; "rollback8" restores
 //   that snapshot and steps 8 frames, and splits each iteration into its restore and its steps
@@ -353,6 +356,12 @@ void register_benchmarks() {
     benchmark::RegisterBenchmark(
         (scene + "/bullet").c_str(),
         [spheres](benchmark::State& s) { whole_run<detsim_bench::BulletPile>(s, spheres); })
+        ->Iterations(1)
+        ->Unit(benchmark::kMillisecond);
+    // The cross-check on the same physical scene: Bullet's contacts get detsim's friction.
+    benchmark::RegisterBenchmark(
+        (scene + "/bullet_matched").c_str(),
+        [spheres](benchmark::State& s) { whole_run<detsim_bench::BulletPileMatched>(s, spheres); })
         ->Iterations(1)
         ->Unit(benchmark::kMillisecond);
 #endif
