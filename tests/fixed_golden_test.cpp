@@ -157,6 +157,22 @@ std::map<std::string, std::uint64_t> compute_hashes() {
   hash_vectors(
       "vec3_length", [&](std::size_t i) { return std::array<Fixed, 1>{length(vec(i))}; }, hashes);
   hash_vectors(
+      "vec3_dot_sum",
+      [&](std::size_t i) {
+        return std::array<Fixed, 1>{
+            DotSum{}.add(vec(i), vec(i + 5)).add(vec(i + 9), vec_shifted(i + 13, 19)).result()};
+      },
+      hashes);
+  hash_vectors(
+      "vec3_sum",
+      [&](std::size_t i) {
+        return v3(Vec3Sum{vec(i)}
+                      .add(y[i] >> 24, vec(i + 5))
+                      .add(y[(i + 1) % kInputs] >> 24, vec(i + 9))
+                      .result());
+      },
+      hashes);
+  hash_vectors(
       "vec3_normalize", [&](std::size_t i) { return v3(normalize(vec(i))); }, hashes);
   hash_vectors(
       "quat_normalize", [&](std::size_t i) { return q4(normalize(quat(i))); }, hashes);

@@ -156,6 +156,77 @@ TEST(Vec3, DotHasNoIntermediateOverflow) {
             (Vec3{Fixed::zero(), Fixed::zero(), raw(std::int64_t{1} << 20)}));
 }
 
+// ---- Fused sums: DotSum and Vec3Sum ------------------------------------------------------------
+
+TEST(Vec3, DotSumAndVec3SumAreTheExactValueRoundedOnceUpTo2To20) {
+  std::mt19937_64 rng(103);
+  for (int i = 0; i < 100000; ++i) {
+    const Vec3 a = random_vec3(rng, 20);
+    const Vec3 b = random_vec3(rng, 20);
+    const Vec3 c = random_vec3(rng, 20);
+    const Vec3 d = random_vec3(rng, 20);
+    const i128 exact = product(a.x, b.x) + product(a.y, b.y) + product(a.z, b.z) +
+                       product(c.x, d.x) + product(c.y, d.y) + product(c.z, d.z);
+    const Fixed sum = DotSum{}.add(a, b).add(c, d).result();
+    ASSERT_TRUE(is_rounded(sum.raw(), exact, 32))
+        << testing::PrintToString(a) << " . " << testing::PrintToString(b) << " + "
+        << testing::PrintToString(c) << " . " << testing::PrintToString(d) << " = "
+        << testing::PrintToString(sum);
+
+    const Fixed s = raw(random_raw(rng, 20));
+    const Fixed t = raw(random_raw(rng, 20));
+    const Vec3 v = Vec3Sum{a}.add(s, c).add(t, d).result();
+    const auto fused = [&](Fixed ai, Fixed ci, Fixed di) {
+      return static_cast<i128>(ai.raw()) * kOne + product(s, ci) + product(t, di);
+    };
+    ASSERT_TRUE(is_rounded(v.x.raw(), fused(a.x, c.x, d.x), 32));
+    ASSERT_TRUE(is_rounded(v.y.raw(), fused(a.y, c.y, d.y), 32));
+    ASSERT_TRUE(is_rounded(v.z.raw(), fused(a.z, c.z, d.z), 32))
+        << testing::PrintToString(a) << " + " << testing::PrintToString(s) << " "
+        << testing::PrintToString(c) << " + " << testing::PrintToString(t) << " "
+        << testing::PrintToString(d) << " = " << testing::PrintToString(v);
+  }
+}
+
+TEST(Vec3, DotSumWithOneTermIsDotAndVec3SumWithNoneIsItsStart) {
+  std::mt19937_64 rng(107);
+  for (int i = 0; i < 10000; ++i) {
+    const Vec3 a = random_full_range(rng);
+    const Vec3 b = random_full_range(rng);
+    ASSERT_EQ(DotSum{}.add(a, b).result(), dot(a, b));
+    ASSERT_EQ(Vec3Sum{a}.result(), a);
+  }
+  EXPECT_EQ(DotSum{}.result(), Fixed::zero());
+  EXPECT_EQ(Vec3Sum{}.result(), Vec3{});
+}
+
+TEST(Vec3, Vec3SumRoundsOnceWhereMultiplyThenAddRoundsTwice) {
+  // In raw units: v = 1, s d = 1 * 2^31 / 2^32 = 0.5, so v + s d = 1.5, a tie, rounds to even: 2.
+  // The product alone is 0.5, a tie that rounds to 0, so v + d * s stays at 1.
+  const Vec3 v{Fixed::epsilon(), Fixed::zero(), Fixed::zero()};
+  const Vec3 d{raw(std::int64_t{1} << 31), Fixed::zero(), Fixed::zero()};
+  const Fixed s = Fixed::epsilon();
+  EXPECT_EQ(Vec3Sum{v}.add(s, d).result().x, raw(2));
+  EXPECT_EQ((v + d * s).x, raw(1));
+}
+
+TEST(Vec3, DotSumAndVec3SumHaveNoIntermediateSaturation) {
+  const Fixed p = num(1 << 20);
+  const Vec3 big{p, p, p};
+  // Each dot is 3 * 2^40, far beyond Fixed; their difference is zero.
+  EXPECT_EQ(DotSum{}.add(big, big).add(-big, big).result(), Fixed::zero());
+  // Rounding each dot first saturates both, to max and min, which add up to -2^-32.
+  EXPECT_EQ(dot(big, big) + dot(-big, big), raw(-1));
+  // max + 2^20 * 2^20 - 2^20 * 2^20 = max, where rounding the first product saturates.
+  const Vec3 top{Fixed::max(), Fixed::min(), Fixed::zero()};
+  const Vec3 e{p, p, p};
+  EXPECT_EQ(Vec3Sum{top}.add(p, e).add(-p, e).result(), top);
+  // And a sum beyond the range saturates once, towards its sign.
+  EXPECT_EQ(Vec3Sum{top}.add(p, e).result(), (Vec3{Fixed::max(), Fixed::max(), Fixed::max()}));
+  EXPECT_EQ(DotSum{}.add(big, big).result(), Fixed::max());
+  EXPECT_EQ(DotSum{}.add(-big, big).result(), Fixed::min());
+}
+
 TEST(Vec3, DotAndCrossSaturate) {
   const Vec3 big{Fixed::max(), Fixed::max(), Fixed::max()};
   EXPECT_EQ(dot(big, big), Fixed::max());

@@ -95,6 +95,53 @@ constexpr Vec3& Vec3::operator/=(Fixed s) noexcept {
           component(a.x, b.y, a.y, b.x)};
 }
 
+/// A sum of dot products rounded once: `DotSum{}.add(a, b).add(c, d).result()` is a . b + c . d
+/// summed exactly, then rounded to nearest (ties to even) and saturated, where
+/// dot(a, b) + dot(c, d) rounds twice and can saturate in between. Holds up to 2^61 terms.
+class DotSum {
+ public:
+  constexpr DotSum& add(Vec3 a, Vec3 b) noexcept {
+    sum_.add_product(a.x.raw(), b.x.raw());
+    sum_.add_product(a.y.raw(), b.y.raw());
+    sum_.add_product(a.z.raw(), b.z.raw());
+    return *this;
+  }
+  [[nodiscard]] constexpr Fixed result() const noexcept { return sum_.to_fixed(); }
+
+ private:
+  detail::ProductSum sum_;
+};
+
+/// A vector plus scaled vectors rounded once per component: `Vec3Sum{v}.add(s, d).result()` is
+/// v + s d with each component summed exactly, then rounded to nearest (ties to even) and
+/// saturated (a fused multiply-add), where v + d * s rounds the products first and can saturate in
+/// between. Holds up to 2^61 terms.
+class Vec3Sum {
+ public:
+  constexpr Vec3Sum() noexcept = default;
+  /// Starts from v exactly.
+  explicit constexpr Vec3Sum(Vec3 v) noexcept {
+    x_.add_scaled(v.x.raw(), Fixed::fraction_bits);
+    y_.add_scaled(v.y.raw(), Fixed::fraction_bits);
+    z_.add_scaled(v.z.raw(), Fixed::fraction_bits);
+  }
+  /// Adds s d.
+  constexpr Vec3Sum& add(Fixed s, Vec3 d) noexcept {
+    x_.add_product(s.raw(), d.x.raw());
+    y_.add_product(s.raw(), d.y.raw());
+    z_.add_product(s.raw(), d.z.raw());
+    return *this;
+  }
+  [[nodiscard, gnu::always_inline]] constexpr Vec3 result() const noexcept {
+    return {x_.to_fixed(), y_.to_fixed(), z_.to_fixed()};
+  }
+
+ private:
+  detail::ProductSum x_;
+  detail::ProductSum y_;
+  detail::ProductSum z_;
+};
+
 /// |v|^2, exact then rounded once (ties to even); saturates to Fixed::max() when |v|^2 >= 2^31
 /// (any component of magnitude 2^15.5 or more can do that). Use length() for large vectors: it does
 /// not go through this value.
