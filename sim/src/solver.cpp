@@ -16,6 +16,14 @@
 // an iteration count, so stacks neither jitter nor explode, and a restitution-1 bounce loses
 // almost nothing. Every constraint is solved in contact order (ascending ID pair), point order
 // within a contact: the order is part of the result.
+//
+// Each point has three rows (the normal and two tangents), and each row its Jacobian per body,
+// computed once per step because the anchors and the world inertia stay fixed for the step: for
+// direction d, body a's row is (-d, d x r_a) and body b's (d, r_b x d), with the responses
+// M^-1 J^T (the linear part times the inverse mass, the angular part times the world inverse
+// inertia). A row's speed J v is one exact sum of every product, rounded once (DotSum), and an
+// impulse moves each velocity by v + lambda M^-1 J^T rounded once per component (Vec3Sum), the two
+// friction rows of a point together. The sub-steps then need no cross product and no matrix.
 #include <algorithm>
 #include <vector>
 
@@ -30,34 +38,58 @@ using namespace detsim::literals;
 
 namespace {
 
+// A row's part for the two bodies' angular velocities, and what a unit impulse along it does to
+// them (per point: it depends on the anchors).
+struct Row {
+  Vec3 angular_a;   // d x r_a
+  Vec3 angular_b;   // r_b x d
+  Vec3 response_a;  // I_a^-1 angular_a
+  Vec3 response_b;  // I_b^-1 angular_b
+  Fixed mass;       // 1 / (J M^-1 J^T), the effective mass; zero when nothing can move
+};
+
+// A row's part for the two bodies' linear velocities, and their response (per contact: every point
+// of a contact shares its directions).
+struct Direction {
+  Vec3 linear_a;    // -d
+  Vec3 linear_b;    // d
+  Vec3 response_a;  // -d m_a^-1
+  Vec3 response_b;  // d m_b^-1
+};
+
 struct SolverPoint {
   Vec3 anchor_a;  // contact point relative to each body's centre at the start of the step
   Vec3 anchor_b;
   Fixed base_separation;
   Fixed separation;  // current_separation at the bodies' present motion (refresh_separations)
-  Fixed normal_mass;
-  Fixed tangent_mass_1;
-  Fixed tangent_mass_2;
-  Fixed relative_velocity;  // normal approach speed before the first push (for restitution)
+  Row normal;
+  Row tangent_1;
+  Row tangent_2;
   Fixed normal_impulse;
   Fixed tangent_impulse_1;
   Fixed tangent_impulse_2;
+};
+
+// Restitution acts once per contact, along the normal at the centroid of its points.
+struct Bounce {
+  Row normal;
+  Fixed relative_velocity;  // normal approach speed before the first push
 };
 
 struct Constraint {
   std::size_t contact;
   std::size_t a;
   std::size_t b;
-  Vec3 normal;
-  Vec3 tangent_1;
-  Vec3 tangent_2;
+  Direction normal;
+  Direction tangent_1;
+  Direction tangent_2;
   Fixed friction;
   Fixed restitution;
   std::uint8_t count;
   // Whether each body's velocity can change under an impulse, and whether it is still (zero
   // velocity that nothing changes). An impulse on a body of zero inverse mass and zero inverse
-  // inertia changes nothing, bit for bit, and a still body adds exactly zero to relative
-  // velocities: the solver skips that arithmetic instead of computing zeros.
+  // inertia changes nothing, bit for bit, and a still body adds exactly zero to a row's speed: the
+  // solver skips that arithmetic instead of computing zeros.
   bool takes_impulse_a;
   bool takes_impulse_b;
   bool still_a;
@@ -65,7 +97,7 @@ struct Constraint {
   bool pushed;   // some point has pushed in this step
   bool bounced;  // restitution applied this step
   std::array<SolverPoint, 4> points;
-  SolverPoint centroid;  // the mean of the points' anchors, for restitution
+  Bounce bounce;  // set only when restitution is not zero
 };
 
 // Soft constraint coefficients (Box2D v3 b2MakeSoft): a spring of `hertz` with damping ratio
@@ -95,13 +127,22 @@ Vec3 perpendicular(Vec3 n) {
   return normalize(Vec3{Fixed::zero(), n.z, -n.y});
 }
 
-// 1 / (m_a^-1 + m_b^-1 + (I_a^-1 (r_a x d)) . (r_a x d) + (I_b^-1 (r_b x d)) . (r_b x d)).
-Fixed effective_mass(const Derived& a, const Derived& b, Vec3 ra, Vec3 rb, Vec3 d) {
-  const Vec3 ca = cross(ra, d);
-  const Vec3 cb = cross(rb, d);
-  const Fixed k = a.inverse_mass + b.inverse_mass + dot(a.inverse_inertia_world * ca, ca) +
-                  dot(b.inverse_inertia_world * cb, cb);
-  return inverse_or_zero(k);
+Direction make_direction(const Derived& a, const Derived& b, Vec3 d) {
+  return {-d, d, -d * a.inverse_mass, d * b.inverse_mass};
+}
+
+// The row of direction d at anchors r_a and r_b, with its effective mass
+// 1 / (m_a^-1 + m_b^-1 + (d x r_a) . I_a^-1 (d x r_a) + (r_b x d) . I_b^-1 (r_b x d)).
+Row make_row(const Derived& a, const Derived& b, Vec3 ra, Vec3 rb, Vec3 d) {
+  Row r;
+  r.angular_a = cross(d, ra);
+  r.angular_b = cross(rb, d);
+  r.response_a = a.inverse_inertia_world * r.angular_a;
+  r.response_b = b.inverse_inertia_world * r.angular_b;
+  const Fixed angular =
+      DotSum{}.add(r.response_a, r.angular_a).add(r.response_b, r.angular_b).result();
+  r.mass = inverse_or_zero(a.inverse_mass + b.inverse_mass + angular);
+  return r;
 }
 
 struct Velocity {
@@ -189,9 +230,12 @@ class Solver {
       k.contact = ci;
       k.a = ia;
       k.b = ib;
-      k.normal = c.manifold.normal;
-      k.tangent_1 = perpendicular(k.normal);
-      k.tangent_2 = cross(k.normal, k.tangent_1);
+      const Vec3 normal = c.manifold.normal;
+      const Vec3 tangent_1 = perpendicular(normal);
+      const Vec3 tangent_2 = cross(normal, tangent_1);
+      k.normal = make_direction(da, db, normal);
+      k.tangent_1 = make_direction(da, db, tangent_1);
+      k.tangent_2 = make_direction(da, db, tangent_2);
       k.friction = sqrt(a.friction * b.friction);
       k.restitution = max(a.restitution, b.restitution);
       k.count = c.point_count;
@@ -206,28 +250,24 @@ class Solver {
       for (std::size_t p = 0; p < c.point_count; ++p) {
         const ContactPoint& mp = c.manifold.points[p];
         SolverPoint& sp = k.points[p];
-        sp = {};
         sp.anchor_a = mp.point - a.position;
         sp.anchor_b = mp.point - b.position;
         sp.base_separation = mp.separation;
         sp.separation = mp.separation;
-        sp.normal_mass = effective_mass(da, db, sp.anchor_a, sp.anchor_b, k.normal);
-        sp.tangent_mass_1 = effective_mass(da, db, sp.anchor_a, sp.anchor_b, k.tangent_1);
-        sp.tangent_mass_2 = effective_mass(da, db, sp.anchor_a, sp.anchor_b, k.tangent_2);
+        sp.normal = make_row(da, db, sp.anchor_a, sp.anchor_b, normal);
+        sp.tangent_1 = make_row(da, db, sp.anchor_a, sp.anchor_b, tangent_1);
+        sp.tangent_2 = make_row(da, db, sp.anchor_a, sp.anchor_b, tangent_2);
         sum_a += sp.anchor_a;
         sum_b += sp.anchor_b;
         sp.normal_impulse = c.cached[p].normal_impulse;
         sp.tangent_impulse_1 = c.cached[p].tangent_impulse_1;
         sp.tangent_impulse_2 = c.cached[p].tangent_impulse_2;
       }
-      k.centroid = {};
+      k.bounce = {};
       if (k.restitution != Fixed::zero()) {  // the centroid serves restitution only
         const Fixed count = Fixed::from_int(c.point_count);
-        k.centroid.anchor_a = sum_a / count;
-        k.centroid.anchor_b = sum_b / count;
-        k.centroid.normal_mass =
-            effective_mass(da, db, k.centroid.anchor_a, k.centroid.anchor_b, k.normal);
-        k.centroid.relative_velocity = dot(relative_velocity(k, k.centroid), k.normal);
+        k.bounce.normal = make_row(da, db, sum_a / count, sum_b / count, normal);
+        k.bounce.relative_velocity = speed(k, k.normal, k.bounce.normal);
       }
       in_contact_[ia] = true;
       in_contact_[ib] = true;
@@ -235,36 +275,51 @@ class Solver {
     }
   }
 
-  // The velocity of a body's material point at `anchor`; exactly zero for a still body, whose
-  // velocities are zero (0 + cross(0, r) is the zero vector).
-  Vec3 point_velocity(std::size_t i, bool is_still, Vec3 anchor) const {
-    if (is_still) return {};
-    const Velocity& v = velocities_[i];
-    return v.linear + cross(v.angular, anchor);
+  // The speed of a row, J v: one exact sum rounded once. A still body's velocities are zero and
+  // add exact zeros, which are skipped.
+  Fixed speed(const Constraint& k, const Direction& d, const Row& r) const {
+    DotSum sum;
+    if (!k.still_a)
+      sum.add(d.linear_a, velocities_[k.a].linear).add(r.angular_a, velocities_[k.a].angular);
+    if (!k.still_b)
+      sum.add(d.linear_b, velocities_[k.b].linear).add(r.angular_b, velocities_[k.b].angular);
+    return sum.result();
   }
 
-  Vec3 relative_velocity(const Constraint& k, const SolverPoint& p) const {
-    return point_velocity(k.b, k.still_b, p.anchor_b) - point_velocity(k.a, k.still_a, p.anchor_a);
+  // A body's response to a unit impulse along a row: M^-1 J^T.
+  struct Response {
+    Vec3 linear;
+    Vec3 angular;
+  };
+
+  // v += impulse * response (+ impulse_2 * response_2), each velocity component rounded once.
+  static void push(Velocity& v, Fixed impulse, Response r) {
+    v.linear = Vec3Sum{v.linear}.add(impulse, r.linear).result();
+    v.angular = Vec3Sum{v.angular}.add(impulse, r.angular).result();
+  }
+  static void push(Velocity& v, Fixed impulse_1, Response r1, Fixed impulse_2, Response r2) {
+    v.linear = Vec3Sum{v.linear}.add(impulse_1, r1.linear).add(impulse_2, r2.linear).result();
+    v.angular = Vec3Sum{v.angular}.add(impulse_1, r1.angular).add(impulse_2, r2.angular).result();
   }
 
-  // v * m; for m = 1 (a body of unit mass) that is v itself, bit for bit, without three multiplies.
-  static Vec3 scaled(Vec3 v, Fixed m) { return m == Fixed::one() ? v : v * m; }
+  // An impulse along one row. A zero impulse, or the side of a body that takes no impulses (zero
+  // responses), would leave every bit as it is: both are skipped.
+  void apply(const Constraint& k, const Direction& d, const Row& r, Fixed impulse) {
+    if (impulse == Fixed::zero()) return;
+    if (k.takes_impulse_a) push(velocities_[k.a], impulse, {d.response_a, r.response_a});
+    if (k.takes_impulse_b) push(velocities_[k.b], impulse, {d.response_b, r.response_b});
+  }
 
-  // A zero impulse, or the side of a body that takes no impulses, would add exact zeros to the
-  // velocities (0 * m = 0, M 0 = 0, v - 0 = v): both are skipped, which changes no bit.
-  void apply(const Constraint& k, const SolverPoint& p, Vec3 impulse) {
-    if (impulse == Vec3{}) return;
+  // Both friction rows of a point at once.
+  void apply_friction(const Constraint& k, const SolverPoint& p, Fixed impulse_1, Fixed impulse_2) {
+    if (impulse_1 == Fixed::zero() && impulse_2 == Fixed::zero()) return;
     if (k.takes_impulse_a) {
-      const Derived& da = s_.derived[k.a];
-      Velocity& va = velocities_[k.a];
-      va.linear -= scaled(impulse, da.inverse_mass);
-      va.angular -= da.inverse_inertia_world * cross(p.anchor_a, impulse);
+      push(velocities_[k.a], impulse_1, {k.tangent_1.response_a, p.tangent_1.response_a}, impulse_2,
+           {k.tangent_2.response_a, p.tangent_2.response_a});
     }
     if (k.takes_impulse_b) {
-      const Derived& db = s_.derived[k.b];
-      Velocity& vb = velocities_[k.b];
-      vb.linear += scaled(impulse, db.inverse_mass);
-      vb.angular += db.inverse_inertia_world * cross(p.anchor_b, impulse);
+      push(velocities_[k.b], impulse_1, {k.tangent_1.response_b, p.tangent_1.response_b}, impulse_2,
+           {k.tangent_2.response_b, p.tangent_2.response_b});
     }
   }
 
@@ -314,7 +369,7 @@ class Solver {
   Fixed current_separation(const Constraint& k, const SolverPoint& sp) const {
     const Vec3 moved =
         displacement(k.b, k.still_b, sp.anchor_b) - displacement(k.a, k.still_a, sp.anchor_a);
-    return sp.base_separation + dot(moved, k.normal);
+    return sp.base_separation + dot(moved, k.normal.linear_b);
   }
 
   // How far a body's material point at `anchor` has moved since the start of the step; exactly
@@ -348,9 +403,8 @@ class Solver {
           sp.tangent_impulse_2 = Fixed::zero();
           continue;
         }
-        const Vec3 impulse = k.normal * sp.normal_impulse + k.tangent_1 * sp.tangent_impulse_1 +
-                             k.tangent_2 * sp.tangent_impulse_2;
-        apply(k, sp, impulse);
+        apply(k, k.normal, sp.normal, sp.normal_impulse);
+        apply_friction(k, sp, sp.tangent_impulse_1, sp.tangent_impulse_2);
       }
     }
   }
@@ -363,7 +417,7 @@ class Solver {
       // Until the contact first pushes, its approach speed (at the centroid, before any point is
       // solved) is what restitution must reverse.
       if (use_bias && !k.pushed && k.restitution != Fixed::zero())
-        k.centroid.relative_velocity = dot(relative_velocity(k, k.centroid), k.normal);
+        k.bounce.relative_velocity = speed(k, k.normal, k.bounce.normal);
       for (std::size_t p = 0; p < k.count; ++p) {
         SolverPoint& sp = k.points[p];
         const Fixed separation = sp.separation;
@@ -376,16 +430,16 @@ class Solver {
                      -s_.def.contact_push_max);
           soft_push = true;
         }
-        const Fixed vn = dot(relative_velocity(k, sp), k.normal);
+        const Fixed vn = speed(k, k.normal, sp.normal);
         // Scales 1 and 0 need no arithmetic: x * 1 = x and x - 0 * y = x, bit for bit.
-        Fixed impulse = soft_push ? -sp.normal_mass * soft.mass_scale * (vn + bias) -
+        Fixed impulse = soft_push ? -sp.normal.mass * soft.mass_scale * (vn + bias) -
                                         soft.impulse_scale * sp.normal_impulse
-                                  : -sp.normal_mass * (vn + bias);
+                                  : -sp.normal.mass * (vn + bias);
         const Fixed accumulated = max(sp.normal_impulse + impulse, Fixed::zero());
         impulse = accumulated - sp.normal_impulse;
         sp.normal_impulse = accumulated;
         if (impulse > Fixed::zero()) k.pushed = true;
-        apply(k, sp, k.normal * impulse);
+        apply(k, k.normal, sp.normal, impulse);
       }
       // Coulomb friction, each point limited to the disc of radius friction * normal impulse.
       for (std::size_t p = 0; p < k.count; ++p) {
@@ -396,9 +450,10 @@ class Solver {
         if (limit == Fixed::zero() && sp.tangent_impulse_1 == Fixed::zero() &&
             sp.tangent_impulse_2 == Fixed::zero())
           continue;
-        const Vec3 dv = relative_velocity(k, sp);
-        const Fixed t1 = sp.tangent_impulse_1 - sp.tangent_mass_1 * dot(dv, k.tangent_1);
-        const Fixed t2 = sp.tangent_impulse_2 - sp.tangent_mass_2 * dot(dv, k.tangent_2);
+        const Fixed t1 =
+            sp.tangent_impulse_1 - sp.tangent_1.mass * speed(k, k.tangent_1, sp.tangent_1);
+        const Fixed t2 =
+            sp.tangent_impulse_2 - sp.tangent_2.mass * speed(k, k.tangent_2, sp.tangent_2);
         Fixed n1 = t1;
         Fixed n2 = t2;
         if (hypot_exceeds(t1, t2, limit)) {  // hypot(t1, t2) > limit, most often false: no root
@@ -406,11 +461,11 @@ class Solver {
           n1 = t1 * scale;
           n2 = t2 * scale;
         }
-        const Vec3 impulse =
-            k.tangent_1 * (n1 - sp.tangent_impulse_1) + k.tangent_2 * (n2 - sp.tangent_impulse_2);
+        const Fixed impulse_1 = n1 - sp.tangent_impulse_1;
+        const Fixed impulse_2 = n2 - sp.tangent_impulse_2;
         sp.tangent_impulse_1 = n1;
         sp.tangent_impulse_2 = n2;
-        apply(k, sp, impulse);
+        apply_friction(k, sp, impulse_1, impulse_2);
       }
     }
   }
@@ -443,12 +498,12 @@ class Solver {
     const Fixed threshold = s_.def.restitution_threshold;
     for (Constraint& k : constraints_) {
       if (k.restitution == Fixed::zero() || k.bounced || !k.pushed) continue;
-      SolverPoint& c = k.centroid;
+      const Bounce& c = k.bounce;
       if (c.relative_velocity > -threshold) continue;
       k.bounced = true;
-      const Fixed vn = dot(relative_velocity(k, c), k.normal);
-      const Fixed impulse = -c.normal_mass * (vn + k.restitution * c.relative_velocity);
-      if (impulse > Fixed::zero()) apply(k, c, k.normal * impulse);
+      const Fixed vn = speed(k, k.normal, c.normal);
+      const Fixed impulse = -c.normal.mass * (vn + k.restitution * c.relative_velocity);
+      if (impulse > Fixed::zero()) apply(k, k.normal, c.normal, impulse);
     }
   }
 
