@@ -33,7 +33,7 @@ struct WorldDef {
   /// Approach speeds below this (m/s, >= 0) get no restitution: resting contacts do not bounce.
   Fixed restitution_threshold = Fixed::one();
   /// Allowed overlap (m, >= 0) that is not pushed apart, so resting contacts persist.
-  Fixed linear_slop = Fixed::from_raw(Fixed::one_raw / 200);  // 5 mm
+  Fixed linear_slop = Fixed::from_raw(Fixed::one_raw >> 12);  // 2^-12 m, about 0.24 mm
   /// Contacts are created this far (m, >= 0) before the surfaces touch (speculative contacts).
   Fixed speculative_distance = Fixed::from_raw(Fixed::one_raw / 50);  // 2 cm
 
