@@ -10,8 +10,9 @@
 // impulses are stored for the next step's warm start.
 //
 // Contacts are not re-collided between sub-steps: each point keeps its anchors relative to the two
-// bodies, and its separation is updated from the bodies' motion since the start of the step (with
-// a small-angle rotation), which is exact for translation and second-order small for rotation.
+// bodies (in its rows, below), and its separation is updated from the bodies' motion since the
+// start of the step (with a small-angle rotation), which is exact for translation and
+// second-order small for rotation.
 // Soft constraints act like a damped spring with a stiffness tied to the sub-step rate rather than
 // an iteration count, so stacks neither jitter nor explode, and a restitution-1 bounce loses
 // almost nothing. Every constraint is solved in contact order (ascending ID pair), point order
@@ -58,8 +59,6 @@ struct Direction {
 };
 
 struct SolverPoint {
-  Vec3 anchor_a;  // contact point relative to each body's centre at the start of the step
-  Vec3 anchor_b;
   Fixed base_separation;
   Fixed separation;  // current_separation at the bodies' present motion (refresh_separations)
   Row normal;
@@ -250,15 +249,16 @@ class Solver {
       for (std::size_t p = 0; p < c.point_count; ++p) {
         const ContactPoint& mp = c.manifold.points[p];
         SolverPoint& sp = k.points[p];
-        sp.anchor_a = mp.point - a.position;
-        sp.anchor_b = mp.point - b.position;
+        // The contact point relative to each body's centre at the start of the step.
+        const Vec3 anchor_a = mp.point - a.position;
+        const Vec3 anchor_b = mp.point - b.position;
         sp.base_separation = mp.separation;
         sp.separation = mp.separation;
-        sp.normal = make_row(da, db, sp.anchor_a, sp.anchor_b, normal);
-        sp.tangent_1 = make_row(da, db, sp.anchor_a, sp.anchor_b, tangent_1);
-        sp.tangent_2 = make_row(da, db, sp.anchor_a, sp.anchor_b, tangent_2);
-        sum_a += sp.anchor_a;
-        sum_b += sp.anchor_b;
+        sp.normal = make_row(da, db, anchor_a, anchor_b, normal);
+        sp.tangent_1 = make_row(da, db, anchor_a, anchor_b, tangent_1);
+        sp.tangent_2 = make_row(da, db, anchor_a, anchor_b, tangent_2);
+        sum_a += anchor_a;
+        sum_b += anchor_b;
         sp.normal_impulse = c.cached[p].normal_impulse;
         sp.tangent_impulse_1 = c.cached[p].tangent_impulse_1;
         sp.tangent_impulse_2 = c.cached[p].tangent_impulse_2;
@@ -365,19 +365,21 @@ class Solver {
     }
   }
 
-  // Where the surfaces of a point are now, from the manifold and the motion since the step began.
+  // Where the surfaces of a point are now, from the manifold and the motion since the step began:
+  // the separation grows at the normal row's speed, so it has grown by the row's Jacobian times
+  // the bodies' displacements (delta position, small-angle delta rotation), one exact sum rounded
+  // once. A still body has not moved (integrate_positions never moves it) and adds exact zeros.
   Fixed current_separation(const Constraint& k, const SolverPoint& sp) const {
-    const Vec3 moved =
-        displacement(k.b, k.still_b, sp.anchor_b) - displacement(k.a, k.still_a, sp.anchor_a);
-    return sp.base_separation + dot(moved, k.normal.linear_b);
-  }
-
-  // How far a body's material point at `anchor` has moved since the start of the step; exactly
-  // zero for a still body, which integrate_positions never moves (0 + cross(0, r) = 0).
-  Vec3 displacement(std::size_t i, bool is_still, Vec3 anchor) const {
-    if (is_still) return {};
-    const Derived& d = s_.derived[i];
-    return d.delta_position + cross(d.delta_angle, anchor);
+    DotSum moved;
+    if (!k.still_a) {
+      const Derived& da = s_.derived[k.a];
+      moved.add(k.normal.linear_a, da.delta_position).add(sp.normal.angular_a, da.delta_angle);
+    }
+    if (!k.still_b) {
+      const Derived& db = s_.derived[k.b];
+      moved.add(k.normal.linear_b, db.delta_position).add(sp.normal.angular_b, db.delta_angle);
+    }
+    return sp.base_separation + moved.result();
   }
 
   // The separations depend only on the bodies' motion since the start of the step, which only
