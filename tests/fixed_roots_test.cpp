@@ -1,8 +1,11 @@
 // sqrt, rsqrt, hypot and the integer root behind them (fixed/src/isqrt.hpp, also used for vector
-// lengths). Every expected value is derived: either a closed form (sqrt(4) = 2, rsqrt(4^j ulp) =
-// 2^(48-j) ulp, Pythagorean triples) or an exact 128/192-bit check of the rounding inequality that
-// defines the correct result, computed with schoolbook multiplication (wide::Portable), never with
-// the code under test.
+// lengths), and normalisation (fixed/src/normalize.hpp). Every expected value is derived: either a
+// closed form (sqrt(4) = 2, rsqrt(4^j ulp) = 2^(48-j) ulp, Pythagorean triples) or an exact
+// 128/192-bit check of the rounding inequality that defines the correct result, computed with
+// schoolbook multiplication (wide::Portable), never with the code under test.
+#include <array>
+#include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <random>
@@ -14,6 +17,8 @@
 #include <gtest/gtest.h>
 #include <detsim/fixed/fixed.hpp>
 #include <detsim/fixed/math.hpp>
+#include <detsim/fixed/quat.hpp>
+#include <detsim/fixed/vec2.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/fixed/wide.hpp>
 
@@ -617,6 +622,172 @@ TEST(IsqrtRound, ThreeComponentLengths) {
     }
   }
   EXPECT_EQ(failures, 0U);
+}
+
+// ---- Normalisation: each component divided by the rounded length, rounded once ----------------
+
+/// The definition of normalize (fixed/src/normalize.hpp), computed independently: magnitudes
+/// shifted so that the largest is in [2^62, 2^63] (four components of 2^63 halved first, ties to
+/// even), L = round(sqrt(S)) of their sum of squares, and each component m_i 2^32 / L rounded to
+/// nearest, ties to even, by one schoolbook division. Counts the quotients within 2^-9 of a
+/// halfway point and the exact ties, so that tests can show they reach those cases.
+struct NormalizeReference {
+  std::size_t near_halfway = 0;
+  std::size_t ties = 0;
+
+  template <std::size_t N>
+  std::array<std::int64_t, N> operator()(std::array<std::int64_t, N> c) {
+    std::array<std::uint64_t, N> m{};
+    std::uint64_t largest = 0;
+    for (std::size_t i = 0; i < N; ++i) {
+      m[i] = c[i] < 0 ? 0 - static_cast<std::uint64_t>(c[i]) : static_cast<std::uint64_t>(c[i]);
+      largest = std::max(largest, m[i]);
+    }
+    if (N == 4 && largest == (std::uint64_t{1} << 63)) {
+      for (std::uint64_t& mi : m)
+        mi = (mi >> 1) + (mi & (mi >> 1) & 1U);
+      largest >>= 1;
+    }
+    const int shift = std::max(std::countl_zero(largest) - 1, 0);
+    U128 sum{};
+    for (std::uint64_t& mi : m) {
+      mi <<= shift;
+      sum = wide::add(sum, square(mi));
+    }
+    const std::uint64_t length = reference_isqrt_round(sum);
+    std::array<std::int64_t, N> result{};
+    for (std::size_t i = 0; i < N; ++i) {
+      const wide::DivResult qr = wide::Portable::div(U128{m[i] >> 32, m[i] << 32}, length);
+      // Twice the remainder against the divisor, in 65 bits: 2r - L in (-L, L).
+      const U128 twice_r = wide::shl(u128(qr.remainder), 1);
+      const bool tie = twice_r == u128(length);
+      const bool up = wide::less(u128(length), twice_r) || (tie && (qr.quotient & 1U) != 0);
+      // Within 2^-9 of the halfway point: |2r - L| < L 2^-8.
+      const U128 distance = wide::less(twice_r, u128(length)) ? wide::sub(u128(length), twice_r)
+                                                              : wide::sub(twice_r, u128(length));
+      near_halfway += wide::less(wide::shl(distance, 8), u128(length)) ? 1U : 0U;
+      ties += tie ? 1U : 0U;
+      const std::uint64_t q = qr.quotient + (up ? 1U : 0U);  // <= 2^32
+      result[i] = c[i] < 0 ? -static_cast<std::int64_t>(q) : static_cast<std::int64_t>(q);
+    }
+    return result;
+  }
+};
+
+/// normalize of the raw components through the public Vec2, Vec3 and Quat functions.
+template <std::size_t N>
+std::array<std::int64_t, N> normalize_raws(const std::array<std::int64_t, N>& c) {
+  if constexpr (N == 2) {
+    const Vec2 n = normalize(Vec2{raw(c[0]), raw(c[1])});
+    return {n.x.raw(), n.y.raw()};
+  } else if constexpr (N == 3) {
+    const Vec3 n = normalize(Vec3{raw(c[0]), raw(c[1]), raw(c[2])});
+    return {n.x.raw(), n.y.raw(), n.z.raw()};
+  } else {
+    const Quat n = normalize(Quat{raw(c[0]), raw(c[1]), raw(c[2]), raw(c[3])});
+    return {n.w.raw(), n.x.raw(), n.y.raw(), n.z.raw()};
+  }
+}
+
+template <std::size_t N>
+std::string show(const std::array<std::int64_t, N>& c) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < N; ++i)
+    s += (i == 0 ? "" : ", ") + show(raw(c[i]));
+  return s + ")";
+}
+
+/// Compares normalize with the reference over inputs from make(rng), which must not be zero.
+template <std::size_t N, typename Make>
+void check_normalize(NormalizeReference& reference, std::mt19937_64& rng, int count, Make make) {
+  std::size_t failures = 0;
+  for (int i = 0; i < count; ++i) {
+    const std::array<std::int64_t, N> c = make(rng);
+    const std::array<std::int64_t, N> expected = reference(c);
+    const std::array<std::int64_t, N> actual = normalize_raws(c);
+    if (actual != expected && ++failures <= 10) {
+      ADD_FAILURE() << "normalize" << show(c) << " = " << show(actual) << ", expected "
+                    << show(expected);
+    }
+  }
+  EXPECT_EQ(failures, 0U) << "normalize of " << N << " components";
+}
+
+TEST(Normalize, IsTheRoundedQuotientByTheRoundedLength) {
+  NormalizeReference reference;
+  std::mt19937_64 rng = seeded(19);
+  const auto component = [](std::mt19937_64& r) {
+    switch (r() % 4) {
+      case 0:
+        return std::int64_t{0};
+      case 1:
+        return static_cast<std::int64_t>(r());  // any raw value, kMin included in principle
+      default:
+        return random_sign(r, log_uniform_positive(r));
+    }
+  };
+  const auto nonzero = [&](auto c) {
+    if (c[0] == 0) c[0] = 1;
+    return c;
+  };
+  check_normalize<2>(reference, rng, 300'000, [&](std::mt19937_64& r) {
+    return nonzero(std::array{component(r), component(r)});
+  });
+  check_normalize<3>(reference, rng, 300'000, [&](std::mt19937_64& r) {
+    return nonzero(std::array{component(r), component(r), component(r)});
+  });
+  check_normalize<4>(reference, rng, 300'000, [&](std::mt19937_64& r) {
+    return nonzero(std::array{component(r), component(r), component(r), component(r)});
+  });
+  // Unit-size quaternions and vectors near the unit sphere, as the simulation renormalises them.
+  const auto near_unit = [](std::mt19937_64& r) {
+    return random_sign(r, static_cast<std::int64_t>(r() >> 33));  // below 2^31: |.| < 1/2
+  };
+  check_normalize<4>(reference, rng, 300'000, [&](std::mt19937_64& r) {
+    return nonzero(std::array{near_unit(r), near_unit(r), near_unit(r), near_unit(r)});
+  });
+  check_normalize<3>(reference, rng, 100'000, [&](std::mt19937_64& r) {
+    return nonzero(std::array{near_unit(r), near_unit(r), near_unit(r)});
+  });
+  // Extremes: kMin, kMax and their neighbours in every position.
+  const std::array<std::int64_t, 8> extremes{kMin, kMin + 1, kMax, kMax - 1, 1, -1, 0, kOne};
+  check_normalize<4>(reference, rng, 100'000, [&](std::mt19937_64& r) {
+    return nonzero(
+        std::array{extremes[r() % 8], extremes[r() % 8], extremes[r() % 8], extremes[r() % 8]});
+  });
+  // normalize computes the length and divides only near a halfway point; the inputs above must
+  // reach that path often.
+  EXPECT_GT(reference.near_halfway, 10'000U);
+}
+
+// Exact ties m_i 2^33 = (2j + 1) L: with L = 2^33 u (u in [2^29, 2^30), L in [2^62, 2^63)) and m_0
+// = u v for odd v, m_0 2^32 / L = v / 2 exactly, and m_1 ~ u sqrt(2^66 - v^2) puts the rounded
+// length at L in most cases. Ties round to even.
+TEST(Normalize, ExactTiesRoundToEven) {
+  NormalizeReference reference;
+  std::mt19937_64 rng = seeded(20);
+  const auto tie_candidate = [](std::mt19937_64& r) {
+    const std::uint64_t u = (std::uint64_t{1} << 29) | (r() >> 35);  // [2^29, 2^30)
+    const std::uint64_t v = (r() >> 31) | 1U;                        // odd, < 2^33
+    // m_1 = round(u sqrt(2^66 - v^2)) = round(sqrt(u^2 (2^66 - v^2))), with u^2 (2^66 - v^2) <
+    // 2^126.
+    const U128 two_66_minus = wide::sub(U128{4, 0}, square(v));
+    const U128 product =
+        wide::add(wide::Portable::mul(two_66_minus.lo, u * u), U128{two_66_minus.hi * u * u, 0});
+    const std::uint64_t m1 = reference_isqrt_round(product);
+    return std::array{random_sign(r, static_cast<std::int64_t>(u * v)),
+                      random_sign(r, static_cast<std::int64_t>(m1))};
+  };
+  check_normalize<2>(reference, rng, 20'000, tie_candidate);
+  check_normalize<3>(reference, rng, 20'000, [&](std::mt19937_64& r) {
+    const auto c = tie_candidate(r);
+    return std::array{c[1], std::int64_t{0}, c[0]};
+  });
+  check_normalize<4>(reference, rng, 20'000, [&](std::mt19937_64& r) {
+    const auto c = tie_candidate(r);
+    return std::array{std::int64_t{0}, c[0], std::int64_t{0}, c[1]};
+  });
+  EXPECT_GT(reference.ties, 10'000U);
 }
 
 }  // namespace

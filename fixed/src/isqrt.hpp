@@ -1,5 +1,6 @@
-// Correctly rounded integer square roots: the one mechanism behind sqrt, hypot (roots.cpp) and the
-// lengths of vectors (vector.cpp). Internal to the fixed module; not installed.
+// Correctly rounded integer square roots: the one mechanism behind hypot (roots.cpp), the lengths
+// of vectors (vector.cpp) and normalisation (normalize.hpp). Internal to the fixed module; not
+// installed.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +15,19 @@ namespace detsim::detail {
 /// 2^64 - 1: for n > 2^128 - 2^64, where it would round to 2^64, it saturates to 2^64 - 1.
 /// Integer arithmetic only, no division; defined in roots.cpp.
 [[nodiscard]] std::uint64_t isqrt_round(wide::U128 n) noexcept;
+
+/// An estimate of 1/sqrt(n) for n in [2^124, 2^128) (the sums of squares of normalize.hpp):
+/// reciprocal 2^(shift - 125) = (1 + b) / sqrt(n) with |b| < 2^-41.49 (a proven bound; see
+/// roots.cpp), where shift is 1 for n < 2^126, else 0 (n 4^shift is in [2^126, 2^128)), and
+/// reciprocal < 2^62 + 4.
+struct ReciprocalRoot {
+  std::uint64_t reciprocal;
+  unsigned shift;
+};
+
+/// The estimate above, from the first steps of isqrt_round (no rounding, no division); defined in
+/// roots.cpp.
+[[nodiscard]] ReciprocalRoot reciprocal_root(wide::U128 n) noexcept;
 
 /// x^2 + y^2 of two raw values, exact: each square is at most 2^126, so the sum fits.
 [[nodiscard]] constexpr wide::U128 sum_of_squares(std::int64_t x, std::int64_t y) noexcept {

@@ -4,10 +4,13 @@
 // quadratic per interval from a table. rsqrt, hypot and isqrt_round (96 intervals) refine it by
 // Newton steps in 64-bit fixed point with 64x64->128 multiplies; the last step picks the correctly
 // rounded result: an error bound on the approximation proves the nearest integer right unless it
-// lies next to a halfway point, and there an exact integer comparison decides. sqrt, whose result
-// has at most 48 bits, starts from a finer table (192 intervals), takes one Karp-Markstein step in
-// plain 64-bit multiplies to within 0.64 below the root and lets an exact comparison, always made,
-// pick between the two integers there. No division anywhere.
+// lies next to a halfway point, and there an exact integer comparison decides. isqrt_round keeps
+// 34 fraction bits of its last correction, so that test fails for about one input in 2^16 at any
+// size. sqrt, whose result has at most 48 bits, starts from a finer table (192 intervals), takes
+// one Karp-Markstein step in plain 64-bit multiplies to within 0.64 below the root and lets an
+// exact comparison, always made, pick between the two integers there. reciprocal_root hands the
+// refined 1/sqrt estimate to normalize (normalize.hpp), which multiplies by it instead of dividing
+// by the rounded length. No division anywhere.
 #include <array>
 #include <cstdint>
 
@@ -25,8 +28,9 @@ using wide::Default;
 using wide::U128;
 
 // 1/sqrt(x) as c0 - t (c1 - t c2), t in [0, 1) the position in the interval; coefficients in
-// Q2.30. rsqrt_seed (rsqrt, hypot, isqrt_round) has the 96 intervals [i/128, (i+1)/128),
-// i = 32..127; sqrt_seed (sqrt) the 192 intervals [i/256, (i+1)/256), i = 64..255.
+// Q2.30. rsqrt_seed (rsqrt, hypot, isqrt_round, reciprocal_root) has the 96 intervals
+// [i/128, (i+1)/128), i = 32..127; sqrt_seed (sqrt) the 192 intervals [i/256, (i+1)/256),
+// i = 64..255.
 struct RsqrtSeed {
   std::uint32_t c0;
   std::uint32_t c1;
@@ -184,33 +188,24 @@ constexpr std::array<RsqrtSeed, 192> sqrt_seed{{
     {0x404060A0, 0x002060E7, 0x0000185B}, {0x40201813, 0x00203031, 0x0000181E},
 }};
 
-/// x << shift for the even shift (0..62) that leaves a nonzero x in [2^62, 2^64).
-struct EvenNormalised {
-  std::uint64_t m;
-  unsigned shift;
+/// n 4^k in [2^126, 2^128) for n != 0, and k (0..63): the even normalisation behind every root of a
+/// 128-bit value.
+struct EvenNormalised128 {
+  U128 m;
+  unsigned k;
 };
 
-/// One step of normalise_even: shift left by `step` if the top `step` bits are zero. The shift is
-/// computed (0 or step), not selected: compilers turn a select here into an unpredictable branch.
-constexpr void normalise_step(EvenNormalised& v, unsigned step) noexcept {
-  const unsigned shift = static_cast<unsigned>((v.m >> (64 - step)) == 0) * step;
-  v.m <<= shift;
-  v.shift += shift;
-}
-
-/// Binary search on the top bits, unrolled by hand (compilers keep a loop with branches). Not
-/// std::countl_zero: without -mlzcnt that compiles to bsr, whose false dependency on its output
-/// register can chain the long multiply sequence of one call into the start of the next (loops
-/// measured 2-3x slower with clang). sqrt uses leading_zeros (leading_zeros.hpp) instead, which
-/// breaks that dependency.
-constexpr EvenNormalised normalise_even(std::uint64_t x) noexcept {
-  EvenNormalised v{x, 0};
-  normalise_step(v, 32);
-  normalise_step(v, 16);
-  normalise_step(v, 8);
-  normalise_step(v, 4);
-  normalise_step(v, 2);
-  return v;
+constexpr EvenNormalised128 normalise_even(U128 n) noexcept {
+  // First move a zero high half out (with masks, as the size of n is as unpredictable as the
+  // input), then shift the top word by its even count of leading zeros. leading_zeros, not
+  // std::countl_zero: see leading_zeros.hpp.
+  const std::uint64_t high_empty = 0 - static_cast<std::uint64_t>(n.hi == 0);  // all ones if so
+  const std::uint64_t top = n.hi | (n.lo & high_empty);
+  const std::uint64_t bottom = n.lo & ~high_empty;
+  const auto shift = static_cast<unsigned>(leading_zeros(top)) & ~1U;  // 0..62
+  // (bottom >> 1) >> (63 - shift) is bottom >> (64 - shift) without the undefined shift by 64.
+  const U128 m{(top << shift) | ((bottom >> 1) >> (63 - shift)), bottom << shift};
+  return {m, static_cast<unsigned>(high_empty & 32U) + shift / 2};
 }
 
 /// 1/sqrt(x) in Q2.30 for x = m / 2^64 in [1/4, 1) (m >= 2^62), relative error < 2^-21.6.
@@ -293,7 +288,7 @@ constexpr std::uint64_t select_rounded_rsqrt(std::uint64_t r, std::uint64_t c) n
 }
 
 /// round(sqrt(n)) for n != 0, given its normalisation m = n 2^(2k) in [2^126, 2^128)
-/// (so sqrt(n) = sqrt(m) / 2^k, k = 0..63). The shared core of isqrt_round and sqrt.
+/// (so sqrt(n) = sqrt(m) / 2^k, k = 0..63). The core of isqrt_round.
 constexpr std::uint64_t rounded_root(U128 n, U128 m, unsigned k) noexcept {
   // y ~ 1/sqrt(x) for x = m.hi / 2^64 in Q3.61, relative error b < 2^-41.5. Let
   // sigma = sqrt(m) in [2^63, 2^64); x drops the low half of m, which moves sqrt by < 1 unit.
@@ -315,53 +310,80 @@ constexpr std::uint64_t rounded_root(U128 n, U128 m, unsigned k) noexcept {
   // (flooring moves the correction by < y 2^-37 <= 2^-36).
   const U128 r = wide::sub(m, Default::mul(s0, s0));
   const std::uint64_t r_scaled = (r.hi << 36) | (r.lo >> 28);
-  // The correction r y 2^-65 = r_scaled y / 2^98 as a signed product: the unsigned product's high
-  // half less y when r_scaled is negative (its two's complement reads 2^64 too high). |product|
-  // < 2^60 * 2^62.01, so the high half is a signed value below 2^58.01 in magnitude. Adding 2^33
-  // before the arithmetic shift rounds to nearest (the low half cannot carry into a multiple of
-  // 2^34): error <= 1/2. The sign of r is random, so it is applied with a mask rather than a
-  // branch.
+  // The correction C = r y 2^-65 = r_scaled y / 2^98 as a signed product: the unsigned product's
+  // high half less y when r_scaled is negative (its two's complement reads 2^64 too high), which
+  // is C 2^34 less under 1 unit. |product| < 2^60 * 2^62.01, so the high half is a signed value
+  // below 2^58.01 in magnitude. The sign of r is random, so it is applied with a mask rather than
+  // a branch.
   const std::uint64_t negative = 0 - (r.hi >> 63);
   const std::uint64_t product_hi = Default::mul(r_scaled, y).hi - (negative & y);
-  const std::int64_t correction =
-      static_cast<std::int64_t>(product_hi + (std::uint64_t{1} << 33)) >> 34;  // |.| <= 2^24
+  // biased = (C + 1/2) 2^34: its integer part is the correction rounded to nearest (the low half
+  // cannot carry into a multiple of 2^34), |.| <= 2^24, and its low 34 bits the fraction f of
+  // C + 1/2, so that V = s0 + C reads s1 - 1/2 + f 2^-34 for s1 = s0 + correction.
+  const std::uint64_t biased = product_hi + (std::uint64_t{1} << 33);
+  const std::int64_t correction = static_cast<std::int64_t>(biased) >> 34;
+  const std::uint64_t fraction = biased & ((std::uint64_t{1} << 34) - 1);
+  // s0 + correction wraps only when V >= 2^64 - 1/2 (s0 > 2^62 cannot wrap downwards). As an
+  // unsigned sum it carries out exactly then or when the correction is negative, so a carry with
+  // a nonnegative correction marks the wrap, and clamping to 2^64 - 1 keeps s1 within 1 of sigma.
+  // Both are bit operations: the sign of the correction is random, and a compiler turns a
+  // comparison of it into a branch that is mispredicted half the time.
   const std::uint64_t s1_wrapping = s0 + static_cast<std::uint64_t>(correction);
-  // s0 + correction wraps only when sigma > 2^64 - 1, so clamping to 2^64 - 1 keeps it within 1.
-  // (s0 > 2^62 cannot wrap downwards.)
-  const std::uint64_t s1 = correction > 0 && s1_wrapping < s0 ? ~std::uint64_t{0} : s1_wrapping;
+  const std::uint64_t carry = static_cast<std::uint64_t>(s1_wrapping < s0);
+  const std::uint64_t wrapped = carry & ~(static_cast<std::uint64_t>(correction) >> 63);
+  const std::uint64_t s1 = s1_wrapping | (0 - wrapped);
 
-  // |s1 - sigma| < 1/2 + 2^-18 + 2^-36 (sampled: 0.49995), or < 1 when clamped. So s1 / 2^k is
-  // within 1 of sqrt(n) and its nearest integer q within 1 of round(sqrt(n)).
+  // |V - sigma| < 2^-18 + 2^-36 + 2^-34 < 2^-17.9 (the step, the floor of r, the high half's
+  // floor), so |s1 - sigma| < 1/2 + 2^-17.9 (sampled: 0.49995), or < 1 when clamped. So s1 / 2^k
+  // is within 1 of sqrt(n) and its nearest integer q (half up) within 1 of round(sqrt(n)).
   // ((s1 << 1) >> k) & 1 is the bit below the binary point of s1 / 2^k (0 when k = 0), and the sum
   // cannot wrap: s1 >> k < 2^63 for k >= 1.
   const std::uint64_t q = (s1 >> k) + (((s1 << 1) >> k) & 1U);
 
-  // Rounding s1 / 2^k and sigma / 2^k = sqrt(n) can differ only if a halfway point
-  // T = (j + 1/2) 2^k lies strictly within 1 of s1 or equals sigma. For k >= 1 every T is an
-  // integer, so that needs s1 == T (s1 is an integer too), and sigma == T would make
-  // sqrt(n) = j + 1/2, impossible for an integer n. Hence q is exact unless the k bits below the
-  // binary point of s1 read 1000...0: about one input in 2^k, and sqrt always has k >= 16. For
-  // k = 0 (n >= 2^126) the halfway points are not integers and the exact test always decides.
-  const std::uint64_t low_bits = s1 & ((std::uint64_t{1} << k) - 1);
+  // Where rounding s1 / 2^k and sigma / 2^k = sqrt(n) can differ (a halfway point
+  // T = (j + 1/2) 2^k never equals sigma: sqrt(n) = j + 1/2 is impossible for an integer n):
+  // - k >= 1: every T is an integer, and one within 1/2 + 2^-17.9 of s1 (the integer round(V))
+  //   is s1 itself. So q is exact unless s1 == T, i.e. the k bits below the binary point of s1
+  //   read 1000...0 (one input in 2^k). Then q rounded T up, and sqrt(n) > T iff V > T, i.e.
+  //   f > 2^33, unless f is within 2^16.1 of 2^33, where V is within 2^-17.9 of T.
+  // - k = 0: q = s1 = round(V), exact unless V is within 2^-17.9 of a half-integer, i.e. f within
+  //   2^16.1 of 0 or 2^34: f + 2^33 (mod 2^34) within 2^16.1 of 2^33.
+  // The tests read the unclamped s1: a wrapped s1 is 0, never 1000...0 for k >= 1, where q rounds
+  // the clamped 2^64 - 1 to the right 2^(64 - k); for k = 0 the saturated q is right either way.
+  // Only the near-halfway test is a branch (taken for about one input in 2^(k + 16)); it leads to
+  // the exact comparison.
+  const std::uint64_t mask = (std::uint64_t{1} << k) - 1;
   const std::uint64_t half = (std::uint64_t{1} << k) >> 1;
-  if (low_bits != half) return q;
+  const auto at_half = static_cast<std::uint64_t>((s1_wrapping & mask) == half);  // 1 for k = 0
+  const auto below_half = static_cast<std::uint64_t>(fraction < (std::uint64_t{1} << 33));
+  const std::uint64_t rounded_up = at_half & static_cast<std::uint64_t>(k != 0) & below_half;
+  const std::uint64_t centred =
+      (fraction + (static_cast<std::uint64_t>(k == 0) << 33)) & ((std::uint64_t{1} << 34) - 1);
+  constexpr std::uint64_t margin = std::uint64_t{1} << 17;  // > 2^16.1
+  const std::uint64_t near_halfway =
+      at_half &
+      static_cast<std::uint64_t>(centred - ((std::uint64_t{1} << 33) - margin) < 2 * margin);
+  if (near_halfway == 0) return q - rounded_up;
   return select_rounded_root(n, q);
 }
 
 }  // namespace
 
 std::uint64_t isqrt_round(U128 n) noexcept {
-  // Normalise by an even shift, m = n 2^(2k) in [2^126, 2^128): first move a zero high half out
-  // (with masks, as the size of n is as unpredictable as the input), then the top word.
-  const std::uint64_t high_empty = 0 - static_cast<std::uint64_t>(n.hi == 0);  // all ones if so
-  const std::uint64_t top = n.hi | (n.lo & high_empty);
-  const std::uint64_t bottom = n.lo & ~high_empty;
-  if (top == 0) return 0;  // n == 0
-  const EvenNormalised normalised = normalise_even(top);
-  const unsigned shift = normalised.shift;  // 0..62
-  // (bottom >> 1) >> (63 - shift) is bottom >> (64 - shift) without the undefined shift by 64.
-  const U128 m{normalised.m | ((bottom >> 1) >> (63 - shift)), bottom << shift};
-  return rounded_root(n, m, static_cast<unsigned>(high_empty & 32U) + shift / 2);
+  if ((n.hi | n.lo) == 0) return 0;
+  const EvenNormalised128 normalised = normalise_even(n);
+  return rounded_root(n, normalised.m, normalised.k);
+}
+
+ReciprocalRoot reciprocal_root(U128 n) noexcept {
+  // n in [2^124, 2^128) is normalised by k = 1 below 2^126, else 0: m = n 4^k, of which rsqrt_q61
+  // reads the high half m.hi; (n.lo >> 1) >> (63 - 2k) is n.lo >> (64 - 2k), 0 for k = 0.
+  // 1/sqrt(n) = 2^k / sqrt(m) and sqrt(m) = 2^64 sqrt(x) for x = m.hi / 2^64, up to the low half
+  // of m, which moves it by a factor below 1 + 2^-127. rsqrt_q61's y = (1 + b) 2^61 / sqrt(x) with
+  // |b| < 2^-41.5, so y 2^(k - 125) = (1 + b') / sqrt(n) with |b'| < 2^-41.49.
+  const auto k = static_cast<unsigned>(n.hi < (std::uint64_t{1} << 62));
+  const std::uint64_t m_hi = (n.hi << (2 * k)) | ((n.lo >> 1) >> (63 - 2 * k));
+  return {rsqrt_q61(m_hi), k};
 }
 
 }  // namespace detail
@@ -408,9 +430,9 @@ Fixed rsqrt(Fixed x) noexcept {
   // (2^16.5, 2^48]. With m = r 2^(2k) in [2^62, 2^64) and x = m / 2^64 it equals
   // 2^(16+k) / sqrt(x): the Q3.61 estimate of 1/sqrt(x) shifted right by 45 - k >= 14.
   const auto r = static_cast<std::uint64_t>(x.raw());
-  const detail::EvenNormalised normalised = detail::normalise_even(r);
-  const std::uint64_t m = normalised.m;
-  const unsigned k = normalised.shift / 2;  // 0..31
+  const int even_shift = detail::leading_zeros(r) & ~1;
+  const std::uint64_t m = r << even_shift;
+  const auto k = static_cast<unsigned>(even_shift / 2);  // 0..31
   const std::uint64_t y = detail::newton_rsqrt_q61(m, detail::rsqrt_q61(m));
 
   // y is within 5 units of v = 2^61 / sqrt(x) (newton_rsqrt_q61), and the result is
