@@ -62,7 +62,8 @@ inline const std::vector<FieldClass>& all_field_classes() {
 
 /// The injection of class `c` for `world` (at the frame it is to change), or nothing when this
 /// state has no target for it (e.g. no contact with a cached point): the rule picks the highest-ID
-/// dynamic body, or the first contact with a point.
+/// dynamic body, or the first contact the solver leaves alone (no awake dynamic body), else the
+/// first whose first point pushed, else the first with a point.
 inline std::optional<Injection> choose_injection(FieldClass c, const World& world) {
   Injection i;
   i.frame = world.frame();
@@ -98,14 +99,33 @@ inline std::optional<Injection> choose_injection(FieldClass c, const World& worl
       i.delta = "12345";
       break;
     case FieldClass::contact_impulse: {
+      // A changed impulse must survive to the next hash check. The solver leaves the impulses of
+      // a pair with no awake dynamic body as they are until the pair wakes, so such a pair is
+      // preferred. A loaded pair's impulse is warm-started into the next step but can be absorbed
+      // within a frame or two (the soft contact returns to the same bits), and a point that has
+      // come apart has its impulse reset: those are the fallbacks, in that order.
+      const auto moving = [&world](BodyId id) {
+        const BodyState b = world.body(id).value();
+        return b.type == BodyType::dynamic && b.awake;
+      };
+      std::optional<ContactState> resting;
+      std::optional<ContactState> loaded;
+      std::optional<ContactState> any;
       for (const ContactState& k : world.contacts()) {
         if (k.point_count == 0) continue;
-        i.body = k.a.value;
-        i.field = "contact[" + std::to_string(k.b.value) + "].point[0].normal_impulse";
-        i.delta = "0.5";
-        return i;
+        if (!any) any = k;
+        if (!loaded && k.points[0].normal_impulse > Fixed::zero()) loaded = k;
+        if (!moving(k.a) && !moving(k.b)) {
+          resting = k;
+          break;
+        }
       }
-      return std::nullopt;
+      const std::optional<ContactState> target = resting ? resting : loaded ? loaded : any;
+      if (!target) return std::nullopt;
+      i.body = target->a.value;
+      i.field = "contact[" + std::to_string(target->b.value) + "].point[0].normal_impulse";
+      i.delta = "0.5";
+      return i;
     }
     case FieldClass::body_removed:
       i.field = "present";
