@@ -100,6 +100,22 @@ TEST(WidePaths, PortableDivEqualsNativeOnTenMillionOperands) {
   EXPECT_EQ(checked, kCount);
 }
 
+TEST(WidePaths, NativeDivOutsideItsPreconditionGivesTheQuotientModulo2To64) {
+  // n.hi >= d breaks Native::div's precondition. On x86-64 the fast path is one DIV instruction,
+  // which would trap there; such calls must keep the general path: no trap, and the quotient
+  // reduced modulo 2^64. volatile keeps the operands from being folded at compile time.
+  volatile std::uint64_t hi = 7;
+  volatile std::uint64_t d = 7;
+  const auto r = wide::Native::div(U128{hi, 5}, d);  // (7 2^64 + 5) / 7 = 2^64 + 5/7
+  EXPECT_EQ(r.quotient, 0U);
+  EXPECT_EQ(r.remainder, 5U);
+  hi = ~std::uint64_t{0};
+  d = 2;
+  const auto s = wide::Native::div(U128{hi, 0}, d);  // (2^64 - 1) 2^63 = 2^127 - 2^63
+  EXPECT_EQ(s.quotient, std::uint64_t{1} << 63);
+  EXPECT_EQ(s.remainder, 0U);
+}
+
 TEST(WidePaths, FixedOperatorsAgreeOnBothPaths) {
   const auto v = operands(kCount + 1, 13);
   for (std::size_t i = 0; i < kCount; ++i) {
