@@ -343,6 +343,29 @@ TEST(ProductSumPaths, RoundingAtTheEdgesOfTheInt64Range) {
   }
 }
 
+TEST(ProductSumPaths, RoundingNextToTheInt128Maximum) {
+  // Sums just below 2^127 that the native form still holds without a wrap: adding the rounding
+  // bias to them leaves the int128 range, and every shift must still saturate (as ExactSum does).
+  // 2^126 + (2^63 - 1)^2 + (2^63 - 1) 2 = 2^127 - 1, then minus small and large amounts.
+  for (const std::int64_t below :
+       {std::int64_t{0}, std::int64_t{1}, std::int64_t{2}, kMax / 2, kMax - 1, kMax}) {
+    detail::NativeProductSum native;
+    detail::ExactSum<3> exact;
+    native.add_product(kMin, kMin);
+    exact.add_product(kMin, kMin);
+    native.add_product(kMax, kMax);
+    exact.add_product(kMax, kMax);
+    native.add_scaled(kMax, 1);
+    exact.add_scaled(kMax, 1);
+    native.add_scaled(-below, 0);
+    exact.add_scaled(-below, 0);
+    ASSERT_FALSE(native.negative()) << below;
+    ASSERT_TRUE(same_sum(native, exact)) << "2^127 - 1 - " << below;
+    for (const unsigned shift : {1U, 32U, 63U})
+      EXPECT_EQ(native.round_to_raw(shift), kMax) << "2^127 - 1 - " << below << ", shift " << shift;
+  }
+}
+
 Fixed raw_fixed(std::int64_t r) {
   return Fixed::from_raw(r);
 }

@@ -56,22 +56,23 @@ constexpr std::uint64_t round_shift_right(wide::U128 v, unsigned shift) noexcept
 
 #if DETSIM_HAS_INT128
 /// v / 2^shift rounded to nearest, ties to even, saturated to the int64 range; 1 <= shift <= 63.
-/// The signed form for 64-bit targets, shared by Fixed * and the native product sum: 64-bit work on
-/// bits shift..shift+63 of v (the candidate result q, floor(v / 2^shift) if it fits) and the bits
-/// above (which must be q's sign extension, else the result saturates; rounding up by one cannot
-/// bring a floor of 2^63 or more back into range, nor push one below -2^63 out of it). Ties to
-/// even: add 1 iff the dropped bits plus q's lowest bit exceed 2^(shift-1) - 1.
+/// The signed form for 64-bit targets, shared by Fixed * and the native product sum. Ties to even
+/// in one addition: w = v + 2^(shift-1) - 1 + (bit `shift` of v) carries into bit `shift` iff the
+/// dropped bits exceed half, or equal it with the kept value odd; then floor(w / 2^shift) is the
+/// rounded value, and it fits iff w's bits shift+63..127 are all equal (the high half, w / 2^64,
+/// is a shift-bit signed integer). Only a v within 2^63 of the int128 maximum can make the
+/// addition overflow, and its quotient saturates anyway.
 constexpr std::int64_t round_shift_saturate(wide::int128_t v, unsigned shift) noexcept {
-  const auto lo = static_cast<std::uint64_t>(v);
-  const auto hi = static_cast<std::uint64_t>(v >> 64);
-  const std::uint64_t q = (lo >> shift) | (hi << (64 - shift));
-  const auto top = static_cast<std::int64_t>(hi) >> shift;
-  if (top != (static_cast<std::int64_t>(q) >> 63)) return top < 0 ? raw_min : raw_max;
-  const std::uint64_t half = std::uint64_t{1} << (shift - 1);
-  const std::uint64_t rest = lo & ((half << 1) - 1);
-  const std::uint64_t up = (rest + (q & 1U) + (half - 1)) >> shift;  // < 2^64 for shift <= 63
-  const auto rounded = static_cast<std::int64_t>(q + up);
-  return rounded < static_cast<std::int64_t>(q) ? raw_max : rounded;  // q == max rounded up
+  const std::uint64_t bias =
+      ((std::uint64_t{1} << (shift - 1)) - 1) + ((static_cast<std::uint64_t>(v) >> shift) & 1U);
+  wide::int128_t w = 0;
+  if (__builtin_add_overflow(v, static_cast<wide::int128_t>(bias), &w)) return raw_max;
+  const auto lo = static_cast<std::uint64_t>(w);
+  const auto hi = static_cast<std::uint64_t>(w >> 64);
+  const auto high_bits = 64 - shift;
+  if (static_cast<std::int64_t>(hi << high_bits) >> high_bits != static_cast<std::int64_t>(hi))
+    return static_cast<std::int64_t>(hi) < 0 ? raw_min : raw_max;
+  return static_cast<std::int64_t>((lo >> shift) | (hi << high_bits));
 }
 #endif
 
