@@ -302,6 +302,7 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("detsim_compiler", DETSIM_BENCH_COMPILER);
   benchmark::AddCustomContext("detsim_cxx_flags", DETSIM_BENCH_CXX_FLAGS);
   benchmark::AddCustomContext("detsim_build_type", DETSIM_BENCH_BUILD_TYPE);
+  benchmark::AddCustomContext("detsim_fixed_bench_flags", DETSIM_FIXED_BENCH_FLAGS);
   benchmark::AddCustomContext("detsim_block_size", std::to_string(kBlock));
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

@@ -517,6 +517,16 @@ def render_fixed(data, args, add):
     add("- The compiler decides whether a loop is vectorised: GCC 12 at -O2 keeps the double mul "
         "and div loops scalar, clang at -O2 vectorises them, which makes those two baselines "
         "several times faster. The figures hold for the compiler named above.")
+    align = context.get("detsim_fixed_bench_flags", "")
+    if align:
+        add(f"- The benchmark program alone is compiled with `{align}`: every timed loop (double, "
+            "detsim and libfixmath alike) starts on a 64-byte boundary. Where the linker happens to "
+            "place a short loop changes its speed: the double mul loop ran at 0.31 or 0.55 ns per "
+            "call in two builds that differed only in unrelated code. The detsim library is built "
+            "without it, as a user builds it.")
+    else:
+        add("- The timed loops are not aligned (the compiler lacks `-falign-loops`): a short loop's "
+            "speed can depend on where the linker places it.")
     add(f"- **ns/op** is CPU time per call. The headline is the **minimum over the {reps} "
         "repetitions** (noise on a shared machine only adds time); the median is beside it.")
     add("- **vs double** is the throughput ratio double ns / other ns: above 1 means faster than "
