@@ -217,6 +217,17 @@ constexpr std::array<unsigned, 13> kShifts = {1, 2, 30, 31, 32, 33, 34, 62, 63, 
     }
   }
   if (native.to_fixed() != exact.to_fixed()) return ::testing::AssertionFailure() << "to_fixed()";
+  // A base added before the one rounding (Vec3Sum's fused multiply-add): odd and even bases flip
+  // which way a tie goes, and bases near the int64 ends bring sums beyond int64 back into range
+  // or push sums inside it out.
+  for (const std::int64_t base :
+       {std::int64_t{0}, std::int64_t{1}, std::int64_t{-1}, std::int64_t{2}, std::int64_t{1} << 32,
+        kMax, kMax - 1, kMin, kMin + 1, kMax / 3, kMin / 3}) {
+    if (native.to_fixed_plus(base) != exact.to_fixed_plus(base))
+      return ::testing::AssertionFailure()
+             << "to_fixed_plus(" << base << "): native " << native.to_fixed_plus(base).raw()
+             << ", exact " << exact.to_fixed_plus(base).raw();
+  }
   return ::testing::AssertionSuccess();
 }
 
@@ -341,6 +352,30 @@ TEST(ProductSumPaths, RoundingAtTheEdgesOfTheInt64Range) {
       }
     }
   }
+}
+
+TEST(ProductSumPaths, ABaseBringsASumBeyondInt64BackIntoRange) {
+  // +-2^95 alone rounds to +-2^63, one past the int64 range at the top; a base of the other sign
+  // brings it back: (-2^63 2^32 + 2^95) / 2^32 = 0. Nearby sums and exact ties (+-2^31 off) check
+  // the rounding there against ExactSum, for every base same_sum tries.
+  const std::int64_t half = std::int64_t{1} << 31;
+  for (const std::int64_t sign : {1, -1}) {
+    for (const std::int64_t delta :
+         {-half - 1, -half, -half + 1, std::int64_t{0}, half - 1, half, half + 1, 3 * half}) {
+      detail::NativeProductSum native;
+      detail::ExactSum<3> exact;
+      native.add_product(sign << 62, std::int64_t{1} << 33);
+      exact.add_product(sign << 62, std::int64_t{1} << 33);
+      native.add_scaled(delta, 0);
+      exact.add_scaled(delta, 0);
+      ASSERT_TRUE(same_sum(native, exact)) << sign << " 2^95 + " << delta;
+    }
+  }
+  detail::NativeProductSum up;
+  up.add_product(std::int64_t{1} << 62, std::int64_t{1} << 33);
+  EXPECT_EQ(up.to_fixed_plus(kMin).raw(), 0);
+  EXPECT_EQ(up.to_fixed_plus(kMin + 5).raw(), 5);
+  EXPECT_EQ(up.to_fixed_plus(0), Fixed::max());
 }
 
 TEST(ProductSumPaths, RoundingNextToTheInt128Maximum) {

@@ -156,6 +156,13 @@ class ExactSum {
     return Fixed::from_raw(round_to_raw(Fixed::fraction_bits));
   }
 
+  /// base + sum / 2^32 rounded once to Fixed: to_fixed() of the sum with base * 2^32 added.
+  [[nodiscard]] constexpr Fixed to_fixed_plus(std::int64_t base) const noexcept {
+    ExactSum with_base = *this;
+    with_base.add_scaled(base, Fixed::fraction_bits);
+    return with_base.to_fixed();
+  }
+
  private:
   Words limb_{};
 };
@@ -174,6 +181,8 @@ class ExactSum {
 class NativeProductSum {
  public:
   using int128 = wide::int128_t;
+
+  constexpr NativeProductSum() noexcept = default;
 
   /// Adds m (or subtracts it when `negative`) for an unsigned 128-bit magnitude m.
   constexpr void add(bool negative, wide::U128 m) noexcept {
@@ -227,12 +236,39 @@ class NativeProductSum {
   [[nodiscard]] constexpr std::int64_t round_to_raw(unsigned shift) const noexcept {
     if (wraps_ == 0 && shift < 64) [[likely]]
       return round_shift_saturate(acc_, shift);
-    return round_exact(shift);
+    return round_exact(acc_, wraps_, shift);
   }
 
   /// The sum of Q64.64 terms rounded to Fixed.
   [[nodiscard]] constexpr Fixed to_fixed() const noexcept {
     return Fixed::from_raw(round_to_raw(Fixed::fraction_bits));
+  }
+
+  /// base + sum / 2^32 rounded once to Fixed, as ExactSum<3>::to_fixed_plus, without forming the
+  /// 128-bit term base * 2^32 (a fused multiply-add's addend). Its low 32 bits are zero, so bit 32
+  /// of the whole sum, the kept value's lowest bit that breaks a tie, is bit 0 of base xor bit 32
+  /// of acc_, and floor((base 2^32 + acc_ + bias) / 2^32) = base + floor((acc_ + bias) / 2^32) =
+  /// base + q. When q fits in 64 bits the result is base + q, saturated; other sums (q beyond
+  /// int64, which base can still bring back, or a wrapped acc_) take the exact path.
+  [[nodiscard, gnu::always_inline]] constexpr Fixed to_fixed_plus(
+      std::int64_t base) const noexcept {
+    if (wraps_ == 0) [[likely]] {
+      const auto low = static_cast<std::uint64_t>(acc_);
+      const std::uint64_t bias =
+          0x7FFFFFFFU + (((low >> 32) ^ static_cast<std::uint64_t>(base)) & 1U);
+      int128 w = 0;
+      if (!__builtin_add_overflow(acc_, static_cast<int128>(bias), &w)) [[likely]] {
+        const auto hi = static_cast<std::uint64_t>(w >> 64);
+        if (static_cast<std::int64_t>(hi << 32) >> 32 == static_cast<std::int64_t>(hi)) [[likely]] {
+          const auto q =
+              static_cast<std::int64_t>((static_cast<std::uint64_t>(w) >> 32) | (hi << 32));
+          std::int64_t sum = 0;
+          if (!__builtin_add_overflow(base, q, &sum)) return Fixed::from_raw(sum);
+          return q < 0 ? Fixed::min() : Fixed::max();  // base and q share the sign of the excess
+        }
+      }
+    }
+    return plus_exact(acc_, wraps_, base);
   }
 
   /// The same sum as an ExactSum<3> (the reference the fast path must agree with).
@@ -259,9 +295,20 @@ class NativeProductSum {
       wraps_ += term < 0 ? 1 : -1;
   }
 
-  [[gnu::cold, gnu::noinline]] constexpr std::int64_t round_exact(unsigned shift) const noexcept {
-    return exact().round_to_raw(shift);
+  // The rare paths take the sum by value: a member call would need the sum in memory, and the
+  // compiler would store every sum there on the fast path too.
+  [[gnu::cold, gnu::noinline]] static constexpr std::int64_t round_exact(int128 acc,
+                                                                         std::int64_t wraps,
+                                                                         unsigned shift) noexcept {
+    return NativeProductSum{acc, wraps}.exact().round_to_raw(shift);
   }
+
+  [[gnu::cold, gnu::noinline]] static constexpr Fixed plus_exact(int128 acc, std::int64_t wraps,
+                                                                 std::int64_t base) noexcept {
+    return NativeProductSum{acc, wraps}.exact().to_fixed_plus(base);
+  }
+
+  constexpr NativeProductSum(int128 acc, std::int64_t wraps) noexcept : acc_(acc), wraps_(wraps) {}
 
   int128 acc_ = 0;
   std::int64_t wraps_ = 0;

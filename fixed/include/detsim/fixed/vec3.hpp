@@ -120,11 +120,7 @@ class Vec3Sum {
  public:
   constexpr Vec3Sum() noexcept = default;
   /// Starts from v exactly.
-  explicit constexpr Vec3Sum(Vec3 v) noexcept {
-    x_.add_scaled(v.x.raw(), Fixed::fraction_bits);
-    y_.add_scaled(v.y.raw(), Fixed::fraction_bits);
-    z_.add_scaled(v.z.raw(), Fixed::fraction_bits);
-  }
+  explicit constexpr Vec3Sum(Vec3 v) noexcept : base_(v) {}
   /// Adds s d.
   constexpr Vec3Sum& add(Fixed s, Vec3 d) noexcept {
     x_.add_product(s.raw(), d.x.raw());
@@ -133,10 +129,12 @@ class Vec3Sum {
     return *this;
   }
   [[nodiscard, gnu::always_inline]] constexpr Vec3 result() const noexcept {
-    return {x_.to_fixed(), y_.to_fixed(), z_.to_fixed()};
+    return {x_.to_fixed_plus(base_.x.raw()), y_.to_fixed_plus(base_.y.raw()),
+            z_.to_fixed_plus(base_.z.raw())};
   }
 
  private:
+  Vec3 base_;  // kept apart from the products: rounding adds it without a 128-bit term
   detail::ProductSum x_;
   detail::ProductSum y_;
   detail::ProductSum z_;
