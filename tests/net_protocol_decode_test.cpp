@@ -176,9 +176,9 @@ TEST(NetProtocolDecode, BodyShorterOrLongerThanItsType) {
     if (s.packet.header.type == PacketType::input) continue;
     Bytes bytes;
     ASSERT_TRUE(encode(s.packet, s.input_size, bytes));
+    ASSERT_GT(bytes.size(), trailer_size);
     Bytes body(bytes.begin(), bytes.end() - static_cast<std::ptrdiff_t>(trailer_size));
-    Bytes shorter = body;
-    shorter.pop_back();
+    Bytes shorter(body.begin(), body.end() - 1);
     Bytes longer = body;
     longer.push_back(0);
     EXPECT_EQ(decode_bytes(Writer().raw(shorter).sealed(), s.input_size), DecodeError::bad_length)

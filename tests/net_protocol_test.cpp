@@ -420,9 +420,9 @@ TEST(NetProtocolRunLength, TokensAreTheShortest) {
   std::vector<Bytes> cases;
   for (std::size_t n = 1; n <= 12; ++n) {
     for (std::size_t bits = 0; bits < (std::size_t{1} << n); ++bits) {
-      Bytes b(n);
+      Bytes b;
       for (std::size_t i = 0; i < n; ++i)
-        b[i] = byte((bits >> i & 1U) != 0 ? 0x33 : 0);
+        b.push_back(byte((bits >> i & 1U) != 0 ? 0x33 : 0));
       cases.push_back(b);
     }
   }

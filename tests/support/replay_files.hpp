@@ -6,6 +6,7 @@
 #include <unistd.h>  // getpid
 #include <xxhash.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -105,11 +106,11 @@ inline void reseal(std::vector<std::uint8_t>& b, const ChunkAt& c) {
 /// A whole chunk's bytes with a valid checksum.
 inline std::vector<std::uint8_t> make_chunk(const char (&type)[5],
                                             const std::vector<std::uint8_t>& payload) {
-  std::vector<std::uint8_t> c(type, type + 4);
-  c.resize(8);
+  // Sized once: type, length, payload, checksum.
+  std::vector<std::uint8_t> c(8 + payload.size() + 8);
+  std::copy(type, type + 4, c.begin());
   put_u32(c, 4, static_cast<std::uint32_t>(payload.size()));
-  c.insert(c.end(), payload.begin(), payload.end());
-  c.resize(c.size() + 8);
+  std::copy(payload.begin(), payload.end(), c.begin() + 8);
   put_u64(c, 8 + payload.size(), XXH3_64bits(c.data(), 8 + payload.size()));
   return c;
 }
