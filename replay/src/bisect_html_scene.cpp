@@ -18,6 +18,7 @@
 #include <detsim/fixed/quat.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/replay/bisect.hpp>
+#include <detsim/sim/shape_outline.hpp>
 
 #include "bisect_html_detail.hpp"
 
@@ -54,9 +55,11 @@ struct Point {
   Fixed z;
 };
 
-/// A body's top-down footprint: a circle (centre a), a capsule (core a..b) or a polygon.
+/// A body's top-down footprint: a circle (centre a), a capsule (core a..b) or a polygon, drawn
+/// from its shape's outline (detsim/sim/shape_outline.hpp); a half-space is not drawn.
 struct Footprint {
-  ShapeType type = ShapeType::sphere;
+  enum class Kind : std::uint8_t { circle, capsule, polygon, half_space };
+  Kind type = Kind::circle;
   Point a;
   Point b;
   Fixed radius;
@@ -95,30 +98,30 @@ std::vector<Point> convex_hull(std::vector<Point> points) {
 }
 
 Footprint footprint(const ScenePose& body) {
+  const ShapeOutline outline = shape_outline(body.shape, body.position, body.orientation);
   Footprint f;
-  f.type = body.shape.type;
-  f.radius = body.shape.radius;
+  f.radius = outline.radius;
   f.a = top_down(body.position);
-  if (f.type == ShapeType::box) {
-    const Vec3 h = body.shape.half_extents;
-    std::vector<Point> corners;
-    for (const int i : {0, 1, 2, 3, 4, 5, 6, 7}) {
-      const Vec3 local{(i & 1) != 0 ? h.x : -h.x, (i & 2) != 0 ? h.y : -h.y,
-                       (i & 4) != 0 ? h.z : -h.z};
-      corners.push_back(top_down(body.position + rotate(body.orientation, local)));
-    }
-    f.polygon = convex_hull(std::move(corners));
-  } else if (f.type == ShapeType::capsule) {
-    const Vec3 axis = rotate(body.orientation, Vec3{Fixed{}, body.shape.half_height, Fixed{}});
-    f.a = top_down(body.position - axis);
-    f.b = top_down(body.position + axis);
+  if (outline.half_space) {
+    f.type = Footprint::Kind::half_space;
+  } else if (outline.points.size() == 2) {
+    f.type = Footprint::Kind::capsule;
+    f.a = top_down(outline.points[0]);
+    f.b = top_down(outline.points[1]);
     // Seen along its axis, a capsule is a circle (a core shorter than a thousandth of the radius
     // would only give the path a meaningless direction).
     const Fixed core = hypot(f.b.x - f.a.x, f.b.z - f.a.z);
     if (core == Fixed{} || core <= (f.radius >> 10)) {
-      f.type = ShapeType::sphere;
+      f.type = Footprint::Kind::circle;
       f.a = top_down(body.position);
     }
+  } else if (outline.points.size() > 2) {
+    // The hull's own radius (zero for a box) is too small to see at the plot's scale.
+    f.type = Footprint::Kind::polygon;
+    std::vector<Point> corners;
+    for (const Vec3 p : outline.points)
+      corners.push_back(top_down(p));
+    f.polygon = convex_hull(std::move(corners));
   }
   return f;
 }
@@ -137,8 +140,9 @@ struct Bounds {
 void add_bounds(Bounds& b, const Footprint& f) {
   for (const Point p : f.polygon)
     b.add(p, Fixed{});
-  if (f.type != ShapeType::box) b.add(f.a, f.radius);
-  if (f.type == ShapeType::capsule) b.add(f.b, f.radius);
+  if (f.type == Footprint::Kind::half_space) return;
+  if (f.type != Footprint::Kind::polygon) b.add(f.a, f.radius);
+  if (f.type == Footprint::Kind::capsule) b.add(f.b, f.radius);
 }
 
 std::string point(Point p) {
@@ -154,13 +158,13 @@ std::string body_svg(const ScenePose& body, const Footprint& f) {
   const std::string title = "<title>body " + std::to_string(body.id) + " (" +
                             dec3(body.position.x) + ", " + dec3(body.position.z) + ")</title>";
   switch (f.type) {
-    case ShapeType::box: {
+    case Footprint::Kind::polygon: {
       std::string points;
       for (const Point p : f.polygon)
         points.append(points.empty() ? "" : " ").append(point(p));
       return "<polygon " + cls + " points=\"" + points + "\">" + title + "</polygon>";
     }
-    case ShapeType::capsule: {
+    case Footprint::Kind::capsule: {
       // The core segment offset by +-radius along its normal, joined by two half circles.
       const Fixed dx = f.b.x - f.a.x, dz = f.b.z - f.a.z, length = hypot(dx, dz);
       const Point n{-(dz / length) * f.radius, (dx / length) * f.radius};
@@ -188,7 +192,7 @@ void scene_panel(std::string& out, const std::string& caption, const std::vector
   for (const bool highlighted : {false, true}) {  // differing bodies on top
     for (std::size_t i = 0; i < scene.size(); ++i) {
       if (scene[i].differs != highlighted) continue;
-      if (scene[i].shape.type == ShapeType::plane) {
+      if (prints[i].type == Footprint::Kind::half_space) {
         ++planes;
         continue;
       }
@@ -216,7 +220,7 @@ void scene_section(std::string& out, const BisectResult& r) {
   for (const auto& [scene, prints] : {std::pair{&r.scene_a, &prints_a}, {&r.scene_b, &prints_b}}) {
     for (const ScenePose& body : *scene) {
       prints->push_back(footprint(body));
-      if (body.shape.type != ShapeType::plane) add_bounds(view, prints->back());
+      add_bounds(view, prints->back());
     }
   }
   if (view.empty()) view.add({}, Fixed::from_int(10));

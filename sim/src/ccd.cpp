@@ -20,6 +20,7 @@
 #include <detsim/fixed/math.hpp>
 #include <detsim/fixed/quat.hpp>
 
+#include "shapes.hpp"
 #include "world_state.hpp"
 
 namespace detsim::sim_detail {
@@ -27,19 +28,6 @@ namespace detsim::sim_detail {
 namespace {
 
 constexpr int max_iterations = 24;
-
-Fixed smallest_dimension(const Shape& shape) {
-  switch (shape.type) {
-    case ShapeType::sphere:
-    case ShapeType::capsule:
-      return shape.radius;
-    case ShapeType::box:
-      return min(shape.half_extents.x, min(shape.half_extents.y, shape.half_extents.z));
-    case ShapeType::plane:
-      break;
-  }
-  return Fixed::zero();
-}
 
 // An upper bound of the rotation angle (radians) between two unit quaternions, taken the shorter
 // way. With c = |q1 - q0| (sign of q1 matched, so c <= sqrt 2), the angle is 4 asin(c / 2), and
@@ -100,7 +88,8 @@ void continuous(WorldState& s) {
     const Derived& d = s.derived[i];
     const Vec3 travel = body.position - d.start_position;
     const Fixed distance_moved = length(travel);
-    const bool fast = distance_moved > smallest_dimension(body.shape) / Fixed::from_int(2);
+    const bool fast = distance_moved > shape_kind(body.shape.type).smallest_dimension(body.shape) /
+                                           Fixed::from_int(2);
     if (!body.ccd && !fast) continue;
     const Sweep sweep{d.start_position, body.position, d.start_orientation, body.orientation,
                       body.orientation != d.start_orientation};
@@ -130,7 +119,7 @@ void continuous(WorldState& s) {
       if (other.sensor) continue;
       if ((body.layer & other.mask) == 0 || (other.layer & body.mask) == 0) continue;
       const Pose other_pose{other.position, to_mat3(other.orientation)};
-      if (other.shape.type != ShapeType::plane) {
+      if (shape_kind(other.shape.type).bounded) {
         const Fixed o = bounding_radius(other.shape);
         const Vec3 oo{o, o, o};
         if (!box_overlap(sweep_min, sweep_max, other.position - oo, other.position + oo)) continue;

@@ -1,11 +1,13 @@
-// Narrowphase dispatcher and the pairs with a round shape: sphere-sphere, sphere-box,
-// sphere-capsule, sphere-plane, capsule-capsule, capsule-plane and box-capsule (the capsule's core
-// segment against the box).
+// Narrowphase dispatch (one table row per pair of shape types) and the pairs with a round shape:
+// sphere-sphere, sphere-box, sphere-capsule, sphere-plane, capsule-capsule, capsule-plane and
+// box-capsule (the capsule's core segment against the box).
 //
 // Precision: every pair works in coordinates relative to one of the bodies, so positions of up to
 // ~10^4 m only enter through one exact subtraction, and every quantity after that is bounded by
 // the shapes' sizes. Distances come from length() (correctly rounded, no intermediate overflow);
 // projections from dot() (exact products, one rounding).
+#include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include <detsim/fixed/math.hpp>
@@ -498,65 +500,69 @@ namespace {
 
 using namespace narrow;
 
-bool known(ShapeType t) noexcept {
-  return t == ShapeType::sphere || t == ShapeType::box || t == ShapeType::capsule ||
-         t == ShapeType::plane;
-}
+using PairFunction = Manifold (*)(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb,
+                                  Fixed margin) noexcept;
 
-/// a.type <= b.type.
-Manifold collide_ordered(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb,
-                         Fixed margin) noexcept {
-  switch (a.type) {
-    case ShapeType::sphere:
-      switch (b.type) {
-        case ShapeType::sphere:
-          return sphere_sphere(a, pa, b, pb, margin);
-        case ShapeType::box:
-          return sphere_box(a, pa, b, pb, margin);
-        case ShapeType::capsule:
-          return sphere_capsule(a, pa, b, pb, margin);
-        case ShapeType::plane:
-          return sphere_plane(a, pa, b, pb, margin);
-      }
-      break;
-    case ShapeType::box:
-      switch (b.type) {
-        case ShapeType::box:
-          return box_box(a, pa, b, pb, margin);
-        case ShapeType::capsule:
-          return box_capsule(a, pa, b, pb, margin);
-        case ShapeType::plane:
-          return box_plane(a, pa, b, pb, margin);
-        case ShapeType::sphere:
-          break;
-      }
-      break;
-    case ShapeType::capsule:
-      switch (b.type) {
-        case ShapeType::capsule:
-          return capsule_capsule(a, pa, b, pb, margin);
-        case ShapeType::plane:
-          return capsule_plane(a, pa, b, pb, margin);
-        case ShapeType::sphere:
-        case ShapeType::box:
-          break;
-      }
-      break;
-    case ShapeType::plane:
-      break;  // two half-spaces: no manifold (planes are static)
+/// One row per pair of shape types that can touch, with a.type <= b.type: a new shape type adds
+/// its rows here (and its pair functions). Pairs without a row have no manifold: two planes, which
+/// are static and unbounded.
+struct PairRow {
+  ShapeType a;
+  ShapeType b;
+  PairFunction collide;
+};
+
+constexpr PairRow kPairs[] = {
+    {ShapeType::sphere, ShapeType::sphere, sphere_sphere},
+    {ShapeType::sphere, ShapeType::box, sphere_box},
+    {ShapeType::sphere, ShapeType::capsule, sphere_capsule},
+    {ShapeType::sphere, ShapeType::plane, sphere_plane},
+    {ShapeType::box, ShapeType::box, box_box},
+    {ShapeType::box, ShapeType::capsule, box_capsule},
+    {ShapeType::box, ShapeType::plane, box_plane},
+    {ShapeType::capsule, ShapeType::capsule, capsule_capsule},
+    {ShapeType::capsule, ShapeType::plane, capsule_plane},
+};
+
+/// kPairs as a table indexed by the two type values, which stay below kTypeLimit.
+constexpr std::size_t kTypeLimit = 16;
+
+constexpr bool types_in_range() {
+  for (const PairRow& row : kPairs) {
+    if (static_cast<std::size_t>(row.a) >= kTypeLimit ||
+        static_cast<std::size_t>(row.b) >= kTypeLimit)
+      return false;
   }
-  return {};
+  return true;
 }
+static_assert(types_in_range(), "raise kTypeLimit");
+
+struct PairTable {
+  std::array<std::array<PairFunction, kTypeLimit>, kTypeLimit> at{};
+  constexpr PairTable() {
+    for (const PairRow& row : kPairs)
+      at[static_cast<std::size_t>(row.a)][static_cast<std::size_t>(row.b)] = row.collide;
+  }
+};
+
+constexpr PairTable kPairTable;
 
 }  // namespace
 
 Manifold collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
                  Fixed margin) noexcept {
-  if (!known(a.type) || !known(b.type)) return {};
-  if (a.type <= b.type) return collide_ordered(a, pose_a, b, pose_b, margin);
+  const auto ta = static_cast<std::size_t>(a.type);
+  const auto tb = static_cast<std::size_t>(b.type);
+  if (ta >= kTypeLimit || tb >= kTypeLimit) return {};
+  if (ta <= tb) {
+    const PairFunction f = kPairTable.at[ta][tb];
+    return f != nullptr ? f(a, pose_a, b, pose_b, margin) : Manifold{};
+  }
   // The pair function sees (b, a): mirror its manifold. Points and separations are symmetric; the
   // normal flips and each feature ID swaps its halves, so the low half still names a's feature.
-  Manifold m = collide_ordered(b, pose_b, a, pose_a, margin);
+  const PairFunction f = kPairTable.at[tb][ta];
+  if (f == nullptr) return {};
+  Manifold m = f(b, pose_b, a, pose_a, margin);
   m.normal = -m.normal;
   for (std::uint8_t i = 0; i < m.count; ++i) {
     m.points[i].feature = mirror_feature(m.points[i].feature);

@@ -97,20 +97,6 @@ UnionFind islands(const WorldState& s) {
 
 }  // namespace
 
-Fixed bounding_radius(const Shape& shape) noexcept {
-  switch (shape.type) {
-    case ShapeType::sphere:
-      return shape.radius;
-    case ShapeType::box:
-      return length(shape.half_extents);
-    case ShapeType::capsule:
-      return shape.radius + shape.half_height;
-    case ShapeType::plane:
-      break;
-  }
-  return Fixed::zero();
-}
-
 void collide_contacts(WorldState& s) {
   for (Contact& c : s.contacts) {
     const std::size_t ia = c.index_a;

@@ -10,6 +10,7 @@
 #include <detsim/fixed/decimal.hpp>
 #include <detsim/fixed/quat.hpp>
 
+#include "shapes.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
@@ -179,9 +180,10 @@ Status change_body(BodyState& b, const Target& t, std::string_view delta) {
 }
 
 Status add_copy(World& world, const BodyState& of) {
-  if (of.shape.type == ShapeType::plane)
-    return Status::error("body " + std::to_string(of.id.value) +
-                         " is a plane: a copy above it would still touch everything");
+  if (!sim_detail::shape_kind(of.shape.type).bounded)
+    return Status::error("body " + std::to_string(of.id.value) + " is a " +
+                         sim_detail::shape_kind(of.shape.type).name +
+                         ": a copy above it would still touch everything");
   BodyDef def;
   def.type = BodyType::static_body;
   def.shape = of.shape;

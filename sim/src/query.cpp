@@ -23,17 +23,16 @@
 
 #include "collide.hpp"
 #include "collide_util.hpp"
+#include "shapes.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
 
 namespace {
 
+using sim_detail::bounding_radius;
 using sim_detail::Manifold;
 using sim_detail::Pose;
-using sim_detail::narrow::axis_vector;
-using sim_detail::narrow::component;
-using sim_detail::narrow::set_component;
 using sim_detail::narrow::to_local;
 
 bool passes(const BodyState& b, const QueryFilter& f) noexcept {
@@ -44,178 +43,11 @@ Pose pose_of(const BodyState& b) noexcept {
   return {b.position, to_mat3(b.orientation)};
 }
 
-/// Radius of a sphere about the body's origin that holds the whole shape (planes have none and
-/// are never asked). At most ~2e4 m for shapes check_shape accepts.
-Fixed bounding_radius(const Shape& s) noexcept {
-  switch (s.type) {
-    case ShapeType::sphere:
-      return s.radius;
-    case ShapeType::box:
-      return length(s.half_extents);
-    case ShapeType::capsule:
-      return s.half_height + s.radius;
-    case ShapeType::plane:
-      break;
-  }
-  return Fixed::max();
-}
-
 /// A cull must never reject what the exact test would accept. The exact tests see the same
 /// quantities after a few more roundings of at most a few ulps of the shape's size plus 2^-32 of
 /// the distance travelled; 2^-10 m plus 2^-24 of the distance is far above both and still tight.
 Fixed cull_slack(Fixed distance) noexcept {
   return Fixed::from_raw(Fixed::one_raw >> 10) + (abs(distance) >> 24);
-}
-
-// ---- Rays in a shape's frame
-// ----------------------------------------------------------------------
-//
-// A local ray is p + v t for t >= 0: p the origin in the shape's frame (outside the shape: the
-// caller has tested containment first), v a unit direction. The functions return the first t at
-// which the ray meets the closed shape, with the point and the outward normal there (shape frame).
-
-struct LocalHit {
-  Fixed t;
-  Vec3 point;
-  Vec3 normal;
-};
-
-/// Where the ray enters the ball of radius r about the origin, for p outside it. The closest
-/// approach is found first and the half chord taken from the perpendicular distance (never from
-/// |p|^2 - r^2, which loses everything to cancellation when the ray passes far from the centre).
-std::optional<Fixed> enter_ball(Vec3 p, Vec3 v, Fixed r) noexcept {
-  if (length(p) <= r) return std::nullopt;  // an origin inside has no entry
-  const Fixed along = -dot(p, v);           // t of the closest approach
-  // From outside a ball, moving away from its centre never reaches it.
-  if (along < Fixed::zero()) return std::nullopt;
-  const Fixed r2 = r * r;
-  const Fixed d2 = length_squared(p + v * along);
-  if (d2 > r2) return std::nullopt;
-  // Grazing (d2 == r2) enters at the closest approach. Rounding cannot make an outside origin
-  // enter behind itself: the entry is at least 0.
-  return max(along - sqrt(r2 - d2), Fixed::zero());
-}
-
-std::optional<LocalHit> ray_sphere(Vec3 p, Vec3 v, Fixed r) noexcept {
-  const auto t = enter_ball(p, v, r);
-  if (!t) return std::nullopt;
-  const Vec3 q = p + v * *t;
-  return LocalHit{*t, q, normalize_or(q, -v)};
-}
-
-/// Slabs (Kay and Kajiya): the ray is inside the box for t in [max of the entries, min of the
-/// exits] over the three axes. The entry face is the axis of the largest entry, ties to the lower
-/// axis. A ray parallel to a slab (v_i == 0 exactly) is inside it for every t or for none; tiny
-/// nonzero v_i need no special case, as the quotients saturate to +-max() like infinities.
-std::optional<LocalHit> ray_box(Vec3 p, Vec3 v, Vec3 h) noexcept {
-  Fixed enter = Fixed::min();
-  Fixed exit = Fixed::max();
-  int face_axis = 0;
-  for (int i = 0; i < 3; ++i) {
-    const Fixed pi = component(p, i);
-    const Fixed vi = component(v, i);
-    const Fixed hi = component(h, i);
-    if (vi == Fixed::zero()) {
-      if (abs(pi) > hi) return std::nullopt;
-      continue;
-    }
-    const bool increasing = vi > Fixed::zero();
-    const Fixed near = ((increasing ? -hi : hi) - pi) / vi;
-    const Fixed far = ((increasing ? hi : -hi) - pi) / vi;
-    if (near > enter) {
-      enter = near;
-      face_axis = i;
-    }
-    exit = min(exit, far);
-  }
-  // The box is behind the ray (exit < 0) or beside it (enter > exit). Otherwise, as p is outside,
-  // the entry is >= 0 in exact arithmetic; the clamp only guards against rounding.
-  if (exit < Fixed::zero() || enter > exit) return std::nullopt;
-  enter = max(enter, Fixed::zero());
-  Vec3 q = p + v * enter;
-  for (int i = 0; i < 3; ++i) {
-    const Fixed hi = component(h, i);
-    set_component(q, i, clamp(component(q, i), -hi, hi));  // rounding may step off the surface
-  }
-  const bool entering_positive_face = component(v, face_axis) < Fixed::zero();
-  const Fixed hf = component(h, face_axis);
-  set_component(q, face_axis, entering_positive_face ? hf : -hf);  // exactly on the face
-  return LocalHit{enter, q, axis_vector(face_axis, entering_positive_face)};
-}
-
-/// A capsule is the union of its two end balls and the cylinder between them, and the first entry
-/// into a union is the earliest entry into any piece. The cylinder's flat ends lie inside the
-/// balls, so only its side needs testing: a 2D ball test in the xz plane, valid when the hit is
-/// within the core's height. Candidates are taken side, bottom, top, each replacing only an
-/// earlier one strictly: ties at the seams go the same way everywhere. half_height == 0 gives two
-/// equal balls and a side of zero height: a sphere.
-std::optional<LocalHit> ray_capsule(Vec3 p, Vec3 v, Fixed r, Fixed half_height) noexcept {
-  std::optional<LocalHit> best;
-  const Vec3 p2{p.x, Fixed::zero(), p.z};
-  const Vec3 v2{v.x, Fixed::zero(), v.z};
-  const Fixed speed2 = length(v2);  // of the ray across the axis, per unit of t
-  if (speed2 > Fixed::zero()) {
-    // The 2D test runs with a unit direction so that its numbers stay those of the capsule's
-    // size; s / speed2 converts its distance back to t (saturating for rays nearly along the
-    // axis, whose side hits, if any, are then beyond any height and rejected below).
-    if (const auto s = enter_ball(p2, normalize(v2), r)) {
-      const Fixed t = *s / speed2;
-      const Fixed y = p.y + v.y * t;
-      if (y >= -half_height && y <= half_height) {
-        const Vec3 q = p + v * t;
-        best = LocalHit{t, q, normalize_or(Vec3{q.x, Fixed::zero(), q.z}, -v2)};
-      }
-    }
-  }
-  for (const bool top : {false, true}) {
-    const Vec3 centre{Fixed::zero(), top ? half_height : -half_height, Fixed::zero()};
-    const auto hit = ray_sphere(p - centre, v, r);
-    if (hit && (!best || hit->t < best->t))
-      best = LocalHit{hit->t, hit->point + centre, hit->normal};
-  }
-  return best;
-}
-
-/// The solid half-space y <= 0.
-std::optional<LocalHit> ray_plane(Vec3 p, Vec3 v) noexcept {
-  if (v.y >= Fixed::zero()) return std::nullopt;  // parallel or leaving
-  const Fixed t = p.y / -v.y;                     // saturates for nearly parallel rays
-  Vec3 q = p + v * t;
-  q.y = Fixed::zero();
-  return LocalHit{t, q, Vec3::unit_y()};
-}
-
-std::optional<LocalHit> ray_shape(const Shape& s, Vec3 p, Vec3 v) noexcept {
-  switch (s.type) {
-    case ShapeType::sphere:
-      return ray_sphere(p, v, s.radius);
-    case ShapeType::box:
-      return ray_box(p, v, s.half_extents);
-    case ShapeType::capsule:
-      return ray_capsule(p, v, s.radius, s.half_height);
-    case ShapeType::plane:
-      return ray_plane(p, v);
-  }
-  return std::nullopt;
-}
-
-/// Whether the closed shape contains the point p of its frame (surfaces included, as overlap()
-/// counts touching as overlapping).
-bool contains(const Shape& s, Vec3 p) noexcept {
-  switch (s.type) {
-    case ShapeType::sphere:
-      return length(p) <= s.radius;
-    case ShapeType::box:
-      return abs(p.x) <= s.half_extents.x && abs(p.y) <= s.half_extents.y &&
-             abs(p.z) <= s.half_extents.z;
-    case ShapeType::capsule: {
-      const Fixed y = clamp(p.y, -s.half_height, s.half_height);
-      return length(Vec3{p.x, p.y - y, p.z}) <= s.radius;
-    }
-    case ShapeType::plane:
-      return p.y <= Fixed::zero();
-  }
-  return false;
 }
 
 struct Ray {
@@ -231,10 +63,11 @@ Ray make_ray(Vec3 origin, Vec3 translation) noexcept {
 /// The ray against one body: the bounding-sphere cull, the containment test, then the exact test
 /// on a ray restarted at t0 (see the file comment).
 std::optional<RayHit> cast_body(const BodyState& b, const Ray& ray) noexcept {
+  const sim_detail::ShapeKind& kind = sim_detail::shape_kind(b.shape.type);
   const Mat3 rotation = to_mat3(b.orientation);
   const Vec3 offset = b.position - ray.origin;
   Fixed t0 = Fixed::zero();
-  if (b.shape.type != ShapeType::plane) {
+  if (kind.bounded) {
     const Fixed bound = bounding_radius(b.shape);
     const Fixed along = dot(offset, ray.direction);
     const Fixed nearest = clamp(along, Fixed::zero(), ray.length);
@@ -244,11 +77,11 @@ std::optional<RayHit> cast_body(const BodyState& b, const Ray& ray) noexcept {
     t0 = max(along - bound - Fixed::one(), Fixed::zero());
   }
   const Vec3 p = to_local(rotation, ray.direction * t0 - offset);
-  if (t0 == Fixed::zero() && contains(b.shape, p)) {
+  if (t0 == Fixed::zero() && kind.contains(b.shape, p)) {
     return RayHit{b.id, ray.origin, Vec3::zero(), Fixed::zero()};
   }
   if (ray.length == Fixed::zero()) return std::nullopt;  // a point: only containment can hit
-  const auto hit = ray_shape(b.shape, p, to_local(rotation, ray.direction));
+  const auto hit = kind.ray(b.shape, p, to_local(rotation, ray.direction));
   if (!hit || hit->t > ray.length - t0) return std::nullopt;
   const Fixed t = t0 + hit->t;
   return RayHit{b.id, b.position + rotation * hit->point,
@@ -308,7 +141,7 @@ std::vector<BodyId> World::overlap(const Shape& shape, Vec3 position, Quat orien
   const Fixed reach = bounding_radius(shape);
   for (const BodyState& b : s_->bodies) {
     if (!passes(b, filter)) continue;
-    if (b.shape.type != ShapeType::plane) {
+    if (sim_detail::shape_kind(b.shape.type).bounded) {
       const Fixed gap = distance(b.position, position);
       if (gap > reach + bounding_radius(b.shape) + cull_slack(gap)) continue;
     }

@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "shapes.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
@@ -86,42 +87,28 @@ WorldDef read_def(ByteReader& r) {
   return d;
 }
 
+// A shape: its type, then the fields its kind writes (shapes.hpp).
 void write_shape(const Shape& s, ByteWriter& w) {
   w.u8(static_cast<std::uint8_t>(s.type));
-  switch (s.type) {
-    case ShapeType::sphere:
-      w.var_fixed(s.radius);
-      break;
-    case ShapeType::box:
-      w.var_vec3(s.half_extents);
-      break;
-    case ShapeType::capsule:
-      w.var_fixed(s.radius);
-      w.var_fixed(s.half_height);
-      break;
-    case ShapeType::plane:
-      break;
-  }
+  shape_kind(s.type).write(s, w);
 }
 
 Shape read_shape(ByteReader& r) {
   const std::size_t type_at = r.offset();
   const std::uint8_t type = r.u8("shape type");
-  switch (type) {
-    case static_cast<std::uint8_t>(ShapeType::sphere):
-      return Shape::sphere(r.var_fixed("sphere radius"));
-    case static_cast<std::uint8_t>(ShapeType::box):
-      return Shape::box(r.var_vec3("box half extents"));
-    case static_cast<std::uint8_t>(ShapeType::capsule): {
-      const Fixed radius = r.var_fixed("capsule radius");
-      return Shape::capsule(radius, r.var_fixed("capsule half height"));
+  if (const ShapeKind* kind = find_shape_kind(static_cast<ShapeType>(type))) return kind->read(r);
+  // The reader keeps the pointer: "1 (sphere), 2 (box), 3 (capsule) or 4 (plane)", built once.
+  static const std::string expected = [] {
+    std::string list;
+    const auto kinds = shape_kinds();
+    for (std::size_t i = 0; i < kinds.size(); ++i) {
+      if (i > 0) list += i + 1 == kinds.size() ? " or " : ", ";
+      list += std::to_string(static_cast<unsigned>(kinds[i]->type)) + " (" + kinds[i]->name + ")";
     }
-    case static_cast<std::uint8_t>(ShapeType::plane):
-      return Shape::plane();
-    default:
-      r.fail_at(type_at, "shape type", "1 (sphere), 2 (box), 3 (capsule) or 4 (plane)");
-      return {};
-  }
+    return list;
+  }();
+  r.fail_at(type_at, "shape type", expected.c_str());
+  return {};
 }
 
 // ---- Property sets: what a body has that the simulation never changes by itself ----

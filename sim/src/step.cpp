@@ -1,6 +1,7 @@
 // World::step: a short orchestrator of named stages (docs/SIM.md describes each).
 #include <detsim/fixed/math.hpp>
 
+#include "shapes.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
@@ -25,32 +26,6 @@ void World::step() {
 
 namespace sim_detail {
 
-namespace {
-
-// Half extents of the world-space bounding box of `shape` under `rotation`.
-Vec3 aabb_extent(const Shape& shape, const Mat3& r) {
-  switch (shape.type) {
-    case ShapeType::sphere:
-      return {shape.radius, shape.radius, shape.radius};
-    case ShapeType::box: {
-      const Vec3 h = shape.half_extents;
-      const auto row = [&h](Vec3 m) { return abs(m.x) * h.x + abs(m.y) * h.y + abs(m.z) * h.z; };
-      return {row(r.rows[0]), row(r.rows[1]), row(r.rows[2])};
-    }
-    case ShapeType::capsule: {
-      const Vec3 axis = r.column(1);  // the core segment's direction
-      const Fixed h = shape.half_height;
-      return {abs(axis.x) * h + shape.radius, abs(axis.y) * h + shape.radius,
-              abs(axis.z) * h + shape.radius};
-    }
-    case ShapeType::plane:
-      break;
-  }
-  return {};
-}
-
-}  // namespace
-
 void prepare_bodies(WorldState& s) {
   s.derived.resize(s.bodies.size());
   for (std::size_t i = 0; i < s.bodies.size(); ++i)
@@ -70,12 +45,13 @@ void prepare_body(WorldState& s, std::size_t i) {
                                                               inverse_or_zero(b.inertia.y),
                                                               inverse_or_zero(b.inertia.z)))
              : Mat3::zero();
-  d.infinite = b.shape.type == ShapeType::plane;
+  const ShapeKind& shape = shape_kind(b.shape.type);
+  d.infinite = !shape.bounded;
   // length(0) * r is exactly 0: most bodies at rest skip the two square roots.
   d.rim_speed = b.angular_velocity == Vec3{}
                     ? Fixed::zero()
-                    : length(b.angular_velocity) * bounding_radius(b.shape);
-  const Vec3 e = aabb_extent(b.shape, d.pose.rotation) + margin;
+                    : length(b.angular_velocity) * shape.bounding_radius(b.shape);
+  const Vec3 e = shape.aabb_extent(b.shape, d.pose.rotation) + margin;
   d.aabb_min = b.position - e;
   d.aabb_max = b.position + e;
   // A moving body's box also covers where its velocity takes it this step, so that speculative

@@ -13,17 +13,8 @@ std::string str(Fixed x) {
   return to_string(x);
 }
 
-// The largest size the simulation accepts: bounding boxes and products of lengths stay far from
-// the Fixed range (2^31).
-constexpr Fixed kMaxSize = Fixed::from_int(10000);
 // A unit quaternion must be this close: | |q|^2 - 1 | <= 2^-20.
 constexpr Fixed kUnitTolerance = Fixed::from_raw(Fixed::one_raw >> 20);
-
-std::string positive(const char* what, Fixed x) {
-  if (x <= Fixed::zero()) return std::string(what) + " must be > 0, got " + str(x);
-  if (x > kMaxSize) return std::string(what) + " must be <= 10000, got " + str(x);
-  return {};
-}
 
 std::string non_negative(const char* what, Fixed x) {
   if (x < Fixed::zero()) return std::string(what) + " must be >= 0, got " + str(x);
@@ -38,28 +29,6 @@ std::string check_orientation(Quat q) {
     return "orientation must be a unit quaternion (|q|^2 within 2^-20 of 1), got |q|^2 = " +
            str(l2);
   return {};
-}
-
-std::string check_shape(const Shape& shape, BodyType type) {
-  switch (shape.type) {
-    case ShapeType::sphere:
-      return positive("sphere radius", shape.radius);
-    case ShapeType::box: {
-      if (auto e = positive("box half extent x", shape.half_extents.x); !e.empty()) return e;
-      if (auto e = positive("box half extent y", shape.half_extents.y); !e.empty()) return e;
-      return positive("box half extent z", shape.half_extents.z);
-    }
-    case ShapeType::capsule: {
-      if (auto e = positive("capsule radius", shape.radius); !e.empty()) return e;
-      if (auto e = non_negative("capsule half height", shape.half_height); !e.empty()) return e;
-      if (shape.half_height > kMaxSize) return "capsule half height must be <= 10000";
-      return {};
-    }
-    case ShapeType::plane:
-      if (type != BodyType::static_body) return "a plane shape needs a static body";
-      return {};
-  }
-  return "unknown shape type " + std::to_string(static_cast<unsigned>(shape.type));
 }
 
 std::string check_body_def(const BodyDef& def) {

@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "shapes.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
@@ -206,8 +207,10 @@ Status World::set_type(BodyId id, BodyType type) {
   return with_body(*s_, id, true, [&](BodyState& b) {
     if (type != BodyType::static_body && type != BodyType::kinematic && type != BodyType::dynamic)
       return Status::error("unknown body type " + std::to_string(static_cast<unsigned>(type)));
-    if (b.shape.type == ShapeType::plane && type != BodyType::static_body)
-      return Status::error("body " + std::to_string(id.value) + " is a plane: it must stay static");
+    const sim_detail::ShapeKind& shape = sim_detail::shape_kind(b.shape.type);
+    if (shape.static_only && type != BodyType::static_body)
+      return Status::error("body " + std::to_string(id.value) + " is a " + shape.name +
+                           ": it must stay static");
     if (type == BodyType::dynamic && b.mass <= Fixed::zero())
       return Status::error("body " + std::to_string(id.value) +
                            " has no mass (it was created with zero mass and density)");

@@ -100,9 +100,6 @@ struct WorldState {
 
 /// Mass and inertia of a body of this definition (what it has whenever it is dynamic).
 [[nodiscard]] MassProperties body_mass(const BodyDef& def) noexcept;
-/// A radius about the body's origin that bounds the shape (0 for a plane, which has no extent that
-/// turns with it).
-[[nodiscard]] Fixed bounding_radius(const Shape& shape) noexcept;
 /// 1 / x for x > 0, else 0.
 [[nodiscard]] Fixed inverse_or_zero(Fixed x) noexcept;
 

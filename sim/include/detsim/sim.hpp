@@ -9,6 +9,7 @@
 #include <detsim/sim/rng.hpp>
 #include <detsim/sim/scenario.hpp>
 #include <detsim/sim/shape.hpp>
+#include <detsim/sim/shape_outline.hpp>
 #include <detsim/sim/state_diff.hpp>
 #include <detsim/sim/status.hpp>
 #include <detsim/sim/world.hpp>

@@ -1,0 +1,68 @@
+// The table of shape kinds (shapes.hpp), and the library's shape functions that go through it:
+// the checks, the public mass properties and outlines.
+#include <array>
+
+#include <detsim/fixed/decimal.hpp>
+
+#include "shapes.hpp"
+#include "world_state.hpp"
+
+namespace detsim {
+
+namespace sim_detail {
+
+namespace {
+
+/// Every kind, ascending by type: a new shape type is a row here.
+constexpr std::array<const ShapeKind*, 4> kKinds = {&sphere_kind, &box_kind, &capsule_kind,
+                                                    &plane_kind};
+
+}  // namespace
+
+std::span<const ShapeKind* const> shape_kinds() noexcept {
+  return kKinds;
+}
+
+const ShapeKind* find_shape_kind(ShapeType t) noexcept {
+  for (const ShapeKind* kind : kKinds) {
+    if (kind->type == t) return kind;
+  }
+  return nullptr;
+}
+
+std::string check_positive_size(const char* what, Fixed x) {
+  if (x <= Fixed::zero()) return std::string(what) + " must be > 0, got " + to_string(x);
+  if (x > max_shape_size) return std::string(what) + " must be <= 10000, got " + to_string(x);
+  return {};
+}
+
+std::string check_shape(const Shape& shape, BodyType type) {
+  const ShapeKind* kind = find_shape_kind(shape.type);
+  if (kind == nullptr)
+    return "unknown shape type " + std::to_string(static_cast<unsigned>(shape.type));
+  if (kind->static_only && type != BodyType::static_body)
+    return std::string("a ") + kind->name + " shape needs a static body";
+  return kind->check(shape);
+}
+
+}  // namespace sim_detail
+
+Fixed volume(const Shape& shape) noexcept {
+  const sim_detail::ShapeKind* kind = sim_detail::find_shape_kind(shape.type);
+  return kind != nullptr ? kind->volume(shape) : Fixed::zero();
+}
+
+MassProperties mass_properties(const Shape& shape, Fixed mass) noexcept {
+  if (mass <= Fixed::zero()) return {};
+  const sim_detail::ShapeKind* kind = sim_detail::find_shape_kind(shape.type);
+  return kind != nullptr ? kind->mass_properties(shape, mass) : MassProperties{};
+}
+
+ShapeOutline shape_outline(const Shape& shape, Vec3 position, Quat orientation) {
+  ShapeOutline out;
+  if (const sim_detail::ShapeKind* kind = sim_detail::find_shape_kind(shape.type))
+    kind->outline(shape, position, orientation, out);
+  return out;
+}
+
+}  // namespace detsim

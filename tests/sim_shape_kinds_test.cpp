@@ -1,0 +1,219 @@
+// The table of shape kinds (sim/src/shapes.hpp): one kind per ShapeType, and the contract every
+// kind keeps. A new shape type gets these checks by adding its examples to `examples` below; the
+// contract tests then hold it to the same geometry as the others (derived from what each function
+// promises, never from a recorded run).
+#include <set>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <detsim/detsim.hpp>
+
+#include "sim/src/shapes.hpp"
+
+namespace detsim {
+namespace {
+
+using namespace detsim::literals;
+using sim_detail::find_shape_kind;
+using sim_detail::shape_kinds;
+using sim_detail::ShapeKind;
+
+// Shapes of each type that a body may have, from small and flat to long.
+std::vector<Shape> examples(ShapeType type) {
+  switch (type) {
+    case ShapeType::sphere:
+      return {Shape::sphere(0.5_fx), Shape::sphere(0.01_fx), Shape::sphere(7_fx)};
+    case ShapeType::box:
+      return {Shape::box({0.5_fx, 0.5_fx, 0.5_fx}), Shape::box({2_fx, 0.1_fx, 0.7_fx})};
+    case ShapeType::capsule:
+      return {Shape::capsule(0.3_fx, 1_fx), Shape::capsule(0.5_fx, 0_fx)};
+    case ShapeType::plane:
+      return {Shape::plane()};
+  }
+  ADD_FAILURE() << "no examples of shape type " << static_cast<unsigned>(type)
+                << ": add them to examples() in this file";
+  return {};
+}
+
+TEST(ShapeKinds, EveryShapeTypeHasExactlyOneKind) {
+  std::set<std::string> names;
+  unsigned previous = 0;
+  for (const ShapeKind* kind : shape_kinds()) {
+    const auto type = static_cast<unsigned>(kind->type);
+    EXPECT_GT(type, previous) << "kinds must be listed ascending by type";
+    previous = type;
+    EXPECT_TRUE(names.insert(kind->name).second) << "two kinds are called " << kind->name;
+    EXPECT_EQ(find_shape_kind(kind->type), kind);
+  }
+  // Every value that names no kind is refused everywhere a shape is taken.
+  std::size_t found = 0;
+  for (unsigned v = 0; v < 256; ++v) {
+    if (find_shape_kind(static_cast<ShapeType>(v)) != nullptr) ++found;
+  }
+  EXPECT_EQ(found, shape_kinds().size());
+  BodyDef def;
+  def.shape.type = static_cast<ShapeType>(200);
+  auto world = World::create({}).value();
+  const auto refused = world.create_body(def);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("unknown shape type 200"), std::string::npos);
+}
+
+TEST(ShapeKinds, MassPropertiesHaveTheGivenMassAndPositiveMoments) {
+  for (const ShapeKind* kind : shape_kinds()) {
+    for (const Shape& s : examples(kind->type)) {
+      ASSERT_EQ(kind->check(s), "");
+      if (!kind->bounded) {
+        EXPECT_EQ(volume(s), Fixed::zero()) << kind->name;
+        EXPECT_EQ(mass_properties(s, 3_fx), MassProperties{}) << kind->name;
+        continue;
+      }
+      EXPECT_GT(volume(s), Fixed::zero()) << kind->name;
+      const MassProperties m = mass_properties(s, 3_fx);
+      EXPECT_EQ(m.mass, 3_fx) << kind->name;
+      EXPECT_GT(m.inertia.x, Fixed::zero()) << kind->name;
+      EXPECT_GT(m.inertia.y, Fixed::zero()) << kind->name;
+      EXPECT_GT(m.inertia.z, Fixed::zero()) << kind->name;
+      // No point of a solid is farther than the bounding radius R from the origin, so no moment
+      // exceeds m R^2 (and each pair of moments obeys the triangle inequality of a real body).
+      const Fixed r = kind->bounding_radius(s);
+      const Fixed bound = 3_fx * r * r;
+      EXPECT_LE(m.inertia.x, bound) << kind->name;
+      EXPECT_LE(m.inertia.x, m.inertia.y + m.inertia.z + Fixed::from_raw(4)) << kind->name;
+      EXPECT_LE(m.inertia.y, m.inertia.x + m.inertia.z + Fixed::from_raw(4)) << kind->name;
+      EXPECT_LE(m.inertia.z, m.inertia.x + m.inertia.y + Fixed::from_raw(4)) << kind->name;
+    }
+  }
+}
+
+// Points in the cube of side 4R about the origin: those the shape contains lie within the
+// bounding radius and the bounding box, and the smallest dimension's ball about the centre is
+// inside the shape.
+TEST(ShapeKinds, ContainedPointsLieWithinTheBoundsAndTheSmallestDimensionIsInside) {
+  Rng rng(7);
+  for (const ShapeKind* kind : shape_kinds()) {
+    if (!kind->bounded) continue;
+    for (const Shape& s : examples(kind->type)) {
+      const Fixed r = kind->bounding_radius(s);
+      const Vec3 box = kind->aabb_extent(s, Mat3::identity());
+      int inside = 0;
+      for (int i = 0; i < 4000; ++i) {
+        const Vec3 p{rng.uniform(-2_fx * r, 2_fx * r), rng.uniform(-2_fx * r, 2_fx * r),
+                     rng.uniform(-2_fx * r, 2_fx * r)};
+        if (!kind->contains(s, p)) continue;
+        ++inside;
+        ASSERT_LE(length(p), r + Fixed::from_raw(16)) << kind->name;
+        ASSERT_LE(abs(p.x), box.x) << kind->name;
+        ASSERT_LE(abs(p.y), box.y) << kind->name;
+        ASSERT_LE(abs(p.z), box.z) << kind->name;
+      }
+      EXPECT_GT(inside, 0) << kind->name << ": no sample fell inside";
+      const Fixed d = kind->smallest_dimension(s);
+      for (const Vec3 axis : {Vec3::unit_x(), Vec3::unit_y(), Vec3::unit_z()}) {
+        EXPECT_TRUE(kind->contains(s, axis * d)) << kind->name;
+        EXPECT_TRUE(kind->contains(s, -axis * d)) << kind->name;
+      }
+    }
+  }
+}
+
+// A ray aimed at the centre from outside the bounding ball hits the surface: the hit point is on
+// the ray, within the bounding radius, and within 2^-16 m of the surface: a step on along the ray
+// is inside the shape, a step back outside it. A ray aimed away from it misses.
+TEST(ShapeKinds, RaysAtTheCentreHitTheSurfaceAndRaysAwayMiss) {
+  Rng rng(11);
+  const Fixed step_back = Fixed::from_raw(Fixed::one_raw >> 16);
+  for (const ShapeKind* kind : shape_kinds()) {
+    if (!kind->bounded) continue;
+    for (const Shape& s : examples(kind->type)) {
+      const Fixed r = kind->bounding_radius(s);
+      for (int i = 0; i < 200; ++i) {
+        const Vec3 v = rng.unit_vector();
+        const Vec3 p = -v * (r * 2_fx + 1_fx);
+        const auto hit = kind->ray(s, p, v);
+        ASSERT_TRUE(hit.has_value()) << kind->name;
+        EXPECT_LE(length(hit->point - (p + v * hit->t)), Fixed::from_raw(1 << 12)) << kind->name;
+        EXPECT_LE(length(hit->point), r + Fixed::from_raw(1 << 12)) << kind->name;
+        EXPECT_TRUE(kind->contains(s, hit->point + v * step_back)) << kind->name;
+        EXPECT_FALSE(kind->contains(s, hit->point - v * step_back)) << kind->name;
+        EXPECT_NEAR(length(hit->normal).to_double(), 1.0, 1e-6) << kind->name;
+        EXPECT_FALSE(kind->ray(s, p, -v).has_value()) << kind->name;
+      }
+    }
+  }
+}
+
+TEST(ShapeKinds, TheBoundingBoxHoldsTheRotatedShape) {
+  Rng rng(13);
+  for (const ShapeKind* kind : shape_kinds()) {
+    if (!kind->bounded) continue;
+    for (const Shape& s : examples(kind->type)) {
+      for (int i = 0; i < 50; ++i) {
+        const Quat q = from_axis_angle(rng.unit_vector(), rng.uniform(0_fx, 3_fx));
+        const Mat3 rotation = to_mat3(q);
+        const Vec3 box = kind->aabb_extent(s, rotation);
+        // The outline's points grown by its radius are the extreme points of a convex shape.
+        const ShapeOutline outline = shape_outline(s, Vec3{}, q);
+        for (const Vec3 p : outline.points) {
+          EXPECT_LE(abs(p.x) + outline.radius, box.x + Fixed::from_raw(64)) << kind->name;
+          EXPECT_LE(abs(p.y) + outline.radius, box.y + Fixed::from_raw(64)) << kind->name;
+          EXPECT_LE(abs(p.z) + outline.radius, box.z + Fixed::from_raw(64)) << kind->name;
+        }
+      }
+    }
+  }
+}
+
+TEST(ShapeKinds, TheEncodingReadsBackTheSameShapeAndNothingMore) {
+  for (const ShapeKind* kind : shape_kinds()) {
+    for (const Shape& s : examples(kind->type)) {
+      ByteWriter w;
+      kind->write(s, w);
+      w.u8(0xAB);  // what follows the shape is not read
+      ByteReader r(w.bytes());
+      EXPECT_EQ(kind->read(r), s) << kind->name;
+      ASSERT_TRUE(r.ok()) << r.error();
+      EXPECT_EQ(r.remaining(), 1U) << kind->name;
+    }
+  }
+}
+
+// The outlines a viewer draws, from each shape's definition.
+TEST(ShapeOutline, EachShapeIsDrawnFromItsDefinition) {
+  const Vec3 at{10_fx, 2_fx, -3_fx};
+  const Quat q = from_axis_angle(Vec3::unit_z(), Fixed::half_pi());  // local +y -> world -x
+
+  const ShapeOutline sphere = shape_outline(Shape::sphere(0.5_fx), at, q);
+  EXPECT_FALSE(sphere.half_space);
+  ASSERT_EQ(sphere.points.size(), 1U);
+  EXPECT_EQ(sphere.points[0], at);
+  EXPECT_EQ(sphere.radius, 0.5_fx);
+
+  const ShapeOutline capsule = shape_outline(Shape::capsule(0.25_fx, 1_fx), at, q);
+  ASSERT_EQ(capsule.points.size(), 2U);
+  EXPECT_EQ(capsule.radius, 0.25_fx);
+  // The core runs along the rotated local y axis: from x + 1 to x - 1.
+  EXPECT_NEAR(capsule.points[0].x.to_double(), 11.0, 1e-8);
+  EXPECT_NEAR(capsule.points[1].x.to_double(), 9.0, 1e-8);
+  EXPECT_NEAR(capsule.points[0].y.to_double(), 2.0, 1e-8);
+
+  const Vec3 h{1_fx, 0.5_fx, 0.25_fx};
+  const ShapeOutline box = shape_outline(Shape::box(h), at, q);
+  ASSERT_EQ(box.points.size(), 8U);
+  EXPECT_EQ(box.radius, Fixed::zero());
+  for (const Vec3 p : box.points)  // every corner is |h| from the centre
+    EXPECT_NEAR(distance(p, at).to_double(), length(h).to_double(), 1e-8);
+
+  const ShapeOutline plane = shape_outline(Shape::plane(), at, q);
+  EXPECT_TRUE(plane.half_space);
+  ASSERT_EQ(plane.points.size(), 1U);
+  EXPECT_NEAR(plane.normal.x.to_double(), -1.0, 1e-8);
+
+  Shape unknown;
+  unknown.type = static_cast<ShapeType>(99);
+  EXPECT_TRUE(shape_outline(unknown, at, q).points.empty());
+}
+
+}  // namespace
+}  // namespace detsim
