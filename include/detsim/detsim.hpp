@@ -1,6 +1,7 @@
 // Everything detsim offers a game, in one include.
 #pragma once
 
+#include <detsim/core.hpp>
 #include <detsim/fixed.hpp>
 #include <detsim/net.hpp>
 #include <detsim/replay.hpp>

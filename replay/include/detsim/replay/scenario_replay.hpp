@@ -7,10 +7,10 @@
 #include <optional>
 #include <string>
 
+#include <detsim/core/status.hpp>
 #include <detsim/replay/desync_report.hpp>
 #include <detsim/replay/replay.hpp>
 #include <detsim/sim/scenario.hpp>
-#include <detsim/sim/status.hpp>
 
 namespace detsim::replay {
 
