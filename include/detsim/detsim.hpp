@@ -5,4 +5,6 @@
 #include <detsim/fixed.hpp>
 #include <detsim/net.hpp>
 #include <detsim/replay.hpp>
+#include <detsim/scenario_net.hpp>
+#include <detsim/scenes.hpp>
 #include <detsim/sim.hpp>

@@ -7,8 +7,8 @@
 
 #include <detsim/core/status.hpp>
 #include <detsim/net/session.hpp>
+#include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/inject.hpp>
-#include <detsim/sim/scenario.hpp>
 
 #include "commands.hpp"
 

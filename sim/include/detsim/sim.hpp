@@ -7,7 +7,6 @@
 #include <detsim/sim/driver.hpp>
 #include <detsim/sim/inject.hpp>
 #include <detsim/sim/mass.hpp>
-#include <detsim/sim/scenario.hpp>
 #include <detsim/sim/shape.hpp>
 #include <detsim/sim/state_diff.hpp>
 #include <detsim/sim/world.hpp>

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include <detsim/core/status.hpp>
-#include <detsim/sim/scenario.hpp>
+#include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace detsim::replay {

@@ -16,7 +16,7 @@
 
 #include <detsim/core/status.hpp>
 #include <detsim/net/game.hpp>
-#include <detsim/sim/scenario.hpp>
+#include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace detsim::net {
