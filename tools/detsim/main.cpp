@@ -241,8 +241,13 @@ exactly one JSON object on stdout.)";
 
 void add_netplay(CLI::App& app, int& exit_code) {
   static detsim::cli::NetplayArgs netplay;
+#if DETSIM_WITH_UDP
   auto* c =
       app.add_subcommand("netplay", "Play one player of an arena match against peers over UDP");
+#else
+  auto* c =
+      app.add_subcommand("netplay", "Not in this build: built without UDP (DETSIM_WITH_UDP=OFF)");
+#endif
   c->add_option("--players", netplay.players, "Players in the match, 2 .. 8 (default 2)")
       ->type_name("N");
   auto* me = c->add_option("--me", netplay.me,
