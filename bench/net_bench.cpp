@@ -18,10 +18,10 @@
 #include <optional>
 #include <vector>
 
-#include <detsim/net/scenario_game.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
-#include <detsim/sim/scenario.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
+#include <detsim/scenes/scenario.hpp>
 
 namespace {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include <detsim/sim/scenario.hpp>
+#include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace {

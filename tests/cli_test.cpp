@@ -58,7 +58,7 @@ TEST(Cli, HelpListsEverySubcommandAndEachHasItsOwnHelp) {
     EXPECT_TRUE(has(detsim_cli(std::string(sub) + " --help").out, "Exit status: 0")) << sub;
   }
   EXPECT_EQ(detsim_cli("--version").out, "detsim " + std::string(version) + "\n");
-  EXPECT_EQ(version, DETSIM_PROJECT_VERSION);  // <detsim/version.hpp> follows CMakeLists.txt
+  EXPECT_EQ(version, DETSIM_PROJECT_VERSION);  // <detsim/core/version.hpp> follows CMakeLists.txt
 }
 
 TEST(Cli, RunPrintsTheFrameCountAndTheLibrarysFinalHash) {

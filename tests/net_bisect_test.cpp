@@ -8,12 +8,12 @@
 
 #include <gtest/gtest.h>
 
-#include <detsim/net/scenario_game.hpp>
-#include <detsim/net/scenario_recorder.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/replay/bisect.hpp>
 #include <detsim/replay/desync_report.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
+#include <detsim/scenario_net/scenario_recorder.hpp>
 
 #include "support/injection_cases.hpp"
 #include "support/replay_files.hpp"

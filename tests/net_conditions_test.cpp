@@ -10,11 +10,11 @@
 
 #include <cstdio>
 
-#include <detsim/net/scenario_game.hpp>
-#include <detsim/net/scenario_recorder.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/replay/scenario_replay.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
+#include <detsim/scenario_net/scenario_recorder.hpp>
 
 #include "support/net_match.hpp"
 #include "support/scale.hpp"

@@ -6,8 +6,8 @@
 #include <fstream>
 #include <iterator>
 
-#include <detsim/net/scenario_recorder.hpp>
 #include <detsim/replay/scenario_replay.hpp>
+#include <detsim/scenario_net/scenario_recorder.hpp>
 
 #include "support/net_match.hpp"
 

@@ -2,8 +2,8 @@
 // misses part of its state fails at the first frame where that part matters, with both states.
 #include <gtest/gtest.h>
 
-#include <detsim/net/scenario_game.hpp>
 #include <detsim/net/synctest.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
 
 #include "support/net_match.hpp"
 

@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <detsim/core/bytes.hpp>
 #include <detsim/fixed/decimal.hpp>
-#include <detsim/sim/bytes.hpp>
 
 #include "support/vector_print.hpp"
 

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include <detsim/fixed/decimal.hpp>
+#include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/inject.hpp>
-#include <detsim/sim/scenario.hpp>
 #include <detsim/sim/state_diff.hpp>
 
 namespace detsim {

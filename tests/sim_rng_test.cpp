@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <detsim/core/rng.hpp>
 #include <detsim/fixed/decimal.hpp>
-#include <detsim/sim/rng.hpp>
 
 #include "support/vector_print.hpp"
 

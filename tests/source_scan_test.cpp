@@ -53,7 +53,7 @@ TEST(SourceScan, SimulationModulesUseNoFloatingPoint) {
   const fs::path root = DETSIM_SOURCE_DIR;
   std::size_t files = 0;
   std::vector<Finding> findings;
-  for (const char* module : {"fixed", "sim", "net", "replay"}) {
+  for (const char* module : {"fixed", "core", "sim", "scenes", "replay", "net", "scenario_net"}) {
     const fs::path dir = root / module;
     if (!fs::exists(dir)) continue;
     for (const auto& entry : fs::recursive_directory_iterator(dir)) {

@@ -6,9 +6,9 @@
 // code per failure and no allocation beyond the packet's own bounded vectors.
 #include <detsim/net/protocol.hpp>
 
-#include <xxhash.h>
-
 #include <algorithm>
+
+#include <detsim/core/hash.hpp>
 
 namespace detsim::net::protocol {
 namespace {
@@ -94,7 +94,7 @@ void put(std::vector<std::uint8_t>& out, std::uint64_t v, std::size_t n) {
 }
 
 std::uint32_t checksum(std::span<const std::uint8_t> bytes) noexcept {
-  return static_cast<std::uint32_t>(XXH3_64bits(bytes.data(), bytes.size()));
+  return static_cast<std::uint32_t>(hash64(bytes));
 }
 
 // Run-length tokens over the XOR deltas: t < 128 -> t + 1 literals follow; t >= 128 -> t - 127

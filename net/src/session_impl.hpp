@@ -8,8 +8,8 @@
 #include <optional>
 #include <vector>
 
+#include <detsim/core/rng.hpp>
 #include <detsim/net/session.hpp>
-#include <detsim/sim/rng.hpp>
 
 #include "input_queue.hpp"
 

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include <detsim/sim/rng.hpp>
+#include <detsim/core/rng.hpp>
 
 namespace detsim::net {
 

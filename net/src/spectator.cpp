@@ -6,8 +6,8 @@
 #include <deque>
 #include <string>
 
+#include <detsim/core/rng.hpp>
 #include <detsim/net/protocol.hpp>
-#include <detsim/sim/rng.hpp>
 
 namespace detsim::net {
 

@@ -1,11 +1,10 @@
 // Desync report files (desync_report.hpp; layout in replay/FORMAT.md).
 #include <detsim/replay/desync_report.hpp>
 
-#include <xxhash.h>
-
 #include <cstdio>
 #include <memory>
 
+#include <detsim/core/hash.hpp>
 #include <detsim/sim/world.hpp>
 
 #include "replay_detail.hpp"
@@ -131,7 +130,7 @@ Status write_desync_report(const std::string& path, const DesyncReport& report) 
   file.u32(desync_report_version);
   file.u64(payload.size());
   file.raw(payload.bytes());
-  file.u64(XXH3_64bits(payload.bytes().data(), payload.size()));
+  file.u64(hash64(payload.bytes()));
 
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> out(std::fopen(path.c_str(), "wb"), &std::fclose);
   if (!out) return Status::error("desync report " + path + ": cannot create the file");
@@ -166,7 +165,7 @@ Expected<DesyncReport> parse_desync_report(std::span<const std::uint8_t> bytes,
   const std::span<const std::uint8_t> payload =
       bytes.subspan(kHeaderSize, static_cast<std::size_t>(size));
   ByteReader trailer(bytes.last(kTrailerSize));
-  if (trailer.u64("checksum") != XXH3_64bits(payload.data(), payload.size()))
+  if (trailer.u64("checksum") != hash64(payload))
     return fail(bytes.size() - kTrailerSize,
                 "the payload's XXH3 checksum does not match (corrupted)");
 

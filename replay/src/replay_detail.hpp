@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <detsim/core/bytes.hpp>
 #include <detsim/replay/replay.hpp>
-#include <detsim/sim/bytes.hpp>
 
 namespace detsim::replay::detail {
 

@@ -4,8 +4,6 @@
 // (four ASCII bytes), its payload length (u32), the payload, and an XXH3-64 of those three. The
 // reader accepts a file that ends inside a chunk (a recording cut short) and reports the ignored
 // tail; any complete chunk that is malformed is an error.
-#include <xxhash.h>
-
 #include <stdio.h>      // fmemopen, fseeko, ftello (POSIX)
 #include <sys/types.h>  // off_t
 #include <algorithm>
@@ -16,8 +14,9 @@
 #include <new>
 #include <utility>
 
+#include <detsim/core/bytes.hpp>
+#include <detsim/core/hash.hpp>
 #include <detsim/replay/replay.hpp>
-#include <detsim/sim/bytes.hpp>
 
 #include "replay_detail.hpp"
 
@@ -123,20 +122,13 @@ using namespace detail;
 // ---- HashChain ----------------------------------------------------------------------------------
 
 struct HashChain::Impl {
-  XXH3_state_t* state = XXH3_createState();
-  Impl() {
-    if (state == nullptr) throw std::bad_alloc();
-    XXH3_64bits_reset(state);
-  }
-  Impl(const Impl& other) : Impl() { XXH3_copyState(state, other.state); }
-  Impl& operator=(const Impl&) = delete;
-  ~Impl() { XXH3_freeState(state); }
+  Hash64Stream stream;
 };
 
 HashChain::HashChain() : impl_(std::make_unique<Impl>()) {}
 HashChain::HashChain(const HashChain& other) : impl_(std::make_unique<Impl>(*other.impl_)) {}
 HashChain& HashChain::operator=(const HashChain& other) {
-  if (this != &other) XXH3_copyState(impl_->state, other.impl_->state);
+  if (this != &other) impl_->stream = other.impl_->stream;
   return *this;
 }
 HashChain::~HashChain() = default;
@@ -145,11 +137,11 @@ void HashChain::add(std::uint64_t frame_hash) noexcept {
   std::uint8_t bytes[8];
   for (int i = 0; i < 8; ++i)
     bytes[i] = static_cast<std::uint8_t>(frame_hash >> (8 * i));
-  XXH3_64bits_update(impl_->state, bytes, sizeof bytes);
+  impl_->stream.update(bytes);
 }
 
 std::uint64_t HashChain::value() const noexcept {
-  return XXH3_64bits_digest(impl_->state);
+  return impl_->stream.digest();
 }
 
 // ---- Files --------------------------------------------------------------------------------------
@@ -210,7 +202,7 @@ struct ReplayWriter::Impl {
     w.u32(type);
     w.u32(static_cast<std::uint32_t>(payload.size()));
     w.raw(payload);
-    w.u64(XXH3_64bits(w.bytes().data(), w.size()));
+    w.u64(hash64(w.bytes()));
     if (std::fwrite(w.bytes().data(), 1, w.size(), file.get()) != w.size() ||
         std::fflush(file.get()) != 0)
       return fail("cannot write: " + os_error());
@@ -369,7 +361,7 @@ struct ReplayReader::Impl {
     std::uint64_t stored = 0;
     for (int i = 0; i < 8; ++i)
       stored |= std::uint64_t{bytes[body + static_cast<std::size_t>(i)]} << (8 * i);
-    const std::uint64_t computed = XXH3_64bits(bytes.data(), body);
+    const std::uint64_t computed = hash64({bytes.data(), body});
     if (stored != computed)
       return error_at(offset, "chunk " + chunk_name(type) + " of " + std::to_string(length) +
                                   " bytes: checksum " + hex64(stored) +

@@ -1,14 +1,13 @@
 // Recording, verifying and seeking replays of the registered scenarios.
-#include <xxhash.h>
-
 #include <algorithm>
 #include <array>
 #include <optional>
 #include <utility>
 
+#include <detsim/core/hash.hpp>
+#include <detsim/core/version.hpp>
 #include <detsim/fixed/decimal.hpp>
 #include <detsim/replay/scenario_replay.hpp>
-#include <detsim/version.hpp>
 
 #include "replay_detail.hpp"
 
@@ -276,7 +275,7 @@ Expected<VerifyResult> verify(const ReplayReader& reader, const VerifyOptions& o
         stop_error = state.status();
         return false;
       }
-      if (XXH3_64bits(state.value().data(), state.value().size()) != record.hashes.total) {
+      if (hash64(state.value()) != record.hashes.total) {
         stop_error = Status::error(reader.path() + ": the keyframe of frame " +
                                    std::to_string(record.frame) +
                                    " does not hash to its frame's recorded hash");

@@ -21,7 +21,7 @@
 #include <detsim/fixed/quat.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
-#include <detsim/sim/bytes.hpp>
+#include <detsim/core/bytes.hpp>
 #include <detsim/sim/mass.hpp>
 #include <detsim/sim/shape.hpp>
 #include <detsim/sim/shape_outline.hpp>

@@ -6,11 +6,12 @@
 // sets. The restore reads into a scratch WorldState and validates every field before the world is
 // replaced, so bad bytes change nothing; it accepts only canonical bytes (the shortest vars, sets
 // in first-use order, flags that match their values), so a state has exactly one encoding.
-#include <xxhash.h>
 #include <algorithm>
 #include <string_view>
 #include <unordered_map>
 #include <unordered_set>
+
+#include <detsim/core/hash.hpp>
 
 #include "shapes.hpp"
 #include "world_state.hpp"
@@ -42,7 +43,7 @@ constexpr std::uint8_t kPointCountMask = 7;
 constexpr std::uint8_t kReported = 8;
 
 std::uint64_t xxh3(const std::vector<std::uint8_t>& bytes) {
-  return XXH3_64bits(bytes.data(), bytes.size());
+  return hash64(bytes);
 }
 
 void write_def(const WorldDef& d, ByteWriter& w) {
@@ -573,7 +574,7 @@ StateHashes World::save(std::vector<std::uint8_t>& out) const {
   sim_detail::encode(*s_, e);
   const std::uint8_t* bytes = e.w.bytes().data();
   const auto slice = [&](std::size_t from, std::size_t to) {
-    return XXH3_64bits(bytes + from, to - from);
+    return hash64(std::span<const std::uint8_t>(bytes + from, to - from));
   };
   StateHashes h;
   h.globals = slice(e.globals, e.rng);

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <detsim/core/bytes.hpp>
 #include <detsim/fixed/mat3.hpp>
-#include <detsim/sim/bytes.hpp>
 #include <detsim/sim/mass.hpp>
 #include <detsim/sim/world.hpp>
 

@@ -11,11 +11,11 @@
 #include <vector>
 
 #include <detsim/net/game.hpp>
-#include <detsim/net/scenario_game.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/net/spectator.hpp>
-#include <detsim/sim/scenario.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
+#include <detsim/scenes/scenario.hpp>
 
 namespace detsim::test {
 

@@ -24,9 +24,9 @@
 #define XXH_INLINE_ALL
 #include <xxhash.h>
 
+#include <detsim/core/bytes.hpp>
 #include <detsim/fixed/decimal.hpp>
 #include <detsim/fixed/math.hpp>
-#include <detsim/sim/bytes.hpp>
 #include <detsim/sim/world.hpp>
 
 #include "support/state_codec.hpp"

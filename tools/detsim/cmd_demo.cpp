@@ -13,11 +13,11 @@
 #include <system_error>
 #include <vector>
 
-#include <detsim/net/scenario_game.hpp>
-#include <detsim/net/scenario_recorder.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/replay/scenario_replay.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
+#include <detsim/scenario_net/scenario_recorder.hpp>
 
 #include "commands.hpp"
 #include "output.hpp"

@@ -18,12 +18,12 @@
 #include <thread>
 #include <vector>
 
-#include <detsim/net/scenario_game.hpp>
-#include <detsim/net/scenario_recorder.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/udp.hpp>
 #include <detsim/replay/desync_report.hpp>
 #include <detsim/replay/replay.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
+#include <detsim/scenario_net/scenario_recorder.hpp>
 
 #include "commands.hpp"
 #include "netplay_plan.hpp"

@@ -4,8 +4,7 @@
 #include <string>
 #include <vector>
 
-#include <xxhash.h>
-
+#include <detsim/core/hash.hpp>
 #include <detsim/replay.hpp>
 
 #include "commands.hpp"
@@ -94,7 +93,7 @@ std::uint64_t session_fingerprint(const Scenario& scenario, net::SessionMode mod
   put_u64(bytes, f.initial_hash);
   put_u64(bytes, static_cast<std::uint64_t>(mode));
   put_u64(bytes, frames);
-  return XXH3_64bits(bytes.data(), bytes.size());
+  return hash64(bytes);
 }
 
 // ---- detsim scenarios ---------------------------------------------------------------------------

@@ -15,10 +15,10 @@
 #include <thread>
 #include <vector>
 
-#include <detsim/net/scenario_game.hpp>
-#include <detsim/net/scenario_recorder.hpp>
 #include <detsim/net/spectator.hpp>
 #include <detsim/net/udp.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
+#include <detsim/scenario_net/scenario_recorder.hpp>
 
 #include "netplay_plan.hpp"
 #include "output.hpp"

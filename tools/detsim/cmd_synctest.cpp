@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include <detsim/net/scenario_game.hpp>
 #include <detsim/net/synctest.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
 #include <detsim/sim/state_diff.hpp>
 
 #include "commands.hpp"

@@ -239,6 +239,17 @@ printed; --desync-report writes this machine's side for bisection); 2 bad usage,
 handshake timeout or a peer that disconnected (the message on stderr names it). --json prints
 exactly one JSON object on stdout.)";
 
+#if !DETSIM_WITH_UDP
+// Without UDP the command stays, takes any arguments and says why it cannot run, so that a script
+// gets that message and exit status 2 rather than "unknown subcommand" or a missing option.
+void add_netplay(CLI::App& app, int& exit_code) {
+  auto* c =
+      app.add_subcommand("netplay", "Not in this build: built without UDP (DETSIM_WITH_UDP=OFF)");
+  c->allow_extras();
+  c->callback(
+      [&exit_code] { exit_code = detsim::cli::netplay_command(detsim::cli::NetplayArgs{}); });
+}
+#else
 void add_netplay(CLI::App& app, int& exit_code) {
   static detsim::cli::NetplayArgs netplay;
   auto* c =
@@ -310,6 +321,7 @@ void add_netplay(CLI::App& app, int& exit_code) {
     exit_code = detsim::cli::netplay_command(netplay);
   });
 }
+#endif
 
 void add_scenario_commands(CLI::App& app, int& exit_code) {
   namespace cli = detsim::cli;

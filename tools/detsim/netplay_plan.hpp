@@ -9,9 +9,9 @@
 #include <string_view>
 #include <vector>
 
+#include <detsim/core/status.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/udp.hpp>
-#include <detsim/sim/status.hpp>
 
 #include "commands.hpp"
 

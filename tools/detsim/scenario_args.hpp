@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
+#include <detsim/core/status.hpp>
 #include <detsim/net/session.hpp>
+#include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/inject.hpp>
-#include <detsim/sim/scenario.hpp>
-#include <detsim/sim/status.hpp>
 
 #include "commands.hpp"
 

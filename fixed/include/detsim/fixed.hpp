@@ -1,8 +1,6 @@
 // The fixed-point layer: Fixed, its functions, and the vector types.
 #pragma once
 
-#include <detsim/version.hpp>
-
 #include <detsim/fixed/decimal.hpp>
 #include <detsim/fixed/fixed.hpp>
 #include <detsim/fixed/mat3.hpp>

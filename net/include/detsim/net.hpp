@@ -3,11 +3,11 @@
 
 #include <detsim/net/game.hpp>
 #include <detsim/net/protocol.hpp>
-#include <detsim/net/scenario_game.hpp>
-#include <detsim/net/scenario_recorder.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/net/spectator.hpp>
 #include <detsim/net/synctest.hpp>
 #include <detsim/net/transport.hpp>
+#if DETSIM_WITH_UDP  // a PUBLIC definition of detsim::net: 0 in a DETSIM_WITH_UDP=OFF build
 #include <detsim/net/udp.hpp>
+#endif

@@ -33,10 +33,10 @@
 #include <string_view>
 #include <vector>
 
+#include <detsim/core/status.hpp>
 #include <detsim/net/game.hpp>
 #include <detsim/net/protocol.hpp>
 #include <detsim/net/transport.hpp>
-#include <detsim/sim/status.hpp>
 
 namespace detsim::net {
 

@@ -45,8 +45,8 @@
 #include <cstdint>
 #include <memory>
 
+#include <detsim/core/status.hpp>
 #include <detsim/net/transport.hpp>
-#include <detsim/sim/status.hpp>
 
 namespace detsim::net {
 

@@ -13,10 +13,10 @@
 #include <memory>
 #include <vector>
 
+#include <detsim/core/status.hpp>
 #include <detsim/net/game.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/transport.hpp>
-#include <detsim/sim/status.hpp>
 
 namespace detsim::net {
 

@@ -11,8 +11,8 @@
 #include <span>
 #include <vector>
 
+#include <detsim/core/status.hpp>
 #include <detsim/net/game.hpp>
-#include <detsim/sim/status.hpp>
 
 namespace detsim::net {
 

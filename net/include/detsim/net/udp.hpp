@@ -30,8 +30,8 @@
 #include <string_view>
 #include <vector>
 
+#include <detsim/core/status.hpp>
 #include <detsim/net/transport.hpp>
-#include <detsim/sim/status.hpp>
 
 namespace detsim::net {
 

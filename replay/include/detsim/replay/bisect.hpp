@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
+#include <detsim/core/status.hpp>
 #include <detsim/sim/shape.hpp>
 #include <detsim/sim/state_diff.hpp>
-#include <detsim/sim/status.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace detsim::replay {

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <detsim/core/status.hpp>
 #include <detsim/replay/replay.hpp>
-#include <detsim/sim/status.hpp>
 
 namespace detsim::replay {
 

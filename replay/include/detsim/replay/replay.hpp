@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include <detsim/sim/scenario.hpp>
-#include <detsim/sim/status.hpp>
+#include <detsim/core/status.hpp>
+#include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace detsim::replay {

@@ -1,5 +1,6 @@
-// Recording, verifying and seeking replays of the registered scenarios (<detsim/sim/scenario.hpp>):
-// what `detsim run --record`, `detsim verify` and the golden replays use.
+// Recording, verifying and seeking replays of the registered scenarios
+// (<detsim/scenes/scenario.hpp>): what `detsim run --record`, `detsim verify` and the golden
+// replays use.
 #pragma once
 
 #include <cstdint>
@@ -7,10 +8,10 @@
 #include <optional>
 #include <string>
 
+#include <detsim/core/status.hpp>
 #include <detsim/replay/desync_report.hpp>
 #include <detsim/replay/replay.hpp>
-#include <detsim/sim/scenario.hpp>
-#include <detsim/sim/status.hpp>
+#include <detsim/scenes/scenario.hpp>
 
 namespace detsim::replay {
 

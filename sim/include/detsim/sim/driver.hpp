@@ -21,11 +21,11 @@
 #include <utility>
 #include <vector>
 
+#include <detsim/core/status.hpp>
 #include <detsim/fixed/fixed.hpp>
 #include <detsim/fixed/quat.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
-#include <detsim/sim/status.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace detsim {

@@ -27,8 +27,8 @@
 #include <string>
 #include <string_view>
 
+#include <detsim/core/status.hpp>
 #include <detsim/fixed/fixed.hpp>
-#include <detsim/sim/status.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace detsim {

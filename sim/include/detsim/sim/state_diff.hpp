@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include <detsim/sim/status.hpp>
+#include <detsim/core/status.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace detsim {

@@ -12,9 +12,9 @@
 #include <span>
 #include <vector>
 
+#include <detsim/core/rng.hpp>
+#include <detsim/core/status.hpp>
 #include <detsim/sim/body.hpp>
-#include <detsim/sim/rng.hpp>
-#include <detsim/sim/status.hpp>
 #include <detsim/sim/world_def.hpp>
 
 namespace detsim {

@@ -1,5 +1,5 @@
+#include <detsim/core/rng.hpp>
 #include <detsim/fixed/wide.hpp>
-#include <detsim/sim/rng.hpp>
 
 namespace detsim {
 

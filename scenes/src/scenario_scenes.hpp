@@ -1,12 +1,12 @@
 // The scenario builders and their per-frame logic, shared by scenario.cpp (the registry) and
-// scenario_play.cpp (the scenes with game logic). Internal to detsim::sim.
+// scenario_play.cpp (the scenes with game logic). Internal to detsim::scenes.
 #pragma once
 
 #include <span>
 
-#include <detsim/sim/scenario.hpp>
+#include <detsim/scenes/scenario.hpp>
 
-namespace detsim::sim_detail {
+namespace detsim::scenes_detail {
 
 // Adds a body to a scenario's world. Scenario definitions are constants checked by the tests: a
 // refusal is a bug here.
@@ -36,4 +36,4 @@ inline constexpr std::uint64_t platform_tag = 0x504C'4154'0000'0000ULL;
 inline constexpr std::uint64_t spawned_tag = 0x5350'4157'0000'0000ULL;
 inline constexpr std::uint64_t crate_tag = 0x4352'4154'0000'0000ULL;
 
-}  // namespace detsim::sim_detail
+}  // namespace detsim::scenes_detail

@@ -1,4 +1,4 @@
-#include <detsim/sim/bytes.hpp>
+#include <detsim/core/bytes.hpp>
 
 namespace detsim {
 

@@ -5,7 +5,7 @@
 
 #include <detsim/fixed/math.hpp>
 #include <detsim/fixed/quat.hpp>
-#include <detsim/sim/scenario.hpp>
+#include <detsim/scenes/scenario.hpp>
 
 #include "scenario_scenes.hpp"
 
@@ -22,10 +22,10 @@ struct Entry {
 };
 
 void build_pile_boxes(World& w, const ScenarioParams& p) {
-  sim_detail::build_pile(w, p, false);
+  scenes_detail::build_pile(w, p, false);
 }
 void build_pile_spheres(World& w, const ScenarioParams& p) {
-  sim_detail::build_pile(w, p, true);
+  scenes_detail::build_pile(w, p, true);
 }
 
 // Sorted by name: scenario_list() is documented to be.
@@ -34,19 +34,19 @@ constexpr std::array entries{
            "2-8 player-controlled spheres pushing crates in a walled arena; RNG-driven crate "
            "spawns and kicks",
            3600, 2, 8, 2, 0, 0, true},
-          sim_detail::build_arena,
-          sim_detail::control_arena},
+          scenes_detail::build_arena,
+          scenes_detail::control_arena},
     Entry{{"bounce", "five spheres dropped from 5 m with restitution 0, 0.25, 0.5, 0.75 and 1", 600,
            0, 0, 0, 0, 0, false},
-          sim_detail::build_bounce,
+          scenes_detail::build_bounce,
           nullptr},
     Entry{{"bullet_wall",
            "a 0.1 m sphere (CCD) at 1000 m/s towards a 0.2 m thick static wall 10 m away", 120, 0,
            0, 0, 0, 0, false},
-          sim_detail::build_bullet_wall,
+          scenes_detail::build_bullet_wall,
           nullptr},
     Entry{{"dominoes", "30 dominoes in a row; the first is tipped over", 600, 0, 0, 0, 0, 0, false},
-          sim_detail::build_dominoes,
+          scenes_detail::build_dominoes,
           nullptr},
     Entry{{"pile_boxes",
            "N 1 m boxes (mass 1) on a cubic lattice, spacing 1.1 m, dropped on a plane "
@@ -62,21 +62,21 @@ constexpr std::array entries{
           nullptr},
     Entry{{"pyramid", "a pyramid of 1 m boxes on a plane, N rows (20 rows: 210 boxes)", 1200, 0, 0,
            0, 20, 100, false, "rows"},
-          sim_detail::build_pyramid,
+          scenes_detail::build_pyramid,
           nullptr},
     Entry{
         {"slope", "boxes of friction 0.2 to 1.0 on a 30-degree slope: those with tan 30 > mu slide",
          600, 0, 0, 0, 0, 0, false},
-        sim_detail::build_slope,
+        scenes_detail::build_slope,
         nullptr},
     Entry{{"spray",
            "RNG-driven spawns of spheres, boxes and capsules onto a rotating paddle and a "
            "moving platform (kinematic)",
            1200, 0, 0, 0, 0, 0, true},
-          sim_detail::build_spray,
-          sim_detail::control_spray},
+          scenes_detail::build_spray,
+          scenes_detail::control_spray},
     Entry{{"stack", "10 boxes of 1 m stacked on a plane", 1200, 0, 0, 0, 0, 0, false},
-          sim_detail::build_stack,
+          scenes_detail::build_stack,
           nullptr},
 };
 
@@ -168,7 +168,7 @@ void Scenario::step(std::span<const PlayerInput> inputs) {
 
 BodyId Scenario::player_body(std::uint32_t player) const {
   if (player >= params_.players) return {};
-  const std::uint64_t tag = sim_detail::player_tag + player;
+  const std::uint64_t tag = scenes_detail::player_tag + player;
   for (const BodyId id : world_.body_ids()) {
     if (world_.body(id)->user_data == tag) return id;
   }
@@ -202,7 +202,7 @@ PlayerInput decode_input(std::span<const std::uint8_t, PlayerInput::encoded_size
   return {in[0], static_cast<std::int8_t>(in[1]), static_cast<std::int8_t>(in[2])};
 }
 
-namespace sim_detail {
+namespace scenes_detail {
 
 namespace {
 
@@ -329,5 +329,5 @@ void build_slope(World& w, const ScenarioParams&) {
   }
 }
 
-}  // namespace sim_detail
+}  // namespace scenes_detail
 }  // namespace detsim

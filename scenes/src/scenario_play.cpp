@@ -8,7 +8,7 @@
 
 #include "scenario_scenes.hpp"
 
-namespace detsim::sim_detail {
+namespace detsim::scenes_detail {
 
 namespace {
 
@@ -184,4 +184,4 @@ void control_arena(World& w, std::span<const PlayerInput> inputs, const Scenario
   }
 }
 
-}  // namespace detsim::sim_detail
+}  // namespace detsim::scenes_detail

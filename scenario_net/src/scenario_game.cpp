@@ -1,5 +1,5 @@
 // The Game adapter for detsim scenarios (scenario_game.hpp).
-#include <detsim/net/scenario_game.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
 
 namespace detsim::net {
 

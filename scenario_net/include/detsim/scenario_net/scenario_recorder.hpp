@@ -10,12 +10,12 @@
 #include <memory>
 #include <string>
 
-#include <detsim/net/scenario_game.hpp>
+#include <detsim/core/status.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/spectator.hpp>
 #include <detsim/replay/desync_report.hpp>
 #include <detsim/replay/replay.hpp>
-#include <detsim/sim/status.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
 
 namespace detsim::net {
 

@@ -12,7 +12,7 @@
 #include <string_view>
 #include <utility>
 
-#include <detsim/sim/status.hpp>
+#include <detsim/core/status.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace detsim {

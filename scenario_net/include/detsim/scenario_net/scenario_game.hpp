@@ -14,9 +14,9 @@
 #include <span>
 #include <vector>
 
+#include <detsim/core/status.hpp>
 #include <detsim/net/game.hpp>
-#include <detsim/sim/scenario.hpp>
-#include <detsim/sim/status.hpp>
+#include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace detsim::net {

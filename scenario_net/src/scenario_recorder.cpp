@@ -1,5 +1,5 @@
 // Replays of session matches (scenario_recorder.hpp).
-#include <detsim/net/scenario_recorder.hpp>
+#include <detsim/scenario_net/scenario_recorder.hpp>
 
 #include <utility>
 

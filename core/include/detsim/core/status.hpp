@@ -40,7 +40,10 @@ class [[nodiscard]] Expected {
   /// The value moved out of a temporary (`auto world = World::create(def).value();`).
   [[nodiscard]] T&& value() && { return std::get<0>(std::move(v_)); }
   [[nodiscard]] const T& operator*() const& { return value(); }
+  /// The value, for changing it in place (`result->add(x)`); only valid when ok().
+  [[nodiscard]] T& operator*() & { return value(); }
   [[nodiscard]] const T* operator->() const { return &value(); }
+  [[nodiscard]] T* operator->() { return &value(); }
   /// The error message; empty when ok().
   [[nodiscard]] const std::string& message() const noexcept {
     static const std::string none;
