@@ -31,6 +31,7 @@ Fingerprint sample_fingerprint() {
   Fingerprint f;
   f.detsim_version = "0.1.0";
   f.state_version = 1;
+  f.state_sections = {"globals", "rng", "bodies", "contacts"};
   f.scenario = "arena";
   f.params = {.seed = 42, .players = 2, .count = 0};
   f.dt = Fixed::from_raw(71582788);
@@ -49,7 +50,9 @@ FrameRecord sample_frame(std::uint64_t frame) {
   r.frame = frame;
   for (std::uint8_t i = 0; i < 6; ++i)
     r.inputs.push_back(static_cast<std::uint8_t>(frame * 7 + i));
-  r.hashes = {frame * 0x9E3779B97F4A7C15ULL, frame + 1, frame + 2, frame + 3, frame + 4};
+  r.hashes.total = frame * 0x9E3779B97F4A7C15ULL;
+  r.hashes.sections = {
+      {"globals", frame + 1}, {"rng", frame + 2}, {"bodies", frame + 3}, {"contacts", frame + 4}};
   return r;
 }
 
@@ -250,8 +253,8 @@ TEST(ReplayFile, ErrorsNameTheFileTheByteAndWhatWasExpected) {
                               ": byte 0: expected the magic \"DSREPLAY\" (this is not a detsim "
                               "replay)");
   b = good;
-  test::put_u32(b, 8, 2);
-  EXPECT_EQ(open_with(b), file.path() + ": byte 8: format version 2, this build reads 1");
+  test::put_u32(b, 8, 1);
+  EXPECT_EQ(open_with(b), file.path() + ": byte 8: format version 1, this build reads 2");
   // A flipped payload byte of the frames chunk: its checksum no longer matches.
   b = good;
   ASSERT_EQ(chunks[1].type, "FRAM");

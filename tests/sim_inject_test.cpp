@@ -432,9 +432,9 @@ TEST(ApplyInjection, RefusedInjectionsLeaveTheWorldUnchanged) {
   expect_refused(
       base,
       spec(at + std::to_string(crate.value) + ":sleep_time:" + to_string(-(sleep + dec("0.5")))),
-      "negative sleep time");
+      "sleep time must be >= 0");
   ASSERT_EQ(base.body(ids[0]).value().type, BodyType::static_body);  // the floor
-  expect_refused(base, spec(at + std::to_string(a) + ":awake:1"), "is static");
+  expect_refused(base, spec(at + std::to_string(a) + ":awake:1"), "a static body cannot be awake");
 
   // The all-zero RNG state.
   World lone;

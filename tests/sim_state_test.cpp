@@ -37,23 +37,30 @@ TEST(StateFormat, DefaultWorldStartsWithMagicAndVersion) {
   EXPECT_EQ(bytes[1], 'S');
   EXPECT_EQ(bytes[2], 'I');
   EXPECT_EQ(bytes[3], 'M');
-  EXPECT_EQ((Bytes(bytes.begin() + 4, bytes.begin() + 8)), (Bytes{2, 0, 0, 0}));
-  EXPECT_EQ(state_encoding_version, 2U);
-  // Then frame 0 (u64) and the next body ID, 1 (u32).
-  EXPECT_EQ((Bytes(bytes.begin() + 8, bytes.begin() + 20)),
+  EXPECT_EQ((Bytes(bytes.begin() + 4, bytes.begin() + 8)), (Bytes{3, 0, 0, 0}));
+  EXPECT_EQ(state_encoding_version, 3U);
+  // Then the section count (var 4) and the first section's record: its name's length (7),
+  // "globals", its version (var 1) and its payload's length: frame 8 + next ID 4 + definition 137
+  // = 149 = 0x95 (u32); then frame 0 (u64) and the next body ID, 1 (u32).
+  EXPECT_EQ((Bytes(bytes.begin() + 8, bytes.begin() + 22)),
+            (Bytes{4, 7, 'g', 'l', 'o', 'b', 'a', 'l', 's', 1, 0x95, 0, 0, 0}));
+  EXPECT_EQ((Bytes(bytes.begin() + 22, bytes.begin() + 34)),
             (Bytes{0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0}));
-  // magic 4 + version 4 + frame 8 + next ID 4 + definition 137 + RNG 32 + three empty counts
-  // (property sets, bodies, contacts) 12.
-  EXPECT_EQ(bytes.size(), 4U + 4 + 8 + 4 + kDefinitionBytes + 32 + 12);
-  EXPECT_EQ(bytes.size(), 201U);
-  EXPECT_EQ((Bytes(bytes.end() - 12, bytes.end())), Bytes(12, 0));
+  // magic 4 + version 4 + count 1, each section's name length, name, version and payload length
+  // (1 + 7 + 1 + 4, 1 + 3 + 1 + 4, 1 + 6 + 1 + 4, 1 + 8 + 1 + 4), and the payloads: globals 149,
+  // RNG 32, bodies two empty counts 8, contacts one empty count 4.
+  EXPECT_EQ(bytes.size(), 9U + 13 + 9 + 12 + 14 + (8 + 4 + kDefinitionBytes) + 32 + 8 + 4);
+  EXPECT_EQ(bytes.size(), 250U);
+  EXPECT_EQ((Bytes(bytes.end() - 4, bytes.end())), Bytes(4, 0));
 
   const Decoded d = decode(bytes);
   ASSERT_TRUE(d.ok) << d.error;
   EXPECT_EQ(d.def, WorldDef{});
   EXPECT_EQ(d.rng, Rng(0).state());
-  EXPECT_EQ(d.rng_at, 20 + kDefinitionBytes);
-  EXPECT_EQ(d.property_count_at, d.rng_at + 32);
+  EXPECT_EQ(d.globals_at, 22U);
+  EXPECT_EQ(d.rng_at, d.globals_at + 12 + kDefinitionBytes + 9);  // after rng's section header
+  EXPECT_EQ(d.property_count_at, d.rng_at + 32 + 12);
+  EXPECT_EQ(d.contact_count_at, d.body_count_at + 4 + 14);
   EXPECT_TRUE(d.sets.empty() && d.bodies.empty() && d.contacts.empty());
   EXPECT_EQ(encode(d), bytes);
 }
@@ -158,15 +165,20 @@ TEST(StateFormat, HashesAreXxh3OfTheCanonicalSections) {
   const std::span<const std::uint8_t> all(bytes);
   const StateHashes h = w.hashes();
   EXPECT_EQ(h.total, xxh3(all));
-  // globals: from the frame to the end of the definition; rng; bodies: from the property-set
-  // count to the end of the last body; contacts: from the contact count to the end.
-  EXPECT_EQ(d.globals_at, 8U);
-  EXPECT_EQ(h.globals, xxh3(all.subspan(d.globals_at, d.rng_at - d.globals_at)));
-  EXPECT_EQ(h.rng, xxh3(all.subspan(d.rng_at, d.property_count_at - d.rng_at)));
-  EXPECT_EQ(d.bodies.back().end, d.contact_count_at);
-  EXPECT_EQ(h.bodies,
-            xxh3(all.subspan(d.property_count_at, d.contact_count_at - d.property_count_at)));
-  EXPECT_EQ(h.contacts, xxh3(all.subspan(d.contact_count_at)));
+  // Each section's hash covers its whole record, from its name's length to the end of its
+  // payload: the sections follow one another, and the last ends with the state.
+  ASSERT_EQ(h.sections.size(), 4U);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(h.sections[i].name, kSectionNames[i]);
+    const std::size_t end = i + 1 < 4 ? d.section_at[i + 1] : bytes.size();
+    EXPECT_EQ(h.sections[i].hash, xxh3(all.subspan(d.section_at[i], end - d.section_at[i])))
+        << kSectionNames[i];
+  }
+  EXPECT_EQ(d.section_at[0], 9U);
+  EXPECT_EQ(d.bodies.back().end, d.section_at[3]);
+  EXPECT_EQ(h.section("bodies"),
+            xxh3(all.subspan(d.section_at[2], d.section_at[3] - d.section_at[2])));
+  EXPECT_EQ(h.section("no such section"), 0U);
   // body_hash: the body's set, then its record as if it were the only body.
   for (std::size_t i = 0; i < d.bodies.size(); ++i) {
     const Expected<std::uint64_t> bh = w.body_hash(d.bodies[i].id);
@@ -314,10 +326,10 @@ HashSnapshot snapshot(const World& w) {
 void expect_only_body_changed(const World& w, const HashSnapshot& before, BodyId touched) {
   const HashSnapshot after = snapshot(w);
   EXPECT_NE(after.world.total, before.world.total);
-  EXPECT_NE(after.world.bodies, before.world.bodies);
-  EXPECT_EQ(after.world.globals, before.world.globals);
-  EXPECT_EQ(after.world.rng, before.world.rng);
-  EXPECT_EQ(after.world.contacts, before.world.contacts);
+  EXPECT_NE(after.world.section("bodies"), before.world.section("bodies"));
+  EXPECT_EQ(after.world.section("globals"), before.world.section("globals"));
+  EXPECT_EQ(after.world.section("rng"), before.world.section("rng"));
+  EXPECT_EQ(after.world.section("contacts"), before.world.section("contacts"));
   const std::vector<BodyId> ids = w.body_ids();
   ASSERT_EQ(after.bodies.size(), before.bodies.size());
   for (std::size_t i = 0; i < ids.size(); ++i) {
@@ -373,10 +385,10 @@ TEST(StateHashes, EachPartHasItsOwnHash) {
     (void)w.rng().next_u64();
     const StateHashes h = w.hashes();
     EXPECT_NE(h.total, before.world.total);
-    EXPECT_NE(h.rng, before.world.rng);
-    EXPECT_EQ(h.globals, before.world.globals);
-    EXPECT_EQ(h.bodies, before.world.bodies);
-    EXPECT_EQ(h.contacts, before.world.contacts);
+    EXPECT_NE(h.section("rng"), before.world.section("rng"));
+    EXPECT_EQ(h.section("globals"), before.world.section("globals"));
+    EXPECT_EQ(h.section("bodies"), before.world.section("bodies"));
+    EXPECT_EQ(h.section("contacts"), before.world.section("contacts"));
   }
   {
     // The globals: creating and destroying a body leaves every body and contact as it was but
@@ -386,10 +398,10 @@ TEST(StateHashes, EachPartHasItsOwnHash) {
     ASSERT_TRUE(w.destroy_body(extra).ok());
     const HashSnapshot after = snapshot(w);
     EXPECT_NE(after.world.total, before.world.total);
-    EXPECT_NE(after.world.globals, before.world.globals);
-    EXPECT_EQ(after.world.rng, before.world.rng);
-    EXPECT_EQ(after.world.bodies, before.world.bodies);
-    EXPECT_EQ(after.world.contacts, before.world.contacts);
+    EXPECT_NE(after.world.section("globals"), before.world.section("globals"));
+    EXPECT_EQ(after.world.section("rng"), before.world.section("rng"));
+    EXPECT_EQ(after.world.section("bodies"), before.world.section("bodies"));
+    EXPECT_EQ(after.world.section("contacts"), before.world.section("contacts"));
     EXPECT_EQ(after.bodies, before.bodies);
   }
   {
@@ -405,17 +417,17 @@ TEST(StateHashes, EachPartHasItsOwnHash) {
     ASSERT_TRUE(st.ok()) << st.message();
     const HashSnapshot after = snapshot(w);
     EXPECT_NE(after.world.total, before.world.total);
-    EXPECT_NE(after.world.contacts, before.world.contacts);
-    EXPECT_EQ(after.world.globals, before.world.globals);
-    EXPECT_EQ(after.world.rng, before.world.rng);
-    EXPECT_EQ(after.world.bodies, before.world.bodies);
+    EXPECT_NE(after.world.section("contacts"), before.world.section("contacts"));
+    EXPECT_EQ(after.world.section("globals"), before.world.section("globals"));
+    EXPECT_EQ(after.world.section("rng"), before.world.section("rng"));
+    EXPECT_EQ(after.world.section("bodies"), before.world.section("bodies"));
     EXPECT_EQ(after.bodies, before.bodies);
   }
   {
     // A step changes the frame number at least.
     World w = base;
     w.step();
-    EXPECT_NE(w.hashes().globals, before.world.globals);
+    EXPECT_NE(w.hashes().section("globals"), before.world.section("globals"));
     EXPECT_NE(w.hashes().total, before.world.total);
   }
 }
@@ -479,7 +491,7 @@ TEST(StateHashes, IdenticalWorldsHashIdenticallyAndDifferentSeedsDiffer) {
   EXPECT_EQ(a.hashes(), b.hashes());
   const World c = played(41, 90);
   EXPECT_NE(a.hashes().total, c.hashes().total);
-  EXPECT_NE(a.hashes().rng, c.hashes().rng);
+  EXPECT_NE(a.hashes().section("rng"), c.hashes().section("rng"));
 }
 
 // ======================================================================================
@@ -542,7 +554,7 @@ TEST(CanonicalBytes, TheIdCounterIsPartOfTheState) {
   const BodyId extra = add(b, {.position = {50_fx, 50_fx, 50_fx}});
   ASSERT_TRUE(b.destroy_body(extra).ok());
   EXPECT_NE(a.save(), b.save());
-  EXPECT_EQ(a.hashes().bodies, b.hashes().bodies);
+  EXPECT_EQ(a.hashes().section("bodies"), b.hashes().section("bodies"));
   EXPECT_EQ(add(a, {}).value + 1, add(b, {}).value);
 }
 

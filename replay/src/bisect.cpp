@@ -393,7 +393,7 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
   };
   r.hashes_a = hashes_at(a, local_is_a, *divergent);
   r.hashes_b = hashes_at(b, local_is_b, *divergent);
-  if (r.hashes_a.globals != 0 && r.hashes_b.globals != 0)
+  if (!r.hashes_a.sections.empty() && !r.hashes_b.sections.empty())
     r.subsystems = differing_subsystems(r.hashes_a, r.hashes_b);
   for (std::uint64_t f = last_agreed;
        f < *divergent && r.inputs_between.size() < options.max_input_frames; ++f) {

@@ -29,6 +29,8 @@ inline constexpr std::uint32_t kChunkKeyframe = chunk_type("KEYF");
 inline constexpr std::uint32_t kChunkEnd = chunk_type("END ");
 
 inline constexpr std::uint32_t max_players = 64;
+/// The most state sections a fingerprint lists.
+inline constexpr std::size_t max_state_sections = 32;
 inline constexpr std::uint32_t max_input_size = 1024;
 
 /// 16 lowercase hex digits.
@@ -45,6 +47,6 @@ bool read_fingerprint(ByteReader& r, Fingerprint& f);
 void decode_inputs(std::span<const std::uint8_t> bytes, std::vector<PlayerInput>& out,
                    std::uint8_t gone = 0);
 void encode_hashes(const StateHashes& h, ByteWriter& w);
-StateHashes decode_hashes(ByteReader& r);
+StateHashes decode_hashes(ByteReader& r, const std::vector<std::string>& sections);
 
 }  // namespace detsim::replay::detail

@@ -49,6 +49,9 @@ void write_fingerprint(const Fingerprint& f, ByteWriter& w) {
   str(f.detsim_version);
   w.u32(f.fixed_fraction_bits);
   w.u32(f.state_version);
+  w.u8(static_cast<std::uint8_t>(f.state_sections.size()));
+  for (const std::string& name : f.state_sections)
+    str(name);
   str(f.scenario);
   w.u64(f.params.seed);
   w.u32(f.params.players);
@@ -75,6 +78,21 @@ bool read_fingerprint(ByteReader& r, Fingerprint& f) {
   f.detsim_version = str("detsim version");
   f.fixed_fraction_bits = r.u32("Fixed fraction bits");
   f.state_version = r.u32("state encoding version");
+  const std::size_t sections_at = r.offset();
+  const std::uint8_t sections = r.u8("state section count");
+  if (r.ok() && (sections == 0 || sections > max_state_sections))
+    r.fail_at(sections_at, "state section count", "1..32");
+  f.state_sections.clear();
+  for (std::uint8_t i = 0; i < sections && r.ok(); ++i) {
+    const std::size_t at = r.offset();
+    f.state_sections.push_back(str("state section name"));
+    if (r.ok() && !valid_section_name(f.state_sections.back()))
+      r.fail_at(at, "state section name", "1..32 bytes of a-z, 0-9, '_' and '.'");
+    for (std::size_t k = 0; r.ok() && k + 1 < f.state_sections.size(); ++k) {
+      if (f.state_sections[k] == f.state_sections.back())
+        r.fail_at(at, "state section name", "a name not listed before");
+    }
+  }
   f.scenario = str("scenario name");
   f.params.seed = r.u64("seed");
   f.params.players = r.u32("players parameter");
@@ -99,19 +117,16 @@ bool read_fingerprint(ByteReader& r, Fingerprint& f) {
 
 void encode_hashes(const StateHashes& h, ByteWriter& w) {
   w.u64(h.total);
-  w.u64(h.globals);
-  w.u64(h.rng);
-  w.u64(h.bodies);
-  w.u64(h.contacts);
+  for (const SectionHash& section : h.sections)
+    w.u64(section.hash);
 }
 
-StateHashes decode_hashes(ByteReader& r) {
+StateHashes decode_hashes(ByteReader& r, const std::vector<std::string>& sections) {
   StateHashes h;
   h.total = r.u64("frame hash");
-  h.globals = r.u64("globals hash");
-  h.rng = r.u64("RNG hash");
-  h.bodies = r.u64("bodies hash");
-  h.contacts = r.u64("contacts hash");
+  h.sections.reserve(sections.size());
+  for (const std::string& name : sections)
+    h.sections.push_back({name, r.u64("state section hash")});
   return h;
 }
 
@@ -236,6 +251,13 @@ Expected<ReplayWriter> ReplayWriter::create(const std::string& path,
     return Status::error(path + ": fingerprint: at most 64 players and 1024 bytes per input");
   if (fingerprint.keyframe_interval == 0)
     return Status::error(path + ": fingerprint: the keyframe interval must be at least 1");
+  if (fingerprint.state_sections.empty() || fingerprint.state_sections.size() > max_state_sections)
+    return Status::error(path + ": fingerprint: the state has 1 to 32 sections, listed " +
+                         std::to_string(fingerprint.state_sections.size()));
+  for (const std::string& name : fingerprint.state_sections) {
+    if (!valid_section_name(name))
+      return Status::error(path + ": fingerprint: \"" + name + "\" is not a section name");
+  }
   if (fingerprint.detsim_version.size() > 255 || fingerprint.scenario.size() > 255)
     return Status::error(path + ": fingerprint: names are at most 255 bytes");
   auto impl = std::make_unique<Impl>();
@@ -264,6 +286,17 @@ Status ReplayWriter::frame(std::span<const std::uint8_t> inputs, const StateHash
         "frame " + std::to_string(m.frames + 1) + ": expected " + std::to_string(expected) +
         " input bytes (" + std::to_string(m.fingerprint.players) + " players x " +
         std::to_string(m.fingerprint.input_size) + "), got " + std::to_string(inputs.size()));
+  const std::vector<std::string>& sections = m.fingerprint.state_sections;
+  bool same_sections = hashes.sections.size() == sections.size();
+  for (std::size_t i = 0; same_sections && i < sections.size(); ++i)
+    same_sections = hashes.sections[i].name == sections[i];
+  if (!same_sections) {
+    std::string got;
+    for (const SectionHash& h : hashes.sections)
+      got += (got.empty() ? "" : ", ") + h.name;
+    return m.fail("frame " + std::to_string(m.frames + 1) + ": the state's sections (" + got +
+                  ") are not the fingerprint's");
+  }
   m.pending.raw(inputs);
   encode_hashes(hashes, m.pending);
   ++m.pending_count;
@@ -332,8 +365,13 @@ struct ReplayReader::Impl {
   std::uint64_t ignored = 0;
   std::string tail_note;
 
-  [[nodiscard]] std::size_t record_size() const noexcept {
-    return std::size_t{fingerprint.players} * fingerprint.input_size + 40;
+  [[nodiscard]] std::size_t record_size() const noexcept { return input_bytes() + hash_bytes(); }
+  [[nodiscard]] std::size_t input_bytes() const noexcept {
+    return std::size_t{fingerprint.players} * fingerprint.input_size;
+  }
+  /// The state's hash, then one per section.
+  [[nodiscard]] std::size_t hash_bytes() const noexcept {
+    return 8 * (1 + fingerprint.state_sections.size());
   }
 
   Status error_at(std::uint64_t offset, const std::string& what) const {
@@ -576,7 +614,7 @@ Status ReplayReader::for_each_frame(std::uint64_t first, std::uint64_t last,
   auto it = std::lower_bound(
       m.chunks.begin(), m.chunks.end(), first,
       [](const FrameChunk& c, std::uint64_t f) { return c.first + c.count - 1 < f; });
-  const std::size_t input_bytes = m.record_size() - 40;
+  const std::size_t input_bytes = m.input_bytes();
   FrameRecord record;
   for (; it != m.chunks.end() && it->first <= last; ++it) {
     auto payload = m.read_chunk(it->offset, kChunkFrames, it->length);
@@ -587,7 +625,7 @@ Status ReplayReader::for_each_frame(std::uint64_t first, std::uint64_t last,
     for (std::uint32_t i = 0; i < it->count; ++i) {
       record.frame = it->first + i;
       const auto inputs = r.raw(input_bytes, "inputs");
-      record.hashes = decode_hashes(r);
+      record.hashes = decode_hashes(r, m.fingerprint.state_sections);
       if (!r.ok())
         return m.error_at(it->offset + 8 + r.error_offset(), "frames: " + r.error_detail());
       if (record.frame < first) continue;

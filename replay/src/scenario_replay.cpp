@@ -113,7 +113,10 @@ Fingerprint fingerprint_of(const Scenario& scenario, std::uint32_t keyframe_inte
   f.players = scenario.params().players;
   f.input_size = PlayerInput::encoded_size;
   f.keyframe_interval = keyframe_interval;
-  f.initial_hash = scenario.world().hashes().total;
+  const StateHashes initial = scenario.world().hashes();
+  f.initial_hash = initial.total;
+  for (const SectionHash& h : initial.sections)
+    f.state_sections.push_back(h.name);
   return f;
 }
 

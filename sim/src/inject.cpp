@@ -10,18 +10,53 @@
 #include <detsim/fixed/decimal.hpp>
 #include <detsim/fixed/quat.hpp>
 
+#include "body_fields.hpp"
 #include "shapes.hpp"
+#include "state_io.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
 namespace {
 
-constexpr std::string_view kFieldsHelp =
-    "position.x|y|z, orientation.w|x|y|z, linear_velocity.x|y|z, angular_velocity.x|y|z, "
-    "force.x|y|z, torque.x|y|z, sleep_time (DELTA a decimal, added); awake (DELTA 1 toggles); "
-    "user_data (DELTA an integer, added); present (DELTA -1 removes BODY, +1 adds a static copy of "
-    "its shape 1000 m above); rng.state[0..3] (BODY 0, DELTA an integer, added mod 2^64); "
-    "contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2 (DELTA a decimal)";
+/// The field forms, for errors and --help: the body's motion fields from the field table, then
+/// the forms that are not body fields. Built once.
+const std::string& fields_help() {
+  static const std::string help = [] {
+    using sim_detail::FieldKind;
+    std::string decimal, toggle, integer;
+    const auto append = [](std::string& list, const std::string& form) {
+      list += (list.empty() ? "" : ", ") + form;
+    };
+    for (const sim_detail::BodyField& f : sim_detail::body_fields()) {
+      if (f.group != sim_detail::FieldGroup::motion) continue;
+      const std::string name = f.name;
+      switch (f.kind) {
+        case FieldKind::vec3:
+          append(decimal, name + ".x|y|z");
+          break;
+        case FieldKind::quat:
+          append(decimal, name + ".w|x|y|z");
+          break;
+        case FieldKind::fixed:
+          append(decimal, name);
+          break;
+        case FieldKind::flag:
+          append(toggle, name);
+          break;
+        case FieldKind::u32:
+        case FieldKind::u64:
+          append(integer, name);
+          break;
+      }
+    }
+    return decimal + " (DELTA a decimal, added); " + toggle + " (DELTA 1 toggles); " + integer +
+           " (DELTA an integer, added); present (DELTA -1 removes BODY, +1 adds a static copy of "
+           "its shape 1000 m above); rng.state[0..3] (BODY 0, DELTA an integer, added mod 2^64); "
+           "contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2 (DELTA a "
+           "decimal)";
+  }();
+  return help;
+}
 
 enum class DeltaKind { fixed, toggle, integer, presence };
 
@@ -68,8 +103,7 @@ std::optional<std::uint64_t> indexed(std::string_view text, std::string_view pre
 Expected<Target> parse_field(std::string_view field) {
   Target t;
   const auto unknown = [&] {
-    return Status::error("unknown field \"" + std::string(field) +
-                         "\"; fields: " + std::string(kFieldsHelp));
+    return Status::error("unknown field \"" + std::string(field) + "\"; fields: " + fields_help());
   };
   if (field.starts_with("rng.")) {
     std::string_view rest;
@@ -96,30 +130,31 @@ Expected<Target> parse_field(std::string_view field) {
     t.base = std::string(name);
     return t;
   }
-  if (field == "sleep_time") {
-    t.base = "sleep_time";
+  if (field == "present") {
+    t.base = "present";
+    t.kind = DeltaKind::presence;
     return t;
   }
-  if (field == "awake" || field == "user_data" || field == "present") {
-    t.base = std::string(field);
-    t.kind = field == "awake"       ? DeltaKind::toggle
-             : field == "user_data" ? DeltaKind::integer
-                                    : DeltaKind::presence;
-    return t;
-  }
+  // A motion field of the body table (body_fields.hpp), whole or one component of it.
+  std::string_view base = field;
+  int component = -1;
   const std::size_t dot = field.rfind('.');
-  if (dot == std::string_view::npos || dot + 2 != field.size()) return unknown();
-  t.base = std::string(field.substr(0, dot));
-  const char c = field.back();
-  const bool vector = t.base == "position" || t.base == "linear_velocity" ||
-                      t.base == "angular_velocity" || t.base == "force" || t.base == "torque";
-  if (vector && c >= 'x' && c <= 'z') {
-    t.component = c - 'x';
-  } else if (t.base == "orientation" && (c == 'w' || (c >= 'x' && c <= 'z'))) {
-    t.component = c == 'w' ? 3 : c - 'x';
-  } else {
-    return unknown();
+  if (dot != std::string_view::npos && dot + 2 == field.size()) {
+    const char c = field.back();
+    base = field.substr(0, dot);
+    component = c == 'w' ? 3 : c >= 'x' && c <= 'z' ? c - 'x' : -2;
   }
+  const sim_detail::BodyField* f = sim_detail::find_body_field(base);
+  if (f == nullptr || f->group != sim_detail::FieldGroup::motion) return unknown();
+  using sim_detail::FieldKind;
+  const bool whole = f->kind != FieldKind::vec3 && f->kind != FieldKind::quat;
+  if (whole ? component != -1 : component < 0 || (f->kind == FieldKind::vec3 && component == 3))
+    return unknown();
+  t.base = f->name;
+  t.component = component;
+  t.kind = f->kind == FieldKind::flag                               ? DeltaKind::toggle
+           : f->kind == FieldKind::u64 || f->kind == FieldKind::u32 ? DeltaKind::integer
+                                                                    : DeltaKind::fixed;
   return t;
 }
 
@@ -152,30 +187,32 @@ Fixed& field_ref(Quat& q, int c) {
   return c == 0 ? q.x : c == 1 ? q.y : c == 2 ? q.z : q.w;
 }
 
+// Changes a copy of the body's field, then checks it as restore() would.
 Status change_body(BodyState& b, const Target& t, std::string_view delta) {
-  const Fixed d = Fixed::parse(delta).value;
-  if (t.base == "position") field_ref(b.position, t.component) += d;
-  if (t.base == "linear_velocity") field_ref(b.linear_velocity, t.component) += d;
-  if (t.base == "angular_velocity") field_ref(b.angular_velocity, t.component) += d;
-  if (t.base == "force") field_ref(b.force, t.component) += d;
-  if (t.base == "torque") field_ref(b.torque, t.component) += d;
-  if (t.base == "orientation") {
-    field_ref(b.orientation, t.component) += d;
-    if (auto e = sim_detail::check_orientation(b.orientation); !e.empty())
-      return Status::error("the change would leave an invalid state: " + e);
+  const sim_detail::BodyField& f = *sim_detail::find_body_field(t.base);
+  switch (f.kind) {
+    case sim_detail::FieldKind::fixed:
+      b.*f.fixed += Fixed::parse(delta).value;
+      break;
+    case sim_detail::FieldKind::vec3:
+      field_ref(b.*f.vec3, t.component) += Fixed::parse(delta).value;
+      break;
+    case sim_detail::FieldKind::quat:
+      field_ref(b.*f.quat, t.component) += Fixed::parse(delta).value;
+      break;
+    case sim_detail::FieldKind::u32:
+      b.*f.u32 += static_cast<std::uint32_t>(*parse_i64(delta));  // modulo 2^32
+      break;
+    case sim_detail::FieldKind::u64:
+      b.*f.u64 += static_cast<std::uint64_t>(*parse_i64(delta));  // modulo 2^64
+      break;
+    case sim_detail::FieldKind::flag:
+      b.*f.flag = !(b.*f.flag);
+      break;
   }
-  if (t.base == "sleep_time") {
-    b.sleep_time += d;
-    if (b.sleep_time < Fixed::zero())
-      return Status::error("the change would leave a negative sleep time");
-  }
-  if (t.base == "awake") {
-    if (b.type == BodyType::static_body)
-      return Status::error("body " + std::to_string(b.id.value) + " is static: it cannot be awake");
-    b.awake = !b.awake;
-  }
-  if (t.base == "user_data")
-    b.user_data += static_cast<std::uint64_t>(*parse_i64(delta));  // modulo 2^64
+  if (auto e = sim_detail::check_body_record(b); !e.empty())
+    return Status::error("body " + std::to_string(b.id.value) +
+                         ": the change would leave an invalid state: " + e);
   return Status::success();
 }
 
@@ -217,7 +254,7 @@ Status apply_injections(World& world, std::span<const Injection> injections) {
 }
 
 std::string_view injection_fields_help() noexcept {
-  return kFieldsHelp;
+  return fields_help();
 }
 
 Expected<Injection> parse_injection(std::string_view spec) {

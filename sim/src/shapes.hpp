@@ -17,11 +17,11 @@
 #include <span>
 #include <string>
 
+#include <detsim/core/bytes.hpp>
 #include <detsim/fixed/mat3.hpp>
 #include <detsim/fixed/quat.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
-#include <detsim/core/bytes.hpp>
 #include <detsim/sim/mass.hpp>
 #include <detsim/sim/shape.hpp>
 #include <detsim/sim/shape_outline.hpp>

@@ -1,12 +1,15 @@
 // Field-level state comparison (state_diff.hpp). Both states are restored into scratch worlds
-// (so both are fully validated) and compared through the public body accessors, field by field in
-// the order BodyState declares them; contacts pair by pair (World::contacts()), point by point.
+// (so both are fully validated); each section whose hash differs is compared by its differ
+// (kDiffers): bodies field by field through the field table (body_fields.hpp), contacts pair by
+// pair (World::contacts()), point by point. A section without a differ is named by its hashes.
 #include <detsim/sim/state_diff.hpp>
 
 #include <algorithm>
 #include <cstdio>
 
 #include <detsim/fixed/decimal.hpp>
+
+#include "body_fields.hpp"
 
 namespace detsim {
 namespace {
@@ -72,29 +75,33 @@ class Collector {
   std::size_t max_;
 };
 
+// Every field of the table (body_fields.hpp), in its order: a new field is diffed by being listed.
 void diff_body(Collector& c, const BodyState& a, const BodyState& b) {
   const std::uint32_t id = a.id.value;
   if (a.type != b.type) c.add("bodies", id, "type", show(a.type), show(b.type));
   if (!(a.shape == b.shape)) c.add("bodies", id, "shape", "(differs)", "(differs)");
-  c.vec(id, "position", a.position, b.position);
-  c.quat(id, "orientation", a.orientation, b.orientation);
-  c.vec(id, "linear_velocity", a.linear_velocity, b.linear_velocity);
-  c.vec(id, "angular_velocity", a.angular_velocity, b.angular_velocity);
-  c.field(id, "mass", a.mass, b.mass);
-  c.vec(id, "inertia", a.inertia, b.inertia);
-  c.field(id, "friction", a.friction, b.friction);
-  c.field(id, "restitution", a.restitution, b.restitution);
-  c.field(id, "linear_damping", a.linear_damping, b.linear_damping);
-  c.field(id, "angular_damping", a.angular_damping, b.angular_damping);
-  c.field(id, "layer", std::uint64_t{a.layer}, std::uint64_t{b.layer});
-  c.field(id, "mask", std::uint64_t{a.mask}, std::uint64_t{b.mask});
-  c.field(id, "sensor", a.sensor, b.sensor);
-  c.field(id, "ccd", a.ccd, b.ccd);
-  c.field(id, "user_data", a.user_data, b.user_data);
-  c.field(id, "awake", a.awake, b.awake);
-  c.field(id, "sleep_time", a.sleep_time, b.sleep_time);
-  c.vec(id, "force", a.force, b.force);
-  c.vec(id, "torque", a.torque, b.torque);
+  for (const sim_detail::BodyField& f : sim_detail::body_fields()) {
+    switch (f.kind) {
+      case sim_detail::FieldKind::fixed:
+        c.field(id, f.name, a.*f.fixed, b.*f.fixed);
+        break;
+      case sim_detail::FieldKind::vec3:
+        c.vec(id, f.name, a.*f.vec3, b.*f.vec3);
+        break;
+      case sim_detail::FieldKind::quat:
+        c.quat(id, f.name, a.*f.quat, b.*f.quat);
+        break;
+      case sim_detail::FieldKind::u32:
+        c.field(id, f.name, std::uint64_t{a.*f.u32}, std::uint64_t{b.*f.u32});
+        break;
+      case sim_detail::FieldKind::u64:
+        c.field(id, f.name, a.*f.u64, b.*f.u64);
+        break;
+      case sim_detail::FieldKind::flag:
+        c.field(id, f.name, a.*f.flag, b.*f.flag);
+        break;
+    }
+  }
 }
 
 std::string contact_name(const ContactState& c) {
@@ -143,14 +150,89 @@ void diff_contacts(Collector& c, const std::vector<ContactState>& ca,
   }
 }
 
+// ---- Sections: each a differ that lists its fields; any other section is named by its hash ----
+
+struct Sides {
+  const World& a;
+  const World& b;
+};
+
+void diff_globals(Collector& c, const Sides& w) {
+  if (w.a.frame() != w.b.frame())
+    c.add("globals", 0, "frame", show(w.a.frame()), show(w.b.frame()));
+  if (!(w.a.def() == w.b.def())) c.add("globals", 0, "world definition", "(differs)", "(differs)");
+}
+
+void diff_rng(Collector& c, const Sides& w) {
+  const Rng::State& ra = w.a.rng().state();
+  const Rng::State& rb = w.b.rng().state();
+  for (std::size_t i = 0; i < ra.size(); ++i)
+    if (ra[i] != rb[i])
+      c.add("rng", 0, "state[" + std::to_string(i) + "]", show(ra[i]), show(rb[i]));
+}
+
+// A merge of both ascending ID lists.
+void diff_bodies(Collector& c, const Sides& w) {
+  const std::vector<BodyId> ia = w.a.body_ids();
+  const std::vector<BodyId> ib = w.b.body_ids();
+  std::size_t i = 0;
+  std::size_t j = 0;
+  while (i < ia.size() || j < ib.size()) {
+    if (j == ib.size() || (i < ia.size() && ia[i].value < ib[j].value)) {
+      c.add("bodies", ia[i].value, "present", "present", "absent");
+      ++i;
+    } else if (i == ia.size() || ib[j].value < ia[i].value) {
+      c.add("bodies", ib[j].value, "present", "absent", "present");
+      ++j;
+    } else {
+      diff_body(c, w.a.body(ia[i]).value(), w.b.body(ib[j]).value());
+      ++i;
+      ++j;
+    }
+  }
+}
+
+void diff_contact_cache(Collector& c, const Sides& w) {
+  diff_contacts(c, w.a.contacts(), w.b.contacts());
+}
+
+struct SectionDiffer {
+  std::string_view name;
+  void (*diff)(Collector& c, const Sides& w);
+};
+
+/// A new section of the World's state adds its differ here.
+constexpr SectionDiffer kDiffers[] = {
+    {"globals", diff_globals},
+    {"rng", diff_rng},
+    {"bodies", diff_bodies},
+    {"contacts", diff_contact_cache},
+};
+
+/// Every section name of either side: A's in order, then those only B has.
+std::vector<std::string> section_names(const StateHashes& a, const StateHashes& b) {
+  std::vector<std::string> names;
+  for (const SectionHash& h : a.sections)
+    names.push_back(h.name);
+  for (const SectionHash& h : b.sections)
+    if (std::find(names.begin(), names.end(), h.name) == names.end()) names.push_back(h.name);
+  return names;
+}
+
 }  // namespace
 
 std::vector<std::string> differing_subsystems(const StateHashes& a, const StateHashes& b) {
   std::vector<std::string> out;
-  if (a.globals != b.globals) out.emplace_back("globals");
-  if (a.rng != b.rng) out.emplace_back("rng");
-  if (a.bodies != b.bodies) out.emplace_back("bodies");
-  if (a.contacts != b.contacts) out.emplace_back("contacts");
+  for (const std::string& name : section_names(a, b)) {
+    const auto hash_of = [&](const StateHashes& h) -> const SectionHash* {
+      for (const SectionHash& s : h.sections)
+        if (s.name == name) return &s;
+      return nullptr;
+    };
+    const SectionHash* ha = hash_of(a);
+    const SectionHash* hb = hash_of(b);
+    if (ha == nullptr || hb == nullptr || ha->hash != hb->hash) out.push_back(name);
+  }
   return out;
 }
 
@@ -167,51 +249,22 @@ Expected<StateDiff> diff_states(std::span<const std::uint8_t> a, std::span<const
   out.frame_b = wb.frame();
   Collector c(out, max_fields);
 
-  // The count is saved with the bodies, not the globals: listed whichever part's hash differs.
-  const std::size_t before = out.fields.size() + out.omitted;
+  // The count is saved with the bodies, not the globals, but it is a global fact: listed first,
+  // whichever section's hash differs, and as a line of the globals section.
+  const std::size_t start = out.fields.size() + out.omitted;
   if (wa.body_count() != wb.body_count())
     c.add("globals", 0, "body count", show(std::uint64_t{wa.body_count()}),
           show(std::uint64_t{wb.body_count()}));
-  if (out.a.globals != out.b.globals) {
-    if (wa.frame() != wb.frame()) c.add("globals", 0, "frame", show(wa.frame()), show(wb.frame()));
-    if (!(wa.def() == wb.def())) c.add("globals", 0, "world definition", "(differs)", "(differs)");
-    // Otherwise a global without an accessor differs (the next body ID): name the part's hashes.
-    if (out.fields.size() + out.omitted == before)
-      c.add("globals", 0, "hash", show(out.a.globals), show(out.b.globals));
-  }
-  const Rng::State& ra = wa.rng().state();
-  const Rng::State& rb = wb.rng().state();
-  for (std::size_t i = 0; i < ra.size(); ++i)
-    if (ra[i] != rb[i])
-      c.add("rng", 0, "state[" + std::to_string(i) + "]", show(ra[i]), show(rb[i]));
-
-  // Bodies: a merge of both ascending ID lists.
-  const std::size_t before_bodies = out.fields.size() + out.omitted;
-  const std::vector<BodyId> ia = wa.body_ids();
-  const std::vector<BodyId> ib = wb.body_ids();
-  std::size_t i = 0;
-  std::size_t j = 0;
-  while (i < ia.size() || j < ib.size()) {
-    if (j == ib.size() || (i < ia.size() && ia[i].value < ib[j].value)) {
-      c.add("bodies", ia[i].value, "present", "present", "absent");
-      ++i;
-    } else if (i == ia.size() || ib[j].value < ia[i].value) {
-      c.add("bodies", ib[j].value, "present", "absent", "present");
-      ++j;
-    } else {
-      diff_body(c, wa.body(ia[i]).value(), wb.body(ib[j]).value());
-      ++i;
-      ++j;
+  const Sides sides{wa, wb};
+  for (const std::string& name : differing_subsystems(out.a, out.b)) {
+    const std::size_t before = name == "globals" ? start : out.fields.size() + out.omitted;
+    for (const SectionDiffer& d : kDiffers) {
+      if (d.name == name) d.diff(c, sides);
     }
-  }
-  // A body's encoding may hold more than BodyState shows: name the part's hashes then.
-  if (out.a.bodies != out.b.bodies && out.fields.size() + out.omitted == before_bodies)
-    c.add("bodies", 0, "hash", show(out.a.bodies), show(out.b.bodies));
-  if (out.a.contacts != out.b.contacts) {
-    const std::size_t before_contacts = out.fields.size() + out.omitted;
-    diff_contacts(c, wa.contacts(), wb.contacts());
-    if (out.fields.size() + out.omitted == before_contacts)
-      c.add("contacts", 0, "cache", show(out.a.contacts), show(out.b.contacts));
+    // A section may hold more than its accessors show (the next body ID, a contact's manifold
+    // flags): name the section's hashes then.
+    if (out.fields.size() + out.omitted == before)
+      c.add(name.c_str(), 0, "hash", show(out.a.section(name)), show(out.b.section(name)));
   }
   return out;
 }

@@ -1,10 +1,12 @@
-// An independent codec of the v2 world-state layout (docs/STATE.md), for the world-state tests
+// An independent codec of the v3 world-state layout (docs/STATE.md), for the world-state tests
 // (support/state_helpers.hpp includes it).
 //
 // Written from docs/STATE.md, not from state_io.cpp, so that the two can disagree. In brief:
-//   "DSIM" u32 version=2 | u64 frame | u32 next ID | definition (fixed width) | 4 x u64 RNG |
-//   u32 property-set count, sets in first-use order | u32 body count, bodies ascending by ID |
-//   u32 contact count, contacts ascending by (a, b).
+//   "DSIM" u32 version=3 | var section count (4) | four sections, each: var name length, name,
+//   var section version (1), u32 payload length, payload. The payloads, in this order:
+//   globals: u64 frame | u32 next ID | definition (fixed width);  rng: 4 x u64;
+//   bodies: u32 property-set count, sets in first-use order | u32 body count, bodies ascending by
+//   ID;  contacts: u32 contact count, contacts ascending by (a, b).
 // `var` is canonical LEB128 (at most 5 bytes for a 32-bit field, 10 for a 64-bit one); `vfixed` a
 // var of the zigzag raw value. A set: type u8, shape (type u8, then its vfixed sizes), mass,
 // inertia, friction, restitution, linear and angular damping (vfixed), layer u32, mask u32, flags
@@ -22,6 +24,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -39,7 +42,10 @@ namespace detsim::state_test {
 using Bytes = std::vector<std::uint8_t>;
 
 inline constexpr std::uint32_t kStateMagic = 0x4D495344U;
-inline constexpr std::uint32_t kStateVersion = 2;
+inline constexpr std::uint32_t kStateVersion = 3;
+/// A World's sections, in their order, each at version 1.
+inline constexpr const char* kSectionNames[] = {"globals", "rng", "bodies", "contacts"};
+inline constexpr std::uint32_t kSectionVersion = 1;
 
 // Body flags.
 inline constexpr std::uint8_t kAwake = 1;
@@ -225,8 +231,12 @@ struct Decoded {
   std::vector<DecodedSet> sets;
   std::vector<DecodedBody> bodies;
   std::vector<DecodedContact> contacts;
-  // Offsets, filled by decode():
-  std::size_t globals_at = 0;  // = 8: the frame
+  // Offsets, filled by decode(): of each section's record (its name length), its u32 payload
+  // length and its payload, in kSectionNames' order; then of the payloads' fields.
+  std::array<std::size_t, 4> section_at{};
+  std::array<std::size_t, 4> section_length_at{};
+  std::array<std::size_t, 4> payload_at{};
+  std::size_t globals_at = 0;  // the frame
   std::size_t next_id_at = 0;
   std::size_t def_at = 0;
   std::size_t rng_at = 0;
@@ -499,40 +509,72 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
   if (r.ok() && d.magic != kStateMagic) r.fail(0, "magic");
   d.version = r.u32("version");
   if (r.ok() && d.version != kStateVersion) r.fail(4, "version");
-  d.globals_at = r.at();
-  d.frame = r.u64("frame");
-  d.next_id_at = r.at();
-  d.next_id = r.u32("next ID");
-  d.def_at = r.at();
-  d.def = read_definition(r);
-  d.rng_at = r.at();
-  for (std::uint64_t& word : d.rng)
-    word = r.u64("rng");
-
-  d.property_count_at = r.at();
-  const std::uint32_t set_count = r.u32("property-set count");
-  for (std::uint32_t i = 0; i < set_count && r.ok(); ++i) {
-    const DecodedSet s = read_set(r);
-    for (const DecodedSet& other : d.sets) {
-      if (r.ok() && same_properties(s, other)) r.fail(s.at, "property set: a duplicate");
+  const std::size_t count_at = r.at();
+  const std::uint64_t sections = r.var("section count", 64);
+  if (r.ok() && sections != 4) r.fail(count_at, "section count: not 4");
+  for (std::size_t i = 0; i < 4 && r.ok(); ++i) {
+    // The section's record: its name, its version, its payload's length; the payload must end
+    // exactly where the length says.
+    d.section_at[i] = r.at();
+    const std::uint64_t name_size = r.var("section name length", 64);
+    std::string name;
+    for (std::uint64_t k = 0; k < name_size && r.ok() && k < 64; ++k)
+      name += static_cast<char>(r.u8("section name"));
+    if (r.ok() && name != kSectionNames[i])
+      r.fail(d.section_at[i], std::string("section name: not ") + kSectionNames[i]);
+    const std::size_t version_at = r.at();
+    if (r.var("section version", 32) != kSectionVersion && r.ok())
+      r.fail(version_at, "section version");
+    d.section_length_at[i] = r.at();
+    const std::uint32_t length = r.u32("section length");
+    d.payload_at[i] = r.at();
+    if (!r.ok()) break;
+    switch (i) {
+      case 0:
+        d.globals_at = r.at();
+        d.frame = r.u64("frame");
+        d.next_id_at = r.at();
+        d.next_id = r.u32("next ID");
+        d.def_at = r.at();
+        d.def = read_definition(r);
+        break;
+      case 1:
+        d.rng_at = r.at();
+        for (std::uint64_t& word : d.rng)
+          word = r.u64("rng");
+        break;
+      case 2: {
+        d.property_count_at = r.at();
+        const std::uint32_t set_count = r.u32("property-set count");
+        for (std::uint32_t k = 0; k < set_count && r.ok(); ++k) {
+          const DecodedSet s = read_set(r);
+          for (const DecodedSet& other : d.sets) {
+            if (r.ok() && same_properties(s, other)) r.fail(s.at, "property set: a duplicate");
+          }
+          d.sets.push_back(s);
+        }
+        d.body_count_at = r.at();
+        const std::uint32_t body_count = r.u32("body count");
+        std::uint64_t previous_id = 0;
+        std::size_t used = 0;
+        for (std::uint32_t k = 0; k < body_count && r.ok(); ++k)
+          read_body(r, d, previous_id, used);
+        if (r.ok() && used != d.sets.size()) r.fail(d.property_count_at, "property set: unused");
+        break;
+      }
+      default: {
+        d.contact_count_at = r.at();
+        const std::uint32_t contact_count = r.u32("contact count");
+        std::uint64_t previous_a = 0;
+        std::uint64_t previous_b = 0;
+        for (std::uint32_t k = 0; k < contact_count && r.ok(); ++k)
+          read_contact(r, d, previous_a, previous_b);
+        break;
+      }
     }
-    d.sets.push_back(s);
+    if (r.ok() && r.at() != d.payload_at[i] + length)
+      r.fail(d.section_length_at[i], "section length: not where the payload ends");
   }
-
-  d.body_count_at = r.at();
-  const std::uint32_t body_count = r.u32("body count");
-  std::uint64_t previous_id = 0;
-  std::size_t used = 0;
-  for (std::uint32_t i = 0; i < body_count && r.ok(); ++i)
-    read_body(r, d, previous_id, used);
-  if (r.ok() && used != d.sets.size()) r.fail(d.property_count_at, "property set: unused");
-
-  d.contact_count_at = r.at();
-  const std::uint32_t contact_count = r.u32("contact count");
-  std::uint64_t previous_a = 0;
-  std::uint64_t previous_b = 0;
-  for (std::uint32_t i = 0; i < contact_count && r.ok(); ++i)
-    read_contact(r, d, previous_a, previous_b);
 
   d.end = r.at();
   if (r.ok() && !r.at_end()) r.fail(r.at(), "trailing bytes");
@@ -630,42 +672,74 @@ inline void write_contact(StateWriter& w, const DecodedContact& c) {
   }
 }
 
-/// The v2 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
-/// sizes of the vectors).
+/// The v3 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
+/// sizes of the vectors, the section lengths those of the payloads written).
 inline Bytes encode(const Decoded& d) {
-  StateWriter w;
-  w.u32(d.magic);
-  w.u32(d.version);
-  w.u64(d.frame);
-  w.u32(d.next_id);
+  StateWriter payloads[4];
+  StateWriter& globals = payloads[0];
+  globals.u64(d.frame);
+  globals.u32(d.next_id);
   const WorldDef& def = d.def;
-  w.fixed(def.gravity.x);
-  w.fixed(def.gravity.y);
-  w.fixed(def.gravity.z);
-  w.fixed(def.dt);
-  w.u32(def.substeps);
-  w.u32(def.iterations);
-  w.u64(def.seed);
+  globals.fixed(def.gravity.x);
+  globals.fixed(def.gravity.y);
+  globals.fixed(def.gravity.z);
+  globals.fixed(def.dt);
+  globals.u32(def.substeps);
+  globals.u32(def.iterations);
+  globals.u64(def.seed);
   for (const Fixed f :
        {def.max_linear_speed, def.max_angular_speed, def.contact_hertz, def.contact_damping_ratio,
         def.contact_push_max, def.restitution_threshold, def.linear_slop, def.speculative_distance})
-    w.fixed(f);
-  w.u8(def.enable_sleep ? 1 : 0);
-  w.fixed(def.sleep_linear_speed);
-  w.fixed(def.sleep_angular_speed);
-  w.fixed(def.time_to_sleep);
+    globals.fixed(f);
+  globals.u8(def.enable_sleep ? 1 : 0);
+  globals.fixed(def.sleep_linear_speed);
+  globals.fixed(def.sleep_angular_speed);
+  globals.fixed(def.time_to_sleep);
   for (const std::uint64_t word : d.rng)
-    w.u64(word);
-  w.u32(static_cast<std::uint32_t>(d.sets.size()));
+    payloads[1].u64(word);
+  payloads[2].u32(static_cast<std::uint32_t>(d.sets.size()));
   for (const DecodedSet& s : d.sets)
-    write_set(w, s);
-  w.u32(static_cast<std::uint32_t>(d.bodies.size()));
+    write_set(payloads[2], s);
+  payloads[2].u32(static_cast<std::uint32_t>(d.bodies.size()));
   for (const DecodedBody& b : d.bodies)
-    write_body(w, b);
-  w.u32(static_cast<std::uint32_t>(d.contacts.size()));
+    write_body(payloads[2], b);
+  payloads[3].u32(static_cast<std::uint32_t>(d.contacts.size()));
   for (const DecodedContact& c : d.contacts)
-    write_contact(w, c);
+    write_contact(payloads[3], c);
+
+  StateWriter w;
+  w.u32(d.magic);
+  w.u32(d.version);
+  w.var(4);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const std::string name = kSectionNames[i];
+    w.var(name.size());
+    for (const char c : name)
+      w.u8(static_cast<std::uint8_t>(c));
+    w.var(kSectionVersion);
+    const Bytes payload = payloads[i].take();
+    w.u32(static_cast<std::uint32_t>(payload.size()));
+    for (const std::uint8_t b : payload)
+      w.u8(b);
+  }
   return w.take();
+}
+
+/// After a test changed the length of a payload in place (a var made longer, bytes cut), the
+/// section lengths that `before` (decoded from the bytes before the change) recorded, adjusted by
+/// `delta` bytes for the section that holds byte `at`.
+inline void adjust_section_length(Bytes& bytes, const Decoded& before, std::size_t at,
+                                  std::ptrdiff_t delta) {
+  for (std::size_t i = 4; i-- > 0;) {
+    if (at < before.payload_at[i]) continue;
+    const std::size_t length_at = before.section_length_at[i];
+    std::uint32_t length = 0;
+    for (std::size_t k = 0; k < 4; ++k)
+      length |= static_cast<std::uint32_t>(bytes[length_at + k]) << (8 * k);
+    put_u32(bytes, length_at,
+            static_cast<std::uint32_t>(static_cast<std::ptrdiff_t>(length) + delta));
+    return;
+  }
 }
 
 inline Bytes encode_set(const DecodedSet& s) {

@@ -59,8 +59,9 @@ inline std::atomic<std::size_t> g_largest_allocation{0};
 namespace detsim {
 
 inline void PrintTo(const StateHashes& h, std::ostream* os) {
-  *os << std::hex << "{total 0x" << h.total << ", globals 0x" << h.globals << ", rng 0x" << h.rng
-      << ", bodies 0x" << h.bodies << ", contacts 0x" << h.contacts << "}" << std::dec;
+  *os << std::hex << "{total 0x" << h.total << ", globals 0x" << h.section("globals") << ", rng 0x"
+      << h.section("rng") << ", bodies 0x" << h.section("bodies") << ", contacts 0x"
+      << h.section("contacts") << "}" << std::dec;
 }
 
 namespace state_test {

@@ -17,13 +17,11 @@ namespace detsim::cli {
 namespace {
 
 std::string hashes_json(const StateHashes& h) {
-  return Json()
-      .hash("total", h.total)
-      .hash("globals", h.globals)
-      .hash("rng", h.rng)
-      .hash("bodies", h.bodies)
-      .hash("contacts", h.contacts)
-      .text();
+  Json json;
+  json.hash("total", h.total);
+  for (const SectionHash& section : h.sections)
+    json.hash(section.name, section.hash);
+  return json.text();
 }
 
 std::string describe(const replay::Fingerprint& f) {

@@ -78,6 +78,13 @@ class ByteWriter {
     bytes_.insert(bytes_.end(), data.begin(), data.end());
   }
 
+  /// Overwrites the four bytes at `at` (written before) with `v`: a length known only after what
+  /// it counts has been written.
+  void patch_u32(std::size_t at, std::uint32_t v) noexcept {
+    for (std::size_t i = 0; i < 4; ++i)
+      bytes_[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+  }
+
   [[nodiscard]] const std::vector<std::uint8_t>& bytes() const noexcept { return bytes_; }
   [[nodiscard]] std::vector<std::uint8_t> take() noexcept { return std::move(bytes_); }
   [[nodiscard]] std::size_t size() const noexcept { return bytes_.size(); }
@@ -100,6 +107,10 @@ class ByteWriter {
 class ByteReader {
  public:
   explicit ByteReader(std::span<const std::uint8_t> data) noexcept : data_(data) {}
+  /// Reads data[offset..]: offsets in errors stay those of the whole of `data` (a part of a larger
+  /// encoding read on its own, bounded by data's end). offset <= data.size().
+  ByteReader(std::span<const std::uint8_t> data, std::size_t offset) noexcept
+      : data_(data), offset_(offset) {}
 
   std::uint8_t u8(const char* what) noexcept { return static_cast<std::uint8_t>(get(1, what)); }
   std::uint16_t u16(const char* what) noexcept { return static_cast<std::uint16_t>(get(2, what)); }

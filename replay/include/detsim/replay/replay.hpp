@@ -25,7 +25,7 @@
 namespace detsim::replay {
 
 /// The version of the replay format this build writes and reads.
-inline constexpr std::uint32_t format_version = 1;
+inline constexpr std::uint32_t format_version = 2;
 /// Keyframe interval used when a caller does not choose one.
 inline constexpr std::uint32_t default_keyframe_interval = 300;
 /// Frames per FRAM chunk: what a killed recording can lose at most.
@@ -38,9 +38,12 @@ struct Fingerprint {
   std::string detsim_version;              ///< of the build that recorded
   std::uint32_t fixed_fraction_bits = 32;  ///< Q32.32
   std::uint32_t state_version = 0;         ///< canonical state encoding (keyframes)
-  std::string scenario;                    ///< a registered scenario's name, or a game's own name
-  ScenarioParams params;                   ///< seed, players, count, with defaults filled in
-  Fixed dt;                                ///< the world's step and solver settings
+  /// The sections of the run's state, in order (at most 32): each frame records one hash per
+  /// section, in this order, after the state's hash.
+  std::vector<std::string> state_sections;
+  std::string scenario;   ///< a registered scenario's name, or a game's own name
+  ScenarioParams params;  ///< seed, players, count, with defaults filled in
+  Fixed dt;               ///< the world's step and solver settings
   std::uint32_t substeps = 0;
   std::uint32_t iterations = 0;
   std::uint32_t players = 0;     ///< inputs per frame

@@ -10,11 +10,14 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include <detsim/core/rng.hpp>
 #include <detsim/core/status.hpp>
 #include <detsim/sim/body.hpp>
+#include <detsim/sim/state_sections.hpp>
 #include <detsim/sim/world_def.hpp>
 
 namespace detsim {
@@ -52,19 +55,25 @@ struct BodyState {
   friend constexpr bool operator==(const BodyState&, const BodyState&) noexcept = default;
 };
 
-/// The version of the canonical state encoding that save() writes and restore() reads
-/// (docs/STATE.md). Replays record it: a keyframe can be restored only by a build that reads it.
-inline constexpr std::uint32_t state_encoding_version = 2;
+/// The hash of one section of a state (state_sections.hpp).
+struct SectionHash {
+  std::string name;
+  std::uint64_t hash = 0;
 
-/// Hashes of the state after a step (XXH3-64 of the canonical bytes of each part).
+  friend bool operator==(const SectionHash&, const SectionHash&) = default;
+};
+
+/// Hashes of a state: of all its bytes, and of each section (docs/STATE.md).
 struct StateHashes {
-  std::uint64_t total = 0;     ///< the frame's state hash: covers everything below
-  std::uint64_t globals = 0;   ///< frame, ID counter, definition
-  std::uint64_t rng = 0;       ///< the RNG state
-  std::uint64_t bodies = 0;    ///< every body
-  std::uint64_t contacts = 0;  ///< the contact cache (manifolds and warm-start impulses)
+  std::uint64_t total = 0;  ///< the frame's state hash: covers every section
+  /// In the state's order. A World's: "globals" (frame, ID counter, definition), "rng", "bodies"
+  /// (every body), "contacts" (the contact cache with its warm-start impulses).
+  std::vector<SectionHash> sections;
 
-  friend constexpr bool operator==(const StateHashes&, const StateHashes&) noexcept = default;
+  /// The hash of the section called `name`, or 0 when there is none.
+  [[nodiscard]] std::uint64_t section(std::string_view name) const noexcept;
+
+  friend bool operator==(const StateHashes&, const StateHashes&) = default;
 };
 
 /// One point of a contact as the contact cache keeps it between steps: the feature pair that made

@@ -95,7 +95,7 @@ TEST(StateCodec, DecodeThenEncodeGivesTheSameBytes) {
 // What restore() refuses
 // ======================================================================================
 
-class V2Restore : public testing::Test {
+class CanonicalRestore : public testing::Test {
  protected:
   void SetUp() override {
     state_ = settled().save();
@@ -111,6 +111,15 @@ class V2Restore : public testing::Test {
     SCOPED_TRACE(what);
     const std::string message = expect_rejected(target_, bad);
     EXPECT_TRUE(names_one_of(message, field_or_record)) << what << ": " << message;
+  }
+
+  // Replaces the var at `at` (in a section's payload) with `with`, keeping that section's length
+  // right: a var of another length must be refused for what it is, not for the container.
+  void replace_in_payload(Bytes& bytes, std::size_t at, const Bytes& with) const {
+    const auto delta = static_cast<std::ptrdiff_t>(with.size()) -
+                       static_cast<std::ptrdiff_t>(var_length_at(bytes, at));
+    replace_var(bytes, at, with);
+    adjust_section_length(bytes, decoded_, at, delta);
   }
 
   // `bytes` must be accepted and saved back unchanged.
@@ -133,7 +142,7 @@ struct VarField {
   std::string what;
 };
 
-TEST_F(V2Restore, OverlongVars) {
+TEST_F(CanonicalRestore, OverlongVars) {
   // Every kind of var, one byte longer than its shortest form (a last byte of zero).
   const DecodedBody& sphere = decoded_.bodies[1];
   const DecodedBody& with_user_data = decoded_.bodies[2];
@@ -162,7 +171,7 @@ TEST_F(V2Restore, OverlongVars) {
     ASSERT_EQ(var_length_at(state_, v.at), shortest) << v.what;
     for (const std::size_t length : {shortest + 1, shortest + 2}) {
       Bytes bad = state_;
-      replace_var(bad, v.at, leb128(value, length));
+      replace_in_payload(bad, v.at, leb128(value, length));
       expect_refused_at(bad, {v.at, v.record_at}, v.what + " in " + std::to_string(length));
     }
   }
@@ -170,11 +179,11 @@ TEST_F(V2Restore, OverlongVars) {
   Bytes bad = state_;
   const std::size_t zero_at = decoded_.bodies[0].linear_velocity_at;
   ASSERT_EQ(state_[zero_at], 0);
-  replace_var(bad, zero_at, Bytes{0x80, 0x00});
+  replace_in_payload(bad, zero_at, Bytes{0x80, 0x00});
   expect_refused_at(bad, {zero_at, decoded_.bodies[0].at}, "zero in two bytes");
 }
 
-TEST_F(V2Restore, VarsBeyondTheirField) {
+TEST_F(CanonicalRestore, VarsBeyondTheirField) {
   // 32-bit fields: a 5-byte var whose value needs 33 to 35 bits, and a 6-byte var.
   const DecodedBody& sphere = decoded_.bodies[1];
   const DecodedContact& contact = decoded_.contacts.back();
@@ -190,12 +199,13 @@ TEST_F(V2Restore, VarsBeyondTheirField) {
          {std::uint64_t{1} << 32, (std::uint64_t{1} << 32) + var_at(state_, v.at),
           (std::uint64_t{1} << 35) - 1}) {
       Bytes bad = state_;
-      replace_var(bad, v.at, leb128(value));
+      replace_in_payload(bad, v.at, leb128(value));
       ASSERT_EQ(leb128(value).size(), 5U);
       expect_refused_at(bad, {v.at, v.record_at}, v.what + " = " + std::to_string(value));
     }
     Bytes bad = state_;
-    replace_var(bad, v.at, leb128(std::uint64_t{1} << 35));  // 6 bytes, canonical but too long
+    replace_in_payload(bad, v.at,
+                       leb128(std::uint64_t{1} << 35));  // 6 bytes, canonical but too long
     expect_refused_at(bad, {v.at, v.record_at}, v.what + " in 6 bytes");
   }
   // 64-bit fields: 11 bytes (overlong, and with a value beyond 64 bits), and a 10-byte var whose
@@ -215,7 +225,7 @@ TEST_F(V2Restore, VarsBeyondTheirField) {
     };
     for (std::size_t i = 0; i < forms.size(); ++i) {
       Bytes bad = state_;
-      replace_var(bad, v.at, forms[i]);
+      replace_in_payload(bad, v.at, forms[i]);
       expect_refused_at(bad, {v.at, v.record_at}, v.what + ", form " + std::to_string(i));
     }
   }
@@ -230,7 +240,7 @@ void merge_set(Decoded& d, std::size_t k, std::size_t instead) {
   d.sets.erase(d.sets.begin() + static_cast<std::ptrdiff_t>(k));
 }
 
-TEST_F(V2Restore, PropertySetsMustBeDistinct) {
+TEST_F(CanonicalRestore, PropertySetsMustBeDistinct) {
   // The two lower stacked boxes share a set; the top one differs only in CCD.
   const auto lower = static_cast<std::size_t>(decoded_.bodies[4].set);
   const auto top = static_cast<std::size_t>(decoded_.bodies[6].set);
@@ -245,7 +255,7 @@ TEST_F(V2Restore, PropertySetsMustBeDistinct) {
   expect_accepted(encode(d), "the duplicate merged");
 }
 
-TEST_F(V2Restore, PropertySetsInFirstUseOrderAndEachUsed) {
+TEST_F(CanonicalRestore, PropertySetsInFirstUseOrderAndEachUsed) {
   // Sets 0 and 1 swapped, and the bodies' indices with them: the same world, another order.
   Decoded d = decoded_;
   std::swap(d.sets[0], d.sets[1]);
@@ -272,7 +282,7 @@ TEST_F(V2Restore, PropertySetsInFirstUseOrderAndEachUsed) {
   expect_rejected(target_, encode(d));
 }
 
-TEST_F(V2Restore, SetIndexOutOfRange) {
+TEST_F(CanonicalRestore, SetIndexOutOfRange) {
   // A plane and three identical boxes: every set is in use before the last body, so its index
   // may be 0 or 1 only.
   const Bytes bytes = boxes(3, true).save();
@@ -294,7 +304,7 @@ TEST_F(V2Restore, SetIndexOutOfRange) {
   expect_accepted(encode(base), "the real indices");
 }
 
-TEST_F(V2Restore, UnknownFlagBits) {
+TEST_F(CanonicalRestore, UnknownFlagBits) {
   const DecodedBody& sphere = decoded_.bodies[1];
   for (const int bit : {0x10, 0x20, 0x40, 0x80}) {
     Decoded d = decoded_;
@@ -311,7 +321,7 @@ TEST_F(V2Restore, UnknownFlagBits) {
   }
 }
 
-TEST_F(V2Restore, FlaggedValuesAreNotZero) {
+TEST_F(CanonicalRestore, FlaggedValuesAreNotZero) {
   const DecodedBody& sphere = decoded_.bodies[1];
   ASSERT_EQ(sphere.flags & (kHasUserData | kHasForce | kHasTorque), 0);
   for (const std::uint8_t bit : {kHasUserData, kHasForce, kHasTorque}) {
@@ -331,7 +341,7 @@ TEST_F(V2Restore, FlaggedValuesAreNotZero) {
   expect_accepted(encode(d), "non-zero flagged values");
 }
 
-TEST_F(V2Restore, FeaturesBeyondTheirRange) {
+TEST_F(CanonicalRestore, FeaturesBeyondTheirRange) {
   // A feature is index * 4 + kind with an 8-bit index: at most 1023.
   const DecodedContact& contact = decoded_.contacts[0];
   ASSERT_GT(contact.point_count(), 0U);
@@ -348,7 +358,7 @@ TEST_F(V2Restore, FeaturesBeyondTheirRange) {
   }
 }
 
-TEST_F(V2Restore, AcceptedExtremesSaveTheSameBytes) {
+TEST_F(CanonicalRestore, AcceptedExtremesSaveTheSameBytes) {
   // The canonical encoding both ways: what restore accepts, save writes back byte for byte, at
   // the limits of every var.
   Decoded d = decoded_;
