@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds and runs every test: the README's test command, and what CI runs.
 #   1. gcc, Release, warnings as errors: the whole suite, plus the installed-package consumer test.
-#   2. clang with AddressSanitizer + UndefinedBehaviorSanitizer, warnings as errors: the whole suite.
+#   2. clang with AddressSanitizer + UndefinedBehaviorSanitizer and checked invariants
+#      (DETSIM_CHECKS), warnings as errors: the whole suite.
 #   3. clang-format: every C++ file is formatted.
 #   4. The determinism matrix (scripts/matrix.sh): every compiler, optimisation level and CPU
 #      architecture that fits in what remains of the CI budget (at least the gcc -O2 build of step 1
@@ -36,11 +37,12 @@ ctest --test-dir build/gcc-release --output-on-failure -j "$jobs"
 
 step "clang ASan+UBSan"
 # -O1 with line tables only: what the sanitizers recommend (reports keep file:line stacks), and
-# far cheaper to build than full debug information.
+# far cheaper to build than full debug information. DETSIM_CHECKS: every DETSIM_ASSERT and
+# World::validate() after every step of every test (they only read: the golden tests still pass).
 san="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
 cmake -S . -B build/clang-sanitize -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
-  -DCMAKE_CXX_FLAGS="$san" -DCMAKE_EXE_LINKER_FLAGS="$san" -DDETSIM_WERROR=ON \
+  -DCMAKE_CXX_FLAGS="$san" -DCMAKE_EXE_LINKER_FLAGS="$san" -DDETSIM_WERROR=ON -DDETSIM_CHECKS=ON \
   -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build build/clang-sanitize -j "$jobs"
 # The accuracy contract is proven on 1M inputs per function, and the decimal round trips on their

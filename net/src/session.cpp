@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <string>
 
+#include <detsim/core/assert.hpp>
+
 #include "session_impl.hpp"
 
 namespace detsim::net {
@@ -183,19 +185,27 @@ void Session::Impl::simulate(std::uint64_t frame, bool resimulating) {
   saved.hash = game->save(saved.bytes);
 }
 
-void Session::Impl::rollback() {
+Status Session::Impl::rollback() {
   const std::uint64_t from = *first_incorrect;
   first_incorrect.reset();
   const detail::State& saved = state_slot(from);
   // The window guarantees the state is held: a correction is never older than the oldest
-  // unconfirmed frame, and the ring spans the whole prediction window.
-  if (saved.frame != from) return;
+  // unconfirmed frame, and the ring spans the whole prediction window. If that ever failed, the
+  // session could not correct its prediction: it stops with an error instead of going on wrong.
+  DETSIM_ASSERT(saved.frame == from);
+  if (saved.frame != from) {
+    broken = "rollback to frame " + std::to_string(from) +
+             ": its state is no longer in the ring of saved states (a session bug; the match "
+             "cannot continue in step with its peers)";
+    return Status::error(broken);
+  }
   game->load(saved.bytes);
   const std::uint64_t end = current;
   for (std::uint64_t frame = from; frame < end; ++frame)
     simulate(frame, true);
   ++stats.rollbacks;
   stats.resimulated_frames += end - from;
+  return Status::success();
 }
 
 void Session::Impl::emit_confirmed() {
@@ -219,6 +229,7 @@ void Session::Impl::emit_confirmed() {
     }
     const detail::State& after = state_slot(frame + 1);
     const bool held = after.frame == frame + 1;
+    DETSIM_ASSERT(held);  // the ring spans every frame not yet emitted (advance_frame waits)
     const std::uint64_t hash = held ? after.hash : 0;
     if (confirmed_listener)
       confirmed_listener(ConfirmedFrame{frame, frame_inputs, frame_status, hash});
@@ -346,13 +357,16 @@ Expected<Advance> Session::advance_frame(std::span<const std::uint8_t> local_inp
     return Status::error("advance_frame: the local input must be " +
                          std::to_string(s.config.input_size) + " bytes, got " +
                          std::to_string(local_input.size()));
+  if (!s.broken.empty()) return Status::error(s.broken);
   if (!s.running) return Advance::synchronizing;
   const std::uint64_t before = s.queues[s.config.local_player].next_confirmed();
   s.add_local_input(local_input);
   if (s.queues[s.config.local_player].next_confirmed() != before)
     for (detail::Peer& peer : s.peers)
       if (peer.synchronized && !peer.disconnected) s.send_inputs(peer);
-  if (s.first_incorrect) s.rollback();
+  if (s.first_incorrect) {
+    if (Status st = s.rollback(); !st) return st;
+  }
   s.emit_confirmed();
   // The ring must hold every state from the oldest frame not yet emitted to the one about to be
   // saved (rollbacks and emission read them).

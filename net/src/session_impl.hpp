@@ -93,7 +93,9 @@ struct Session::Impl {
   // session.cpp: the frame loop.
   void add_local_input(std::span<const std::uint8_t> input);
   void simulate(std::uint64_t frame, bool resimulating);
-  void rollback();
+  /// Loads the first incorrect frame's state and re-simulates to the present; an error (and
+  /// `broken` set) when that state is no longer held.
+  Status rollback();
   void emit_confirmed();
   void add_local_check(std::uint64_t frame, std::uint64_t hash, const detail::State* state);
   void compare_checks(detail::Peer& peer);
@@ -151,6 +153,8 @@ struct Session::Impl {
   std::vector<std::uint8_t> frame_log;
   std::size_t unit_size = 0;
   std::vector<detail::State> states;  ///< ring of saved states
+  /// Set when the session cannot go on (a broken invariant): advance_frame returns it from then on.
+  std::string broken;
   std::uint64_t current = 0;
   std::optional<std::uint64_t> first_incorrect;
   std::uint64_t next_emit = 0;  ///< the next frame to hand to the confirmed listener

@@ -385,8 +385,8 @@ void Session::poll(std::uint64_t now_us) {
   if (s.running) {
     // As GGPO does while idle: a correction received here is applied now, so a game that stops
     // advancing (at a match's end, or waiting) still gets its confirmed frames out.
-    if (s.first_incorrect) s.rollback();
-    s.emit_confirmed();
+    // A failed rollback stops the session: advance_frame reports it (Session::Impl::broken).
+    if (!s.first_incorrect || s.rollback().ok()) s.emit_confirmed();
   }
   s.send_due();
 }

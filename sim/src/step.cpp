@@ -22,6 +22,7 @@ void World::step() {
     b.torque = {};
   }
   ++s.frame;
+  sim_detail::check_after_step(s);  // 10. invariants, in builds with DETSIM_CHECKS
 }
 
 namespace sim_detail {

@@ -113,6 +113,11 @@ void continuous(WorldState& s);            // fast and CCD bodies moved back to 
 void update_sleep(WorldState& s);          // sleep timers; islands at rest fall asleep
 void report_contacts(WorldState& s);       // contact and sensor events, in pair order
 
+/// The world's invariants (invariants.cpp): "" when every one holds, else what is broken.
+[[nodiscard]] std::string validate_world(const WorldState& s);
+/// validate_world after a step, in builds with DETSIM_CHECKS (nothing in the others).
+void check_after_step(const WorldState& s);
+
 /// prepare_bodies for body i alone (derived already sized): when a body wakes in mid-step.
 void prepare_body(WorldState& s, std::size_t i);
 

@@ -233,6 +233,11 @@ class World {
   StateHashes save(std::vector<std::uint8_t>& bytes) const;
   /// XXH3-64 of one body's canonical bytes, or an error for an unknown ID.
   [[nodiscard]] Expected<std::uint64_t> body_hash(BodyId id) const;
+  /// Checks the world's invariants (docs/ARCHITECTURE.md): body IDs ascending and below the next
+  /// ID, valid shapes, unit orientations, static bodies still and asleep, sleeping bodies still,
+  /// the contact cache ascending and consistent, and islands asleep or awake as a whole. Changes
+  /// nothing; an error names what is broken. Builds with DETSIM_CHECKS run it after every step.
+  [[nodiscard]] Status validate() const;
   /// The contact cache (part of the saved state), ascending (a, b).
   [[nodiscard]] std::vector<ContactState> contacts() const;
 

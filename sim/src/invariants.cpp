@@ -1,0 +1,75 @@
+// The World's invariants (World::validate, and after every step in builds with DETSIM_CHECKS).
+//
+// What restore() checks of bytes, checked here of the live state, plus what only a stepped world
+// must hold: the contact cache's order and consistency, and islands that sleep as a whole. Each
+// check reads; none changes the world. A failure names the body or pair and what is wrong.
+#include <detsim/core/assert.hpp>
+
+#include "world_state.hpp"
+
+namespace detsim {
+
+namespace sim_detail {
+
+std::string validate_world(const WorldState& s) {
+  const auto body = [](std::uint32_t id) { return "body " + std::to_string(id) + ": "; };
+  if (s.next_id == 0) return "the next body ID is 0";
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    const BodyState& b = s.bodies[i];
+    if (b.id.value == 0 || b.id.value >= s.next_id)
+      return body(b.id.value) + "ID outside 1.." + std::to_string(s.next_id - 1);
+    if (i > 0 && s.bodies[i - 1].id >= b.id) return body(b.id.value) + "IDs are not ascending";
+    if (auto e = check_shape(b.shape, b.type); !e.empty()) return body(b.id.value) + e;
+    if (auto e = check_orientation(b.orientation); !e.empty()) return body(b.id.value) + e;
+    if (b.sleep_time < Fixed::zero()) return body(b.id.value) + "negative sleep time";
+    if (b.type == BodyType::static_body && b.awake) return body(b.id.value) + "static and awake";
+    if (b.type == BodyType::static_body &&
+        (b.linear_velocity != Vec3{} || b.angular_velocity != Vec3{}))
+      return body(b.id.value) + "static with a velocity";
+    if (b.type == BodyType::dynamic && !b.awake &&
+        (b.linear_velocity != Vec3{} || b.angular_velocity != Vec3{}))
+      return body(b.id.value) + "asleep with a velocity";
+  }
+  for (std::size_t k = 0; k < s.contacts.size(); ++k) {
+    const Contact& c = s.contacts[k];
+    const std::string pair = "contact (" + std::to_string(c.a) + ", " + std::to_string(c.b) + "): ";
+    if (c.a >= c.b) return pair + "a is not below b";
+    if (k > 0 &&
+        (s.contacts[k - 1].a > c.a || (s.contacts[k - 1].a == c.a && s.contacts[k - 1].b >= c.b)))
+      return pair + "the cache is not in ascending (a, b) order";
+    if (s.find(c.a) < 0 || s.find(c.b) < 0) return pair + "names a body that does not exist";
+    if (c.point_count > 4) return pair + "more than 4 points";
+    if (c.touching != (c.point_count > 0)) return pair + "touching disagrees with its points";
+    if (c.reported && !c.touching) return pair + "reported without points";
+  }
+  // Islands sleep and wake as a whole: no touching pair of dynamic bodies is half asleep.
+  if (s.def.enable_sleep) {
+    for (const Contact& c : s.contacts) {
+      if (!c.touching) continue;
+      const BodyState& a = s.bodies[static_cast<std::size_t>(s.find(c.a))];
+      const BodyState& b = s.bodies[static_cast<std::size_t>(s.find(c.b))];
+      if (a.type == BodyType::dynamic && b.type == BodyType::dynamic && !a.sensor && !b.sensor &&
+          a.awake != b.awake)
+        return "contact (" + std::to_string(c.a) + ", " + std::to_string(c.b) +
+               "): one body of a touching pair sleeps, the other is awake (an island is split)";
+    }
+  }
+  return {};
+}
+
+void check_after_step(const WorldState& s) {
+  if constexpr (checks_enabled) {
+    if (const std::string e = validate_world(s); !e.empty())
+      invariant_failed(("after step " + std::to_string(s.frame) + ": " + e).c_str(), __FILE__,
+                       __LINE__);
+  }
+}
+
+}  // namespace sim_detail
+
+Status World::validate() const {
+  if (std::string e = sim_detail::validate_world(*s_); !e.empty()) return Status::error(e);
+  return Status::success();
+}
+
+}  // namespace detsim
