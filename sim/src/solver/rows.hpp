@@ -22,7 +22,10 @@
 //
 // Inlining: the helpers run per row and per iteration, in the hottest loops of the step; they
 // are defined here, `inline`, so that each kind's translation unit inlines them as if they were
-// its own.
+// its own. row_speed is also `always_inline`: GCC 12 at -O2 otherwise calls it out of line from
+// every site of the contact kind's passes, which cost the 1000-box pile 0.8 % more instructions
+// per step than when the contact solver was one class (callgrind); inlined, the step is back to
+// the same count.
 #pragma once
 
 #include <cstddef>
@@ -111,8 +114,8 @@ inline Row make_row(const Derived& a, const Derived& b, Vec3 ra, Vec3 rb, Vec3 d
 
 /// The speed of a row, J v: one exact sum rounded once, a's terms first. A still body's
 /// velocities are zero and add exact zeros, which are skipped.
-inline Fixed row_speed(const std::vector<Velocity>& v, const BodyPair& k, const Direction& d,
-                       const Row& r) {
+[[gnu::always_inline]] inline Fixed row_speed(const std::vector<Velocity>& v, const BodyPair& k,
+                                              const Direction& d, const Row& r) {
   DotSum sum;
   if (!k.still_a) sum.add(d.linear_a, v[k.a].linear).add(r.angular_a, v[k.a].angular);
   if (!k.still_b) sum.add(d.linear_b, v[k.b].linear).add(r.angular_b, v[k.b].angular);
