@@ -108,7 +108,7 @@ void prepare_bodies(WorldState& s);        // poses, inverse masses, world inert
 void update_contacts(WorldState& s);       // broadphase: contact list = overlapping pairs, by ID
 void collide_contacts(WorldState& s);      // narrowphase: manifolds, warm start matched by feature
 void wake_touched_islands(WorldState& s);  // sleeping bodies touched by awake ones wake
-void solve(WorldState& s);                 // sub-stepped soft contact solver and integration
+void solve(WorldState& s);                 // the sub-stepped solver's stages (solver/solve.cpp)
 void continuous(WorldState& s);            // fast and CCD bodies moved back to their first touch
 void update_sleep(WorldState& s);          // sleep timers; islands at rest fall asleep
 void report_contacts(WorldState& s);       // contact and sensor events, in pair order

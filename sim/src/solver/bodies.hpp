@@ -1,0 +1,53 @@
+// The solver's view of the bodies for one step: their velocities as the sub-steps move them, and
+// the per-body stages of the sub-step (integrate velocities, clamp speeds, integrate positions).
+// Constraint kinds read and push these velocities through the row helpers (rows.hpp); they never
+// touch a body's position, which only integrate_positions moves. Internal to detsim::sim.
+//
+// The velocities are one contiguous array parallel to WorldState::bodies (Box2D v3's body
+// states): what a constraint gathers by index now, and what a wide row batch will gather lanes
+// from later.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "../world_state.hpp"
+#include "rows.hpp"
+
+namespace detsim::sim_detail {
+
+/// Per-step solver data of every body, and the body stages of a sub-step.
+struct SolverBodies {
+  /// Loads every body's velocities and the step's constants (h = dt / substeps).
+  explicit SolverBodies(WorldState& s);
+
+  /// Whether an impulse can change body i's velocity (non-zero inverse mass or inertia).
+  [[nodiscard]] bool takes_impulse(std::size_t i) const;
+  /// Whether body i is still: no velocity, and none to come (integrate_velocities and
+  /// clamp_speeds touch only awake dynamic bodies, impulses only bodies that take them).
+  [[nodiscard]] bool still(std::size_t i) const;
+  /// Bodies a and b of a constraint, with what the row helpers may skip for each.
+  [[nodiscard]] BodyPair pair(std::size_t a, std::size_t b) const;
+
+  /// Gravity, forces, torques, implicit damping and the speed limits, for one sub-step.
+  void integrate_velocities();
+  /// The speed limits, again: contact impulses (a crushed light body) can exceed what gravity
+  /// could.
+  void clamp_speeds();
+  /// Positions and orientations by one sub-step, and the motion since the step began.
+  void integrate_positions();
+  /// Writes the velocities back to the awake bodies (once, after the last sub-step).
+  void store_velocities();
+
+  WorldState& s;
+  Fixed h;                 ///< the sub-step, dt / substeps
+  Fixed inv_h;             ///< substeps / dt
+  Vec3 gravity_kick;       ///< gravity * h: the velocity change of a body without forces
+  Vec3 gravity_half_kick;  ///< half of gravity_kick
+  std::vector<Velocity> velocities;
+  std::vector<Vec3> half_kick;  ///< half of this sub-step's velocity change from gravity and forces
+  /// The body has contact points this step (set by the contact kind's prepare).
+  std::vector<bool> in_contact;
+};
+
+}  // namespace detsim::sim_detail

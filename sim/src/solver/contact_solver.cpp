@@ -1,0 +1,275 @@
+// Contacts, the first constraint kind: soft contacts of the sub-stepped solver ("soft step",
+// Catto, Box2D v3, 2024) in 3D. solve.cpp runs the stages; this file is what each stage does to
+// contacts.
+//
+// Contacts are not re-collided between sub-steps: each point keeps its anchors relative to the two
+// bodies (in its rows), and its separation is updated from the bodies' motion since the start of
+// the step (with a small-angle rotation), which is exact for translation and second-order small
+// for rotation. Soft constraints act like a damped spring with a stiffness tied to the sub-step
+// rate rather than an iteration count, so stacks neither jitter nor explode, and a restitution-1
+// bounce loses almost nothing. Every constraint is solved in contact order (ascending ID pair),
+// point order within a contact: the order is part of the result.
+//
+// Each point has three rows (the normal and two tangents, rows.hpp), each with its Jacobian per
+// body, computed once per step because the anchors and the world inertia stay fixed for the step.
+// The two friction rows of a point are pushed together. The sub-steps then need no cross product
+// and no matrix.
+#include "contact_solver.hpp"
+
+#include <algorithm>
+
+namespace detsim::sim_detail {
+
+namespace {
+
+// A unit vector perpendicular to the unit vector n, chosen by n's components only.
+Vec3 perpendicular(Vec3 n) {
+  const Fixed threshold = Fixed::from_raw(2479700525);  // 0.57735 ~ 1/sqrt(3)
+  if (abs(n.x) >= threshold) return normalize(Vec3{n.y, -n.x, Fixed::zero()});
+  return normalize(Vec3{Fixed::zero(), n.z, -n.y});
+}
+
+}  // namespace
+
+ContactSolver::ContactSolver(WorldState& s, SolverBodies& bodies) : s_(s), bodies_(bodies) {
+  // The contact spring may not be stiffer than a quarter of the sub-step rate (Box2D's bound),
+  // or the implicit discretisation stops damping it.
+  const Fixed hertz = min(s.def.contact_hertz, bodies.inv_h >> 2);
+  soft_ = make_soft(hertz, s.def.contact_damping_ratio, bodies.h);
+  static_soft_ =
+      make_soft(min(hertz << 1, bodies.inv_h >> 2), s.def.contact_damping_ratio, bodies.h);
+}
+
+// Every separation starts at its base (no motion yet).
+void ContactSolver::prepare() {
+  constraints_.clear();
+  // At most one constraint per contact: reserved at once, the constraints are never moved while
+  // the list grows (each is about 1.5 KB).
+  constraints_.reserve(s_.contacts.size());
+  for (std::size_t ci = 0; ci < s_.contacts.size(); ++ci) {
+    const Contact& c = s_.contacts[ci];
+    if (c.point_count == 0) continue;
+    const BodyState& a = s_.bodies[c.index_a];
+    const BodyState& b = s_.bodies[c.index_b];
+    if (a.sensor || b.sensor) continue;
+    const bool dynamic_a = a.type == BodyType::dynamic && a.awake;
+    const bool dynamic_b = b.type == BodyType::dynamic && b.awake;
+    if (!dynamic_a && !dynamic_b) continue;
+    prepare_constraint(ci);
+  }
+}
+
+void ContactSolver::prepare_constraint(std::size_t ci) {
+  const Contact& c = s_.contacts[ci];
+  const std::size_t ia = c.index_a;
+  const std::size_t ib = c.index_b;
+  const BodyState& a = s_.bodies[ia];
+  const BodyState& b = s_.bodies[ib];
+  const Derived& da = s_.derived[ia];
+  const Derived& db = s_.derived[ib];
+  // Built in place: a constraint is about 1.5 KB, and a copy per contact per step is waste.
+  ContactConstraint& k = constraints_.emplace_back();
+  k.contact = ci;
+  k.bodies = bodies_.pair(ia, ib);
+  const Vec3 normal = c.manifold.normal;
+  const Vec3 tangent_1 = perpendicular(normal);
+  const Vec3 tangent_2 = cross(normal, tangent_1);
+  k.normal = make_direction(da, db, normal);
+  k.tangent_1 = make_direction(da, db, tangent_1);
+  k.tangent_2 = make_direction(da, db, tangent_2);
+  k.friction = sqrt(a.friction * b.friction);
+  k.restitution = max(a.restitution, b.restitution);
+  k.count = c.point_count;
+  k.pushed = false;
+  k.bounced = false;
+  Vec3 sum_a;
+  Vec3 sum_b;
+  for (std::size_t p = 0; p < c.point_count; ++p) {
+    const ContactPoint& mp = c.manifold.points[p];
+    SolverPoint& sp = k.points[p];
+    // The contact point relative to each body's centre at the start of the step.
+    const Vec3 anchor_a = mp.point - a.position;
+    const Vec3 anchor_b = mp.point - b.position;
+    sp.base_separation = mp.separation;
+    sp.separation = mp.separation;
+    sp.normal = make_row(da, db, anchor_a, anchor_b, normal);
+    sp.tangent_1 = make_row(da, db, anchor_a, anchor_b, tangent_1);
+    sp.tangent_2 = make_row(da, db, anchor_a, anchor_b, tangent_2);
+    sum_a += anchor_a;
+    sum_b += anchor_b;
+    sp.normal_impulse = c.cached[p].normal_impulse;
+    sp.tangent_impulse_1 = c.cached[p].tangent_impulse_1;
+    sp.tangent_impulse_2 = c.cached[p].tangent_impulse_2;
+  }
+  k.bounce = {};
+  if (k.restitution != Fixed::zero()) {  // the centroid serves restitution only
+    const Fixed count = Fixed::from_int(c.point_count);
+    k.bounce.normal = make_row(da, db, sum_a / count, sum_b / count, normal);
+    k.bounce.relative_velocity = row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
+  }
+  bodies_.in_contact[ia] = true;
+  bodies_.in_contact[ib] = true;
+}
+
+void ContactSolver::warm_start() {
+  for (ContactConstraint& k : constraints_) {
+    for (std::size_t p = 0; p < k.count; ++p) {
+      SolverPoint& sp = k.points[p];
+      // A point whose surfaces have come apart (a bounce, a body lifted off) carries no load:
+      // re-applying its old impulse would push the bodies apart a second time and feed energy
+      // into whatever else they touch before this point's own solve takes it back.
+      if (sp.separation > Fixed::zero()) {
+        sp.normal_impulse = Fixed::zero();
+        sp.tangent_impulse_1 = Fixed::zero();
+        sp.tangent_impulse_2 = Fixed::zero();
+        continue;
+      }
+      apply_impulse(bodies_.velocities, k.bodies, k.normal, sp.normal, sp.normal_impulse);
+      apply_impulses(bodies_.velocities, k.bodies, k.tangent_1, sp.tangent_1, sp.tangent_impulse_1,
+                     k.tangent_2, sp.tangent_2, sp.tangent_impulse_2);
+    }
+  }
+}
+
+// The normal rows of a contact's points, in point order. `inline`, like the row helpers: it runs
+// per contact per pass, and the hint keeps it inside solve_contacts' loop, where it was written
+// before the contact kind had a file of its own.
+inline void ContactSolver::solve_normal(ContactConstraint& k, const Softness& soft, bool use_bias) {
+  for (std::size_t p = 0; p < k.count; ++p) {
+    SolverPoint& sp = k.points[p];
+    const Fixed separation = sp.separation;
+    Fixed bias;
+    bool soft_push = false;  // soft: mass and impulse scaled; else scales 1 and 0
+    if (separation > Fixed::zero()) {
+      bias = separation * bodies_.inv_h;  // speculative: close the gap within this sub-step
+    } else if (use_bias) {
+      bias = max(soft.bias_rate * min(separation + s_.def.linear_slop, Fixed::zero()),
+                 -s_.def.contact_push_max);
+      soft_push = true;
+    }
+    const Fixed vn = row_speed(bodies_.velocities, k.bodies, k.normal, sp.normal);
+    // Scales 1 and 0 need no arithmetic: x * 1 = x and x - 0 * y = x, bit for bit.
+    Fixed impulse = soft_push ? -sp.normal.mass * soft.mass_scale * (vn + bias) -
+                                    soft.impulse_scale * sp.normal_impulse
+                              : -sp.normal.mass * (vn + bias);
+    const Fixed accumulated = max(sp.normal_impulse + impulse, Fixed::zero());
+    impulse = accumulated - sp.normal_impulse;
+    sp.normal_impulse = accumulated;
+    if (impulse > Fixed::zero()) k.pushed = true;
+    apply_impulse(bodies_.velocities, k.bodies, k.normal, sp.normal, impulse);
+  }
+}
+
+// Coulomb friction, each point limited to the disc of radius friction * normal impulse.
+inline void ContactSolver::solve_friction(ContactConstraint& k) {
+  for (std::size_t p = 0; p < k.count; ++p) {
+    SolverPoint& sp = k.points[p];
+    const Fixed limit = k.friction * sp.normal_impulse;
+    // With a zero limit the clamp below gives zero whatever t1 and t2 are (0 / |t| = 0, and
+    // |t| = 0 only for t = 0): a point with no friction impulse keeps none.
+    if (limit == Fixed::zero() && sp.tangent_impulse_1 == Fixed::zero() &&
+        sp.tangent_impulse_2 == Fixed::zero())
+      continue;
+    const Fixed t1 =
+        sp.tangent_impulse_1 -
+        sp.tangent_1.mass * row_speed(bodies_.velocities, k.bodies, k.tangent_1, sp.tangent_1);
+    const Fixed t2 =
+        sp.tangent_impulse_2 -
+        sp.tangent_2.mass * row_speed(bodies_.velocities, k.bodies, k.tangent_2, sp.tangent_2);
+    Fixed n1 = t1;
+    Fixed n2 = t2;
+    if (hypot_exceeds(t1, t2, limit)) {  // hypot(t1, t2) > limit, most often false: no root
+      const Fixed scale = limit / hypot(t1, t2);
+      n1 = t1 * scale;
+      n2 = t2 * scale;
+    }
+    const Fixed impulse_1 = n1 - sp.tangent_impulse_1;
+    const Fixed impulse_2 = n2 - sp.tangent_impulse_2;
+    sp.tangent_impulse_1 = n1;
+    sp.tangent_impulse_2 = n2;
+    apply_impulses(bodies_.velocities, k.bodies, k.tangent_1, sp.tangent_1, impulse_1, k.tangent_2,
+                   sp.tangent_2, impulse_2);
+  }
+}
+
+void ContactSolver::solve() {
+  solve_contacts(true);
+}
+
+void ContactSolver::relax() {
+  solve_contacts(false);
+}
+
+void ContactSolver::solve_contacts(bool use_bias) {
+  for (ContactConstraint& k : constraints_) {
+    const bool against_static = s_.derived[k.bodies.a].inverse_mass == Fixed::zero() ||
+                                s_.derived[k.bodies.b].inverse_mass == Fixed::zero();
+    const Softness& soft = against_static ? static_soft_ : soft_;
+    // Until the contact first pushes, its approach speed (at the centroid, before any point is
+    // solved) is what restitution must reverse.
+    if (use_bias && !k.pushed && k.restitution != Fixed::zero())
+      k.bounce.relative_velocity =
+          row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
+    solve_normal(k, soft, use_bias);
+    solve_friction(k);
+  }
+}
+
+// Where the surfaces of a point are now, from the manifold and the motion since the step began:
+// the separation grows at the normal row's speed, so it has grown by the row's Jacobian times
+// the bodies' displacements (delta position, small-angle delta rotation), one exact sum rounded
+// once. A still body has not moved (integrate_positions never moves it) and adds exact zeros.
+inline Fixed ContactSolver::current_separation(const ContactConstraint& k,
+                                               const SolverPoint& sp) const {
+  DotSum moved;
+  if (!k.bodies.still_a) {
+    const Derived& da = s_.derived[k.bodies.a];
+    moved.add(k.normal.linear_a, da.delta_position).add(sp.normal.angular_a, da.delta_angle);
+  }
+  if (!k.bodies.still_b) {
+    const Derived& db = s_.derived[k.bodies.b];
+    moved.add(k.normal.linear_b, db.delta_position).add(sp.normal.angular_b, db.delta_angle);
+  }
+  return sp.base_separation + moved.result();
+}
+
+// The separations depend only on the bodies' motion since the start of the step, which only
+// integrate_positions changes: computed once after it (and set to their base in prepare), they
+// serve the warm start, the solve and the relaxation that follow.
+void ContactSolver::positions_moved() {
+  for (ContactConstraint& k : constraints_) {
+    for (std::size_t p = 0; p < k.count; ++p)
+      k.points[p].separation = current_separation(k, k.points[p]);
+  }
+}
+
+// Restitution acts once per contact, at the centroid of its points, reversing the centroid's
+// approach speed: one Newton impulse at one point conserves energy for e = 1, whereas
+// per-point impulses applied one after another over-shoot on a rotating body and can add energy.
+void ContactSolver::restitution() {
+  const Fixed threshold = s_.def.restitution_threshold;
+  for (ContactConstraint& k : constraints_) {
+    if (k.restitution == Fixed::zero() || k.bounced || !k.pushed) continue;
+    const Bounce& c = k.bounce;
+    if (c.relative_velocity > -threshold) continue;
+    k.bounced = true;
+    const Fixed vn = row_speed(bodies_.velocities, k.bodies, k.normal, c.normal);
+    const Fixed impulse = -c.normal.mass * (vn + k.restitution * c.relative_velocity);
+    if (impulse > Fixed::zero())
+      apply_impulse(bodies_.velocities, k.bodies, k.normal, c.normal, impulse);
+  }
+}
+
+void ContactSolver::store_impulses() {
+  for (const ContactConstraint& k : constraints_) {
+    Contact& c = s_.contacts[k.contact];
+    c.pushed = k.pushed;
+    for (std::size_t p = 0; p < k.count; ++p) {
+      c.cached[p].normal_impulse = k.points[p].normal_impulse;
+      c.cached[p].tangent_impulse_1 = k.points[p].tangent_impulse_1;
+      c.cached[p].tangent_impulse_2 = k.points[p].tangent_impulse_2;
+    }
+  }
+}
+
+}  // namespace detsim::sim_detail
