@@ -7,13 +7,11 @@
 //   the surfaces along the normal at that point (negative when they overlap).
 // - Points are reported while separation <= `margin` (speculative contacts), at most four per pair.
 // - `feature` identifies the pair of features (vertex/edge/face indices of each shape) that made
-// the
-//   point, so that the solver can match a point with the same point of the previous step and warm
-//   start it. It is stable while the same features touch, and depends only on the shapes' features,
-//   never on the order in which points were found.
+//   the point, so that the solver can match a point with the same point of the previous step and
+//   warm start it. It is stable while the same features touch, and depends only on the shapes'
+//   features, never on the order in which points were found.
 // - Everything is Fixed arithmetic and deterministic: no data-dependent iteration order, ties
-// broken
-//   by index.
+//   broken by index.
 #pragma once
 
 #include <array>

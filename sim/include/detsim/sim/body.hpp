@@ -40,8 +40,10 @@ struct BodyDef {
   /// kg. When zero, the mass is density * volume. Dynamic bodies must end up with a positive mass.
   Fixed mass{};
   Fixed density = Fixed::from_int(1000);  ///< kg/m^3 (water), used when mass is zero
-  Fixed friction = Fixed::from_raw(Fixed::one_raw * 6 / 10);  ///< Coulomb coefficient, >= 0
-  Fixed restitution{};                                        ///< 0 (no bounce) .. 1 (elastic)
+  /// Coulomb coefficient, >= 0. 0.6 rounded down to the Q32.32 grid, the value every run and
+  /// golden file has used (0.6_fx rounds to nearest, one ulp above).
+  Fixed friction = 0.5999999999_fx;
+  Fixed restitution{};      ///< 0 (no bounce) .. 1 (elastic)
   Fixed linear_damping{};   ///< 1/s, >= 0: velocity *= 1 / (1 + dt * damping) per step
   Fixed angular_damping{};  ///< 1/s, >= 0
   /// Collision filtering: a and b collide when (a.layer & b.mask) and (b.layer & a.mask).
