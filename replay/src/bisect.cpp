@@ -437,7 +437,7 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
     r.diffs_omitted = diff.value().omitted;
     std::set<std::uint32_t> bodies;
     for (const FieldDiff& d : r.diffs)
-      if (d.subsystem == "bodies" || d.subsystem == "contacts") bodies.insert(d.body);
+      if (d.body != 0) bodies.insert(d.body);  // whatever the section, a field of a body
     r.scene_a = scene_of(*sa, bodies);
     r.scene_b = scene_of(*sb, bodies);
     break;

@@ -46,9 +46,8 @@ std::string field_json(const FieldDiff& f) {
 }
 
 void print_field(const FieldDiff& f) {
-  const std::string where = f.subsystem == "bodies" || f.subsystem == "contacts"
-                                ? "body " + std::to_string(f.body)
-                                : f.subsystem;
+  // A field of a body (in any section) is placed by its body; any other by its section.
+  const std::string where = f.body != 0 ? "body " + std::to_string(f.body) : f.subsystem;
   std::printf("  %-12s %-22s A %s\n  %-12s %-22s B %s\n", where.c_str(), f.field.c_str(),
               f.a.c_str(), "", "", f.b.c_str());
 }

@@ -16,9 +16,10 @@ namespace detsim {
 
 /// One difference between state A and state B.
 struct FieldDiff {
-  /// "globals", "rng", "bodies" or "contacts".
+  /// The state section the field is in (a World's: "globals", "rng", "bodies", "contacts").
   std::string subsystem;
-  /// The body's ID for "bodies"; for "contacts" the pair's lower ID; else 0.
+  /// The body the field belongs to, in any section ("bodies": the body; "contacts": the pair's
+  /// lower ID); 0 for a field of no body. A section's own "hash" line has 0.
   std::uint32_t body = 0;
   /// e.g. "position.y", "orientation.w", "angular_velocity.x", "sleep_time", "frame", "state[2]";
   /// "present" when the body exists on one side only; for a contact of `body` with body 23:
@@ -41,7 +42,7 @@ struct StateDiff {
   [[nodiscard]] bool equal() const noexcept { return a == b; }
 };
 
-/// The parts whose hashes differ, in order: "globals", "rng", "bodies", "contacts".
+/// The sections whose hashes differ (or that one side lacks), in A's order, then B's extras.
 [[nodiscard]] std::vector<std::string> differing_subsystems(const StateHashes& a,
                                                             const StateHashes& b);
 
