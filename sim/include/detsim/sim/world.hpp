@@ -234,8 +234,8 @@ class World {
   /// XXH3-64 of one body's canonical bytes, or an error for an unknown ID.
   [[nodiscard]] Expected<std::uint64_t> body_hash(BodyId id) const;
   /// Checks the world's invariants (docs/ARCHITECTURE.md): body IDs ascending and below the next
-  /// ID, valid shapes, unit orientations, static bodies still and asleep, sleeping bodies still,
-  /// the contact cache ascending and consistent, and islands asleep or awake as a whole. Changes
+  /// ID, valid shapes, unit orientations, static bodies asleep, the contact cache ascending and
+  /// consistent, and (after a step) islands asleep or awake as a whole. Changes
   /// nothing; an error names what is broken. Builds with DETSIM_CHECKS run it after every step.
   [[nodiscard]] Status validate() const;
   /// The contact cache (part of the saved state), ascending (a, b).
