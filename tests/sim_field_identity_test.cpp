@@ -1,9 +1,9 @@
 // golden/fields.txt: what the simulation computed, independent of how the state is encoded.
 //
-// For every built-in scenario (the parameters of golden/scenarios.txt) and the mixed scene of
-// golden/sim.txt, every body's position,
-// orientation, linear and angular velocity at every frame, hashed in a layout of this test's own
-// (below) that no state encoding version changes. golden/scenarios.txt hashes the canonical state
+// For every golden scenario run (tools/detsim/golden_runs.hpp, shared with golden/scenarios.txt)
+// and the mixed scene of golden/sim.txt, every body's position, orientation, linear and angular
+// velocity at every frame, hashed in a layout of this test's own (below) that no state encoding
+// version changes. golden/scenarios.txt hashes the canonical state
 // bytes, which change whenever the encoding does; this file does not, so a refactor of the state
 // format (or of any code around the physics) can prove that every simulated value stayed the same
 // bit for bit. Regenerate only when the physics changes on purpose:
@@ -19,32 +19,12 @@
 
 #include "support/golden.hpp"
 #include "support/mixed_scene.hpp"
+#include "tools/detsim/golden_runs.hpp"
 
 namespace detsim {
 namespace {
 
 const char* const kGoldenPath = DETSIM_SOURCE_DIR "/golden/fields.txt";
-
-struct Run {
-  const char* scenario;
-  ScenarioParams params;
-  std::uint64_t frames;
-};
-
-// The golden runs of `detsim golden check` (tools/detsim/cmd_golden.cpp), so that the two files
-// cover the same frames.
-constexpr Run kRuns[] = {
-    {"arena", {.seed = 1, .players = 4, .count = 0}, 1200},
-    {"bounce", {.seed = 1, .players = 0, .count = 0}, 1000},
-    {"bullet_wall", {.seed = 1, .players = 0, .count = 0}, 1000},
-    {"dominoes", {.seed = 1, .players = 0, .count = 0}, 1000},
-    {"pile_boxes", {.seed = 1, .players = 0, .count = 64}, 1000},
-    {"pile_spheres", {.seed = 1, .players = 0, .count = 64}, 1000},
-    {"pyramid", {.seed = 1, .players = 0, .count = 8}, 1000},
-    {"slope", {.seed = 1, .players = 0, .count = 0}, 1000},
-    {"spray", {.seed = 3, .players = 0, .count = 0}, 1200},
-    {"stack", {.seed = 1, .players = 0, .count = 0}, 1200},
-};
 
 // The layout hashed per frame: the frame number (u64), then per body in ascending ID order its ID
 // (u32) and the raw Q32.32 values (i64) of position x y z, orientation w x y z, linear velocity
@@ -92,7 +72,7 @@ std::uint64_t field_hash(const World& world, FieldBytes& bytes) {
 std::map<std::string, std::uint64_t> run_all() {
   std::map<std::string, std::uint64_t> out;
   FieldBytes bytes;
-  for (const Run& run : kRuns) {
+  for (const golden::GoldenRun& run : golden::runs) {
     auto created = Scenario::create(run.scenario, run.params);
     EXPECT_TRUE(created.ok()) << created.message();
     if (!created.ok()) continue;

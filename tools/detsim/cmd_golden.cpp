@@ -17,6 +17,7 @@
 #include <detsim/replay.hpp>
 
 #include "commands.hpp"
+#include "golden_runs.hpp"
 #include "output.hpp"
 #include "scenario_args.hpp"
 
@@ -30,28 +31,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// The golden runs: every scenario, each long enough to have a hash at frame 1000, and small enough
-/// for the emulated 32-bit legs of the determinism matrix, which run ~50x slower than x86-64: the
-/// piles have 64 bodies, the pyramid 8 rows, and the resting scenes fall asleep long before their
-/// last frame, after which a frame costs almost nothing.
-struct GoldenRun {
-  const char* scenario;
-  ScenarioParams params;
-  std::uint64_t frames;
-};
-
-constexpr GoldenRun kRuns[] = {
-    {"arena", {.seed = 1, .players = 4, .count = 0}, 1200},
-    {"bounce", {.seed = 1, .players = 0, .count = 0}, 1000},
-    {"bullet_wall", {.seed = 1, .players = 0, .count = 0}, 1000},
-    {"dominoes", {.seed = 1, .players = 0, .count = 0}, 1000},
-    {"pile_boxes", {.seed = 1, .players = 0, .count = 64}, 1000},
-    {"pile_spheres", {.seed = 1, .players = 0, .count = 64}, 1000},
-    {"pyramid", {.seed = 1, .players = 0, .count = 8}, 1000},
-    {"slope", {.seed = 1, .players = 0, .count = 0}, 1000},
-    {"spray", {.seed = 3, .players = 0, .count = 0}, 1200},
-    {"stack", {.seed = 1, .players = 0, .count = 0}, 1200},
-};
+using golden::GoldenRun;
+constexpr const auto& kRuns = golden::runs;
 
 /// The golden replays (recorded by `golden update`, verified by `golden check`).
 struct GoldenReplay {

@@ -1,0 +1,34 @@
+// The golden scenario runs: what `detsim golden` hashes into golden/scenarios.txt and what
+// tests/sim_field_identity_test.cpp records into golden/fields.txt, one list for both.
+#pragma once
+
+#include <cstdint>
+
+#include <detsim/scenes/scenario.hpp>
+
+namespace detsim::golden {
+
+/// Every scenario, each long enough to have a hash at frame 1000, and small enough for the
+/// emulated 32-bit legs of the determinism matrix, which run ~50x slower than x86-64: the piles
+/// have 64 bodies, the pyramid 8 rows, and the resting scenes fall asleep long before their last
+/// frame, after which a frame costs almost nothing.
+struct GoldenRun {
+  const char* scenario;
+  ScenarioParams params;
+  std::uint64_t frames;
+};
+
+inline constexpr GoldenRun runs[] = {
+    {"arena", {.seed = 1, .players = 4, .count = 0}, 1200},
+    {"bounce", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"bullet_wall", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"dominoes", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"pile_boxes", {.seed = 1, .players = 0, .count = 64}, 1000},
+    {"pile_spheres", {.seed = 1, .players = 0, .count = 64}, 1000},
+    {"pyramid", {.seed = 1, .players = 0, .count = 8}, 1000},
+    {"slope", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"spray", {.seed = 3, .players = 0, .count = 0}, 1200},
+    {"stack", {.seed = 1, .players = 0, .count = 0}, 1200},
+};
+
+}  // namespace detsim::golden
