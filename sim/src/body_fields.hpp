@@ -42,16 +42,93 @@ struct BodyField {
 /// The field called `name`, or nullptr.
 [[nodiscard]] const BodyField* find_body_field(std::string_view name) noexcept;
 
-/// Whether the field of `b` is zero (all components; false for a flag that is clear).
-[[nodiscard]] bool field_is_zero(const BodyField& f, const BodyState& b) noexcept;
+// Per field, per body, on every save: inline, so that the encoder's loops see through them.
+
+/// Whether the field of `b` is zero (all components; a flag: clear).
+[[nodiscard]] inline bool field_is_zero(const BodyField& f, const BodyState& b) noexcept {
+  switch (f.kind) {
+    case FieldKind::fixed:
+      return b.*f.fixed == Fixed::zero();
+    case FieldKind::vec3:
+      return b.*f.vec3 == Vec3{};
+    case FieldKind::quat:
+      return b.*f.quat == Quat{Fixed::zero(), {}, {}, {}};
+    case FieldKind::u32:
+      return b.*f.u32 == 0;
+    case FieldKind::u64:
+      return b.*f.u64 == 0;
+    case FieldKind::flag:
+      return !(b.*f.flag);
+  }
+  return false;
+}
 
 /// The two bodies' values of the field are equal.
-[[nodiscard]] bool field_equal(const BodyField& f, const BodyState& a, const BodyState& b) noexcept;
+[[nodiscard]] inline bool field_equal(const BodyField& f, const BodyState& a,
+                                      const BodyState& b) noexcept {
+  switch (f.kind) {
+    case FieldKind::fixed:
+      return a.*f.fixed == b.*f.fixed;
+    case FieldKind::vec3:
+      return a.*f.vec3 == b.*f.vec3;
+    case FieldKind::quat:
+      return a.*f.quat == b.*f.quat;
+    case FieldKind::u32:
+      return a.*f.u32 == b.*f.u32;
+    case FieldKind::u64:
+      return a.*f.u64 == b.*f.u64;
+    case FieldKind::flag:
+      return a.*f.flag == b.*f.flag;
+  }
+  return false;
+}
 
 /// Sets the field of `b` to zero (false for a flag).
-void clear_field(const BodyField& f, BodyState& b) noexcept;
+inline void clear_field(const BodyField& f, BodyState& b) noexcept {
+  switch (f.kind) {
+    case FieldKind::fixed:
+      b.*f.fixed = {};
+      break;
+    case FieldKind::vec3:
+      b.*f.vec3 = {};
+      break;
+    case FieldKind::quat:
+      b.*f.quat = Quat{Fixed::zero(), {}, {}, {}};
+      break;
+    case FieldKind::u32:
+      b.*f.u32 = 0;
+      break;
+    case FieldKind::u64:
+      b.*f.u64 = 0;
+      break;
+    case FieldKind::flag:
+      b.*f.flag = false;
+      break;
+  }
+}
 
 /// Copies the field from `from` to `to`.
-void copy_field(const BodyField& f, BodyState& to, const BodyState& from) noexcept;
+inline void copy_field(const BodyField& f, BodyState& to, const BodyState& from) noexcept {
+  switch (f.kind) {
+    case FieldKind::fixed:
+      to.*f.fixed = from.*f.fixed;
+      break;
+    case FieldKind::vec3:
+      to.*f.vec3 = from.*f.vec3;
+      break;
+    case FieldKind::quat:
+      to.*f.quat = from.*f.quat;
+      break;
+    case FieldKind::u32:
+      to.*f.u32 = from.*f.u32;
+      break;
+    case FieldKind::u64:
+      to.*f.u64 = from.*f.u64;
+      break;
+    case FieldKind::flag:
+      to.*f.flag = from.*f.flag;
+      break;
+  }
+}
 
 }  // namespace detsim::sim_detail

@@ -84,7 +84,8 @@ const GroupLayout& motion_layout() {
   return layout;
 }
 
-void write_value(const BodyField& f, const BodyState& b, ByteWriter& w) {
+[[gnu::always_inline]] inline void write_value(const BodyField& f, const BodyState& b,
+                                               ByteWriter& w) {
   switch (f.kind) {
     case FieldKind::fixed:
       w.var_fixed(b.*f.fixed);
@@ -128,7 +129,7 @@ void read_value(const BodyField& f, BodyState& b, ByteReader& r, const char* wha
   }
 }
 
-std::uint8_t flags_of(const GroupLayout& layout, const BodyState& b) {
+[[gnu::always_inline]] inline std::uint8_t flags_of(const GroupLayout& layout, const BodyState& b) {
   unsigned bits = 0;
   unsigned bit = 0;
   for (const BodyField* f : layout.flags)
