@@ -2,6 +2,8 @@
 // stepper's paths. `each_frame(world, frame)` is called after every step (frames 1..600).
 #pragma once
 
+#include <functional>
+
 #include <gtest/gtest.h>
 #include <detsim/detsim.hpp>
 
@@ -10,8 +12,9 @@ namespace detsim::test {
 // Spheres, boxes and capsules rained from RNG-chosen places onto a ground plane, a kinematic paddle
 // sweeping through them, a tilted static ramp, forces and impulses from the RNG every frame: most
 // of the stepper's paths (every shape pair, sleep and wake, kinematic pushing, warm starting).
-template <class EachFrame>
-void run_mixed_scene(EachFrame&& each_frame) {
+// Not a template: clang 14 leaves consteval literals (_fx) inside a function template's
+// instantiation as undefined references.
+inline void run_mixed_scene(const std::function<void(const World&, int)>& each_frame) {
   using namespace detsim::literals;
   WorldDef def;
   def.seed = 2026;
