@@ -12,6 +12,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include <detsim/core/assert.hpp>
+
 #include "body_fields.hpp"
 #include "shapes.hpp"
 #include "state_io.hpp"
@@ -45,13 +47,10 @@ struct GroupLayout {
         values.push_back(&f);
       }
     }
+    DETSIM_ASSERT(flags.size() + optional.size() <= 8);  // one flags byte
     names.reserve(body_fields().size());
-    for (const BodyField& f : body_fields()) {
-      std::string name = std::string("body ") + f.name;
-      for (char& c : name)
-        if (c == '_') c = ' ';
-      names.push_back(std::move(name));
-    }
+    for (const BodyField& f : body_fields())
+      names.push_back("body " + display(f));
     flags_expected = "only bits ";
     std::size_t bit = 0;
     for (const auto* list : {&flags, &optional}) {
