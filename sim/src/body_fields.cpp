@@ -8,36 +8,36 @@ namespace detsim::sim_detail {
 
 namespace {
 
-constexpr BodyField fixed_field(const char* name, FieldGroup g, Fixed BodyState::*m) {
-  BodyField f{name, FieldKind::fixed, g, false};
+// The member pointer's type picks the kind.
+constexpr void set_member(BodyField& f, Fixed BodyState::*m) {
+  f.kind = FieldKind::fixed;
   f.fixed = m;
-  return f;
 }
-constexpr BodyField vec3_field(const char* name, FieldGroup g, Vec3 BodyState::*m,
-                               bool optional = false) {
-  BodyField f{name, FieldKind::vec3, g, optional};
+constexpr void set_member(BodyField& f, Vec3 BodyState::*m) {
+  f.kind = FieldKind::vec3;
   f.vec3 = m;
-  return f;
 }
-constexpr BodyField quat_field(const char* name, FieldGroup g, Quat BodyState::*m) {
-  BodyField f{name, FieldKind::quat, g, false};
+constexpr void set_member(BodyField& f, Quat BodyState::*m) {
+  f.kind = FieldKind::quat;
   f.quat = m;
-  return f;
 }
-constexpr BodyField u32_field(const char* name, FieldGroup g, std::uint32_t BodyState::*m) {
-  BodyField f{name, FieldKind::u32, g, false};
+constexpr void set_member(BodyField& f, std::uint32_t BodyState::*m) {
+  f.kind = FieldKind::u32;
   f.u32 = m;
-  return f;
 }
-constexpr BodyField u64_field(const char* name, FieldGroup g, std::uint64_t BodyState::*m,
-                              bool optional) {
-  BodyField f{name, FieldKind::u64, g, optional};
+constexpr void set_member(BodyField& f, std::uint64_t BodyState::*m) {
+  f.kind = FieldKind::u64;
   f.u64 = m;
-  return f;
 }
-constexpr BodyField flag_field(const char* name, FieldGroup g, bool BodyState::*m) {
-  BodyField f{name, FieldKind::flag, g, false};
+constexpr void set_member(BodyField& f, bool BodyState::*m) {
+  f.kind = FieldKind::flag;
   f.flag = m;
+}
+
+template <class T>
+constexpr BodyField field(const char* name, FieldGroup g, T BodyState::*m, bool optional = false) {
+  BodyField f{name, FieldKind::fixed, g, optional};
+  set_member(f, m);
   return f;
 }
 
@@ -47,25 +47,25 @@ constexpr FieldGroup motion = FieldGroup::motion;
 // BodyState's fields after id, type and shape, in declaration order. The encoding follows from
 // the order and the groups (docs/STATE.md, "bodies"): never reorder, only append.
 constexpr std::array kFields{
-    vec3_field("position", motion, &BodyState::position),
-    quat_field("orientation", motion, &BodyState::orientation),
-    vec3_field("linear_velocity", motion, &BodyState::linear_velocity),
-    vec3_field("angular_velocity", motion, &BodyState::angular_velocity),
-    fixed_field("mass", property, &BodyState::mass),
-    vec3_field("inertia", property, &BodyState::inertia),
-    fixed_field("friction", property, &BodyState::friction),
-    fixed_field("restitution", property, &BodyState::restitution),
-    fixed_field("linear_damping", property, &BodyState::linear_damping),
-    fixed_field("angular_damping", property, &BodyState::angular_damping),
-    u32_field("layer", property, &BodyState::layer),
-    u32_field("mask", property, &BodyState::mask),
-    flag_field("sensor", property, &BodyState::sensor),
-    flag_field("ccd", property, &BodyState::ccd),
-    u64_field("user_data", motion, &BodyState::user_data, true),
-    flag_field("awake", motion, &BodyState::awake),
-    fixed_field("sleep_time", motion, &BodyState::sleep_time),
-    vec3_field("force", motion, &BodyState::force, true),
-    vec3_field("torque", motion, &BodyState::torque, true),
+    field("position", motion, &BodyState::position),
+    field("orientation", motion, &BodyState::orientation),
+    field("linear_velocity", motion, &BodyState::linear_velocity),
+    field("angular_velocity", motion, &BodyState::angular_velocity),
+    field("mass", property, &BodyState::mass),
+    field("inertia", property, &BodyState::inertia),
+    field("friction", property, &BodyState::friction),
+    field("restitution", property, &BodyState::restitution),
+    field("linear_damping", property, &BodyState::linear_damping),
+    field("angular_damping", property, &BodyState::angular_damping),
+    field("layer", property, &BodyState::layer),
+    field("mask", property, &BodyState::mask),
+    field("sensor", property, &BodyState::sensor),
+    field("ccd", property, &BodyState::ccd),
+    field("user_data", motion, &BodyState::user_data, true),
+    field("awake", motion, &BodyState::awake),
+    field("sleep_time", motion, &BodyState::sleep_time),
+    field("force", motion, &BodyState::force, true),
+    field("torque", motion, &BodyState::torque, true),
 };
 
 }  // namespace
