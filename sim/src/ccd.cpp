@@ -8,7 +8,11 @@
 // kept: the next step's speculative contact then stops it as usual. Swept bodies: those with the
 // CCD flag, and any dynamic body whose travel in the step exceeds half its smallest dimension.
 // They are swept in ascending ID order against every other solid body the layers allow, static
-// ones and moving ones alike (those at their pose after the solver, possibly already moved back).
+// ones and moving ones alike. A moving one is swept too, from its pose at the start of the step to
+// its pose now (after the solver, possibly already moved back): the time of impact is the pair's,
+// both at the same fraction of the step, so a bullet stops at a crate it hits however fast either
+// moves, and never at a body that moves along with it. Ties are broken by ID: lower IDs are swept
+// first, and a later body sweeps against where they ended.
 //
 // The sweep is conservative advancement: with d the distance at time t of the step and b a bound
 // on how fast the distance can shrink per unit of t, no touch can happen before t + d / b. Every
@@ -110,7 +114,6 @@ void continuous(WorldState& s) {
                   max(sweep.p0.z, sweep.p1.z)};
     const Vec3 sweep_min = lo - rr;
     const Vec3 sweep_max = hi + rr;
-    const Fixed beyond = bound + target + r;
 
     Fixed first_hit = Fixed::one();  // the earliest touch, as a fraction of the step
     for (std::size_t j = 0; j < s.bodies.size(); ++j) {
@@ -118,22 +121,43 @@ void continuous(WorldState& s) {
       const BodyState& other = s.bodies[j];
       if (other.sensor) continue;
       if ((body.layer & other.mask) == 0 || (other.layer & body.mask) == 0) continue;
-      const Pose other_pose{other.position, to_mat3(other.orientation)};
+      // The other body moves too, from its pose at the start of the step to its pose now: the
+      // sweep is of the pair, both at the same time t, so a body that moves along with this one
+      // is never hit, and one that this body passed during the step always is.
+      const Derived& od = s.derived[j];
+      const Sweep other_sweep{od.start_position, other.position, od.start_orientation,
+                              other.orientation, other.orientation != od.start_orientation};
+      const bool other_moves = other_sweep.p0 != other_sweep.p1 || other_sweep.turns;
+      Fixed pair_bound = bound;
       if (shape_kind(other.shape.type).bounded) {
         const Fixed o = bounding_radius(other.shape);
         const Vec3 oo{o, o, o};
-        if (!box_overlap(sweep_min, sweep_max, other.position - oo, other.position + oo)) continue;
+        const Vec3 olo{min(other_sweep.p0.x, other_sweep.p1.x),
+                       min(other_sweep.p0.y, other_sweep.p1.y),
+                       min(other_sweep.p0.z, other_sweep.p1.z)};
+        const Vec3 ohi{max(other_sweep.p0.x, other_sweep.p1.x),
+                       max(other_sweep.p0.y, other_sweep.p1.y),
+                       max(other_sweep.p0.z, other_sweep.p1.z)};
+        if (!box_overlap(sweep_min, sweep_max, olo - oo, ohi + oo)) continue;
+        if (other_moves) {
+          pair_bound += length(other_sweep.p1 - other_sweep.p0);
+          if (other_sweep.turns)
+            pair_bound += angle_bound(other_sweep.q0, other_sweep.q1) * o * Fixed::from_int(2);
+        }
       }
+      const Fixed pair_beyond = pair_bound + target + r;
       // Already touching at the start: the contact solver has it; a sweep would only stick.
-      if (distance(body.shape, sweep.at(Fixed::zero()), other.shape, other_pose, beyond) <= target)
+      if (distance(body.shape, sweep.at(Fixed::zero()), other.shape, other_sweep.at(Fixed::zero()),
+                   pair_beyond) <= target)
         continue;
       Fixed t = Fixed::zero();
       bool stop = true;  // a touch, or out of iterations: t is then the last safe time
       for (int k = 0; k < max_iterations; ++k) {
-        const Fixed gap = distance(body.shape, sweep.at(t), other.shape, other_pose, beyond);
+        const Fixed gap =
+            distance(body.shape, sweep.at(t), other.shape, other_sweep.at(t), pair_beyond);
         if (gap <= target) break;
         // A safe advance that aims for half the target gap, so the loop ends near the surface.
-        t += (gap - target / Fixed::from_int(2)) / bound;
+        t += (gap - target / Fixed::from_int(2)) / pair_bound;
         if (t >= first_hit) {
           stop = false;  // no touch before what is already known
           break;

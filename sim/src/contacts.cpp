@@ -182,10 +182,15 @@ void report_contacts(WorldState& s) {
 void update_sleep(WorldState& s) {
   const Fixed lin2 = s.def.sleep_linear_speed * s.def.sleep_linear_speed;
   const Fixed ang2 = s.def.sleep_angular_speed * s.def.sleep_angular_speed;
-  for (BodyState& b : s.bodies) {
+  // A body that overlap recovery is still moving apart is not at rest, whatever its velocity.
+  const Fixed pushed_limit = s.def.sleep_linear_speed * s.def.dt;
+  const Fixed pushed2 = pushed_limit * pushed_limit;
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    BodyState& b = s.bodies[i];
     if (b.type != BodyType::dynamic || !b.awake) continue;
-    const bool slow =
-        length_squared(b.linear_velocity) <= lin2 && length_squared(b.angular_velocity) <= ang2;
+    const bool slow = length_squared(b.linear_velocity) <= lin2 &&
+                      length_squared(b.angular_velocity) <= ang2 &&
+                      length_squared(s.derived[i].pushed_out) <= pushed2;
     b.sleep_time = slow ? min(b.sleep_time + s.def.dt, Fixed::from_int(1000)) : Fixed::zero();
   }
   if (!s.def.enable_sleep) return;

@@ -68,6 +68,7 @@ void prepare_body(WorldState& s, std::size_t i) {
   d.start_orientation = b.orientation;
   d.delta_position = {};
   d.delta_angle = {};
+  d.pushed_out = {};
 }
 
 }  // namespace sim_detail

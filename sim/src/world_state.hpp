@@ -71,6 +71,7 @@ struct Derived {
   // Solver scratch for the current step.
   Vec3 delta_position;  ///< since the start of the step
   Vec3 delta_angle;     ///< small-angle sum of angular velocity * h since the start of the step
+  Vec3 pushed_out;      ///< how far overlap recovery moved the body this step (part of delta)
 };
 
 struct WorldState {

@@ -12,9 +12,18 @@ Vec3 halve(Vec3 v) {
 
 // `inline`: called twice per body per sub-step; the hint keeps it inlined as it was when it was a
 // member function defined in its class.
+// The result's length never exceeds the limit: v * (limit / |v|) can round a few ulp above it, so
+// the factor steps down by one ulp until it does not (one or two steps; each shortens the result
+// by |v| ulp, more than the rounding it makes up for).
 inline Vec3 clamp_speed(Vec3 v, Fixed limit) {
   if (!length_exceeds(v, limit)) return v;  // length(v) <= limit, most often: no root needed
-  return v * (limit / length(v));
+  Fixed factor = limit / length(v);
+  Vec3 r = v * factor;
+  while (length_exceeds(r, limit)) {
+    factor -= Fixed::from_raw(1);
+    r = v * factor;
+  }
+  return r;
 }
 
 bool solvable(const BodyState& b) {
@@ -32,9 +41,9 @@ SolverBodies::SolverBodies(WorldState& state) : s(state) {
   h = s.def.dt / substeps;
   inv_h = substeps / s.def.dt;
   gravity_kick = s.def.gravity * h;
-  gravity_half_kick = halve(gravity_kick);
   velocities.resize(s.bodies.size());
   half_kick.resize(s.bodies.size());
+  push.resize(s.bodies.size());
   in_contact.assign(s.bodies.size(), false);
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
     const BodyState& b = s.bodies[i];
@@ -65,13 +74,11 @@ void SolverBodies::integrate_velocities() {
     Velocity& v = velocities[i];
     // Without a force, the kick is gravity's (g + 0 m = g exactly), the same for every body; a
     // zero torque adds exactly zero (M 0 h = 0).
+    const Vec3 start = v.linear;
     if (b.force == Vec3{}) {
-      half_kick[i] = gravity_half_kick;
       v.linear += gravity_kick;
     } else {
-      const Vec3 kick = (def.gravity + b.force * d.inverse_mass) * h;
-      half_kick[i] = halve(kick);
-      v.linear += kick;
+      v.linear += (def.gravity + b.force * d.inverse_mass) * h;
     }
     if (b.torque != Vec3{}) v.angular += (d.inverse_inertia_world * b.torque) * h;
     // Implicit damping, unconditionally stable: v /= 1 + h c.
@@ -79,6 +86,12 @@ void SolverBodies::integrate_velocities() {
     if (b.angular_damping > Fixed::zero()) v.angular /= Fixed::one() + h * b.angular_damping;
     v.linear = clamp_speed(v.linear, def.max_linear_speed);
     v.angular = clamp_speed(v.angular, def.max_angular_speed);
+    // Half of the velocity change the body actually got: after damping and the speed limit, so
+    // that the trapezoidal position step below stays between the old and the new velocity (half
+    // of the unclamped kick of a huge force moved a body backwards by far more than the limit).
+    // Without damping or clamping it is half of the kick itself, bit for bit ((v + k) - v = k in
+    // fixed point, where nothing saturates).
+    half_kick[i] = halve(v.linear - start);
   }
 }
 
@@ -103,12 +116,23 @@ void SolverBodies::integrate_positions() {
     // forces follows the exact parabola (semi-implicit Euler alone loses v h / 2 of height per
     // flight). A body with contact points keeps plain semi-implicit Euler, whose resting
     // equilibrium the soft contacts are tuned for (the shifted one creeps sideways).
-    const Vec3 dp = in_contact[i] ? v.linear * h : (v.linear - half_kick[i]) * h;
+    Vec3 dp = in_contact[i] ? v.linear * h : (v.linear - half_kick[i]) * h;
+    Vec3 angular = v.angular;
+    Velocity& p = push[i];
+    if (p.linear != Vec3{} || p.angular != Vec3{}) {
+      // Overlap recovery moves the body by at most contact_push_max per second (and turns it no
+      // faster than the angular speed limit), however many bodies it overlaps.
+      const Vec3 pushed = clamp_speed(p.linear, s.def.contact_push_max) * h;
+      dp += pushed;
+      d.pushed_out += pushed;
+      angular += clamp_speed(p.angular, s.def.max_angular_speed);
+      p = {};
+    }
     b.position += dp;
     d.delta_position += dp;
-    if (v.angular != Vec3{}) {
-      b.orientation = integrate(b.orientation, v.angular, h);
-      d.delta_angle += v.angular * h;
+    if (angular != Vec3{}) {
+      b.orientation = integrate(b.orientation, angular, h);
+      d.delta_angle += angular * h;
     }
   }
 }

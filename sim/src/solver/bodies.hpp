@@ -34,17 +34,21 @@ struct SolverBodies {
   /// The speed limits, again: contact impulses (a crushed light body) can exceed what gravity
   /// could.
   void clamp_speeds();
-  /// Positions and orientations by one sub-step, and the motion since the step began.
+  /// Positions and orientations by one sub-step (velocity plus push-out velocity), and the
+  /// motion since the step began; the push-out velocities go back to zero.
   void integrate_positions();
   /// Writes the velocities back to the awake bodies (once, after the last sub-step).
   void store_velocities();
 
   WorldState& s;
-  Fixed h;                 ///< the sub-step, dt / substeps
-  Fixed inv_h;             ///< substeps / dt
-  Vec3 gravity_kick;       ///< gravity * h: the velocity change of a body without forces
-  Vec3 gravity_half_kick;  ///< half of gravity_kick
+  Fixed h;            ///< the sub-step, dt / substeps
+  Fixed inv_h;        ///< substeps / dt
+  Vec3 gravity_kick;  ///< gravity * h: the velocity change of a body without forces
   std::vector<Velocity> velocities;
+  /// Overlap recovery's velocities for the current sub-step (split impulses): they move the
+  /// positions apart in integrate_positions, limited to contact_push_max, and are then dropped,
+  /// so pushing overlapping bodies apart never gives them kinetic energy.
+  std::vector<Velocity> push;
   std::vector<Vec3> half_kick;  ///< half of this sub-step's velocity change from gravity and forces
   /// The body has contact points this step (set by the contact kind's prepare).
   std::vector<bool> in_contact;

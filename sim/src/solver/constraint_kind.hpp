@@ -25,13 +25,16 @@ class ConstraintKind {
   virtual void prepare() = 0;
   /// Once per sub-step: applies the accumulated impulses.
   virtual void warm_start() = 0;
-  /// `iterations` times per sub-step: one pass with the position bias (soft constraints).
+  /// `iterations` times per sub-step: one pass over the velocity constraints.
   virtual void solve() = 0;
+  /// `iterations` times per sub-step, after solve: one pass of position error recovery on the
+  /// push-out velocities (SolverBodies::push), which move positions and are never kept.
+  virtual void push_out() = 0;
   /// Once per sub-step, after the bodies moved: updates what depends on their positions (a
   /// contact's separations).
   virtual void positions_moved() = 0;
-  /// `iterations` times per sub-step, after the positions moved: one pass without bias, removing
-  /// the velocity that the bias added.
+  /// `iterations` times per sub-step, after the positions moved: one more pass over the velocity
+  /// constraints, at the new positions.
   virtual void relax() = 0;
   /// Once per sub-step, after relaxing: restitution (bounces).
   virtual void restitution() = 0;

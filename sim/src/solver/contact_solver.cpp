@@ -10,6 +10,14 @@
 // bounce loses almost nothing. Every constraint is solved in contact order (ascending ID pair),
 // point order within a contact: the order is part of the result.
 //
+// Under abuse the spring alone gives way: a load of thousands of times a body's weight pressed
+// it through the floor, and overlap pushed apart at contact_push_max per contact added up to tens
+// of metres per second among hundreds of overlapping bodies. So the spring has a range, the
+// speculative distance below the surface: a point may approach no faster than what stops it at
+// the end of that range within the sub-step (hard_stop), and overlap beyond the range is not
+// pushed by velocity at all but by push_out, on velocities that move the positions and are then
+// dropped. Ordinary contacts never leave the range and behave as the plain soft step.
+//
 // Each point has three rows (the normal and two tangents, rows.hpp), each with its Jacobian per
 // body, computed once per step because the anchors and the world inertia stay fixed for the step.
 // The two friction rows of a point are pushed together. The sub-steps then need no cross product
@@ -102,11 +110,13 @@ void ContactSolver::prepare_constraint(std::size_t ci) {
     sp.tangent_impulse_2 = c.cached[p].tangent_impulse_2;
   }
   k.bounce = {};
-  if (k.restitution != Fixed::zero()) {  // the centroid serves restitution only
+  // The centroid's row: the whole manifold's first push (solve_centre), and restitution's.
+  if (c.point_count > 1 || k.restitution != Fixed::zero()) {
     const Fixed count = Fixed::from_int(c.point_count);
     k.bounce.normal = make_row(da, db, sum_a / count, sum_b / count, normal);
-    k.bounce.relative_velocity = row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
   }
+  if (k.restitution != Fixed::zero())
+    k.bounce.relative_velocity = row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
   bodies_.in_contact[ia] = true;
   bodies_.in_contact[ib] = true;
 }
@@ -115,6 +125,7 @@ void ContactSolver::warm_start() {
   for (ContactConstraint& k : constraints_) {
     for (std::size_t p = 0; p < k.count; ++p) {
       SolverPoint& sp = k.points[p];
+      sp.push_impulse = Fixed::zero();
       // A point whose surfaces have come apart (a bounce, a body lifted off) carries no load:
       // re-applying its old impulse would push the bodies apart a second time and feed energy
       // into whatever else they touch before this point's own solve takes it back.
@@ -135,6 +146,7 @@ void ContactSolver::warm_start() {
 // per contact per pass, and the hint keeps it inside solve_contacts' loop, where it was written
 // before the contact kind had a file of its own.
 inline void ContactSolver::solve_normal(ContactConstraint& k, const Softness& soft, bool use_bias) {
+  const Fixed depth = s_.def.speculative_distance;
   for (std::size_t p = 0; p < k.count; ++p) {
     SolverPoint& sp = k.points[p];
     const Fixed separation = sp.separation;
@@ -142,7 +154,10 @@ inline void ContactSolver::solve_normal(ContactConstraint& k, const Softness& so
     bool soft_push = false;  // soft: mass and impulse scaled; else scales 1 and 0
     if (separation > Fixed::zero()) {
       bias = separation * bodies_.inv_h;  // speculative: close the gap within this sub-step
-    } else if (use_bias) {
+    } else if (use_bias && separation >= -depth) {
+      // Overlap within the soft range: a damped spring pushes it apart (and gives a little under
+      // load). Deeper, the point is rigid (bias zero): the bodies may not approach at all, and
+      // push_out moves the excess apart without velocity.
       bias = max(soft.bias_rate * min(separation + s_.def.linear_slop, Fixed::zero()),
                  -s_.def.contact_push_max);
       soft_push = true;
@@ -152,12 +167,49 @@ inline void ContactSolver::solve_normal(ContactConstraint& k, const Softness& so
     Fixed impulse = soft_push ? -sp.normal.mass * soft.mass_scale * (vn + bias) -
                                     soft.impulse_scale * sp.normal_impulse
                               : -sp.normal.mass * (vn + bias);
+    // The spring has a hard stop at the end of its range: at least the impulse that stops the
+    // point there within this sub-step, whatever presses the bodies together.
+    if (soft_push)
+      impulse = max(impulse, -sp.normal.mass * (vn + hard_stop(separation) * bodies_.inv_h));
     const Fixed accumulated = max(sp.normal_impulse + impulse, Fixed::zero());
     impulse = accumulated - sp.normal_impulse;
     sp.normal_impulse = accumulated;
     if (impulse > Fixed::zero()) k.pushed = true;
     apply_impulse(bodies_.velocities, k.bodies, k.normal, sp.normal, impulse);
   }
+}
+
+// How far a point at `separation` may still close within a sub-step: to the surface when apart
+// (a speculative contact), to the end of the soft range (the speculative distance) when
+// overlapping within it, not at all beyond.
+inline Fixed ContactSolver::hard_stop(Fixed separation) const {
+  if (separation > Fixed::zero()) return separation;
+  return max(separation + s_.def.speculative_distance, Fixed::zero());
+}
+
+// The manifold as one: before its points, an impulse at the centroid of its points stops the
+// centroid's approach (up to the smallest gap, which a speculative contact may close), booked in
+// equal shares to the points, whose own rows then correct the rest. Solved one after another
+// alone, the first point of a face takes the whole load and turns the body, which the next
+// points must undo: with the few passes of a sub-step, a box pressed onto a floor by a huge force
+// kept turning into it, and a box hitting a wall face-on left spinning. The shares are the
+// points' accumulated impulses, so the solution is the same problem's, reached from a better
+// start. Only a push is applied here: taking load off is left to each point's own row.
+inline void ContactSolver::solve_centre(ContactConstraint& k) {
+  if (k.count < 2) return;
+  Fixed gap = k.points[0].separation;
+  for (std::size_t p = 1; p < k.count; ++p)
+    gap = min(gap, k.points[p].separation);
+  const Fixed bias = hard_stop(gap) * bodies_.inv_h;
+  const Fixed vn = row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
+  const Fixed impulse = -k.bounce.normal.mass * (vn + bias);
+  if (impulse <= Fixed::zero()) return;
+  const Fixed share = impulse / Fixed::from_int(k.count);
+  for (std::size_t p = 0; p < k.count; ++p)
+    k.points[p].normal_impulse += share;
+  k.pushed = true;
+  apply_impulse(bodies_.velocities, k.bodies, k.normal, k.bounce.normal,
+                share * Fixed::from_int(k.count));
 }
 
 // Coulomb friction, each point limited to the disc of radius friction * normal impulse.
@@ -196,21 +248,48 @@ void ContactSolver::solve() {
   solve_contacts(true);
 }
 
+// Overlap recovery (split impulses, Catto 2006; Bullet's split impulse; Jolt's position
+// iterations): each point overlapping by more than linear_slop asks its bodies' push-out
+// velocities to separate at the spring's rate, bias_rate * overlap (contact_hertz and the damping
+// ratio, stiffer against static bodies), up to contact_push_max. The push-out velocities move the
+// positions in integrate_positions and are then dropped: recovery never adds kinetic energy, and
+// the velocity constraints (solve, relax) stay rigid, so no load can press a body further in.
+void ContactSolver::push_out() {
+  const Fixed depth = s_.def.speculative_distance;
+  const Fixed push_max = s_.def.contact_push_max;
+  for (ContactConstraint& k : constraints_) {
+    const bool against_static = s_.derived[k.bodies.a].inverse_mass == Fixed::zero() ||
+                                s_.derived[k.bodies.b].inverse_mass == Fixed::zero();
+    const Fixed rate = against_static ? static_soft_.bias_rate : soft_.bias_rate;
+    for (std::size_t p = 0; p < k.count; ++p) {
+      SolverPoint& sp = k.points[p];
+      const Fixed overlap = -(sp.separation + depth);  // beyond the soft range
+      if (overlap <= Fixed::zero() && sp.push_impulse == Fixed::zero()) continue;
+      const Fixed target = min(rate * max(overlap, Fixed::zero()), push_max);
+      const Fixed vn = row_speed(bodies_.push, k.bodies, k.normal, sp.normal);
+      const Fixed impulse = sp.normal.mass * (target - vn);
+      const Fixed accumulated = max(sp.push_impulse + impulse, Fixed::zero());
+      apply_impulse(bodies_.push, k.bodies, k.normal, sp.normal, accumulated - sp.push_impulse);
+      sp.push_impulse = accumulated;
+    }
+  }
+}
+
 void ContactSolver::relax() {
   solve_contacts(false);
 }
 
-void ContactSolver::solve_contacts(bool use_bias) {
+void ContactSolver::solve_contacts(bool first_pass) {
   for (ContactConstraint& k : constraints_) {
-    const bool against_static = s_.derived[k.bodies.a].inverse_mass == Fixed::zero() ||
-                                s_.derived[k.bodies.b].inverse_mass == Fixed::zero();
-    const Softness& soft = against_static ? static_soft_ : soft_;
     // Until the contact first pushes, its approach speed (at the centroid, before any point is
     // solved) is what restitution must reverse.
-    if (use_bias && !k.pushed && k.restitution != Fixed::zero())
+    if (first_pass && !k.pushed && k.restitution != Fixed::zero())
       k.bounce.relative_velocity =
           row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
-    solve_normal(k, soft, use_bias);
+    const bool against_static = s_.derived[k.bodies.a].inverse_mass == Fixed::zero() ||
+                                s_.derived[k.bodies.b].inverse_mass == Fixed::zero();
+    solve_centre(k);
+    solve_normal(k, against_static ? static_soft_ : soft_, first_pass);
     solve_friction(k);
   }
 }

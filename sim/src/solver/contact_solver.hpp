@@ -25,6 +25,7 @@ struct SolverPoint {
   Fixed normal_impulse;
   Fixed tangent_impulse_1;
   Fixed tangent_impulse_2;
+  Fixed push_impulse;  ///< accumulated on the push-out velocities, this sub-step
 };
 
 /// Restitution acts once per contact, along the normal at the centroid of its points.
@@ -46,7 +47,7 @@ struct ContactConstraint {
   bool pushed;   ///< some point has pushed in this step
   bool bounced;  ///< restitution applied this step
   std::array<SolverPoint, 4> points;
-  Bounce bounce;  ///< set only when restitution is not zero
+  Bounce bounce;  ///< the centroid's row: set when there are 2 or more points or restitution
 };
 
 /// The contacts of the step, in contact order (ascending ID pair), point order within a contact.
@@ -63,6 +64,7 @@ class ContactSolver final : public ConstraintKind {
   void prepare() override;
   void warm_start() override;
   void solve() override;
+  void push_out() override;
   void positions_moved() override;
   void relax() override;
   void restitution() override;
@@ -70,7 +72,9 @@ class ContactSolver final : public ConstraintKind {
 
  private:
   void prepare_constraint(std::size_t contact_index);
-  void solve_contacts(bool use_bias);
+  void solve_contacts(bool first_pass);
+  [[nodiscard]] Fixed hard_stop(Fixed separation) const;
+  void solve_centre(ContactConstraint& k);
   void solve_normal(ContactConstraint& k, const Softness& soft, bool use_bias);
   void solve_friction(ContactConstraint& k);
   [[nodiscard]] Fixed current_separation(const ContactConstraint& k, const SolverPoint& p) const;

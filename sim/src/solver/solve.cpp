@@ -4,8 +4,10 @@
 // Per step, each constraint kind prepares its rows (prepare). Then, for each of `substeps`
 // sub-steps of length h = dt / substeps: integrate velocities (gravity, forces, damping, speed
 // clamp) -> warm start (apply the accumulated impulses) -> solve (soft constraints with a
-// position bias, `iterations` passes) -> clamp speeds -> integrate positions (and let each kind
-// update what depends on them: a contact's separations) -> relax (the same constraints without
+// position bias, `iterations` passes) -> push out (overlap beyond a constraint's soft range, on
+// push-out velocities that move positions and are then dropped, `iterations` passes) -> clamp
+// speeds -> integrate positions (velocity plus push-out velocity; each kind then updates what
+// depends on positions: a contact's separations) -> relax (the same constraints without
 // bias, `iterations` passes, removing the velocity the bias added) -> restitution (contacts that
 // took their first impulse in this sub-step bounce, once per step, so a bouncing body moves away
 // for the rest of the step instead of resting on the surface until the step ends) -> clamp
@@ -61,6 +63,7 @@ void solve(WorldState& s) {
     bodies.integrate_velocities();
     each_kind(kinds, &ConstraintKind::warm_start);
     each_kind(kinds, &ConstraintKind::solve, iterations);
+    each_kind(kinds, &ConstraintKind::push_out, iterations);
     bodies.clamp_speeds();
     bodies.integrate_positions();
     each_kind(kinds, &ConstraintKind::positions_moved);
