@@ -246,6 +246,41 @@ TEST(CoincidentSpawn, NeverGainsMoreEnergyThanThePushOutCapAllows) {
   RecordProperty("most_energy_j", std::to_string(most));
 }
 
+// --- A scene of millimetres behaves like a scene of metres -------------------------------------
+
+class SmallStack : public testing::TestWithParam<std::int32_t> {};
+
+// Five boxes of edge 1 / GetParam() m, 10 g each, stacked on the ground in a world made for that
+// size (scale_lengths): the stack stands, no box more than a tenth of an edge from where it was
+// put, sideways or down, as a stack of metre boxes does. (With the metre defaults, the 1 cm and
+// 1 mm stacks fall over: the contact spring sags by more than a body's size.)
+TEST_P(SmallStack, StandsInAWorldMadeForItsSize) {
+  const Fixed edge = 1_fx / Fixed::from_int(GetParam());
+  const WorldDef def = scale_lengths(WorldDef{}, edge);
+  const Fixed half = edge / 2_fx;
+  std::vector<BodyId> ids;
+  run(
+      def,
+      [&](World& w) {
+        ids.clear();
+        add_ground(w);
+        for (int i = 0; i < 5; ++i)
+          ids.push_back(add(w, box({{}, half + edge * Fixed::from_int(i), {}}, half, 0.01_fx)));
+      },
+      300, {},
+      [&](World& w, int f) {
+        for (std::size_t i = 0; i < ids.size(); ++i) {
+          const BodyState s = state(w, ids[i]);
+          const Fixed put = half + edge * Fixed::from_int(static_cast<std::int32_t>(i));
+          EXPECT_LT(abs(s.position.y - put), edge / 10_fx) << "frame " << f << ", box " << i;
+          EXPECT_LT(abs(s.position.x), edge / 10_fx) << "frame " << f << ", box " << i;
+          EXPECT_LT(abs(s.position.z), edge / 10_fx) << "frame " << f << ", box " << i;
+        }
+      });
+}
+
+INSTANTIATE_TEST_SUITE_P(EdgeOneOver, SmallStack, testing::Values(1, 10, 100, 1000));
+
 // --- A face-on impact stays symmetric -----------------------------------------------------------
 
 class FaceOnImpact : public testing::TestWithParam<int> {};

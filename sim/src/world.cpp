@@ -1,8 +1,11 @@
 // World: construction, bodies and game inputs. The step is in step.cpp, the state's bytes in
 // state_io.cpp.
 #include <algorithm>
+#include <cstdint>
 #include <string>
 #include <utility>
+
+#include <detsim/fixed/math.hpp>
 
 #include "shapes.hpp"
 #include "world_state.hpp"
@@ -22,6 +25,21 @@ std::ptrdiff_t WorldState::find(std::uint32_t id) const noexcept {
 }
 
 }  // namespace sim_detail
+
+WorldDef scale_lengths(WorldDef def, Fixed unit) noexcept {
+  def.linear_slop = def.linear_slop * unit;
+  def.speculative_distance = def.speculative_distance * unit;
+  def.contact_push_max = def.contact_push_max * unit;
+  def.sleep_linear_speed = def.sleep_linear_speed * unit;
+  if (unit <= Fixed::zero()) return def;  // refused by World::create (the push max is not > 0)
+  def.contact_hertz = def.contact_hertz / sqrt(unit);
+  // The solver holds the spring to a quarter of the sub-step rate: substeps >= 4 hertz dt.
+  const Fixed needed = Fixed::from_int(4) * def.contact_hertz * def.dt;
+  const std::int64_t whole = (needed.raw() + Fixed::one_raw - 1) / Fixed::one_raw;
+  def.substeps = static_cast<std::uint32_t>(
+      std::clamp<std::int64_t>(whole, static_cast<std::int64_t>(def.substeps), 64));
+  return def;
+}
 
 namespace {
 

@@ -48,4 +48,18 @@ struct WorldDef {
   friend constexpr bool operator==(const WorldDef&, const WorldDef&) noexcept = default;
 };
 
+/// The defaults are made for bodies about a metre across: a 2 cm contact range and a 0.24 mm
+/// slop are larger than a millimetre body, and tiny beside a kilometre one; and a contact spring
+/// of a given stiffness sags by g / omega^2 under its load whatever the body's size. This returns
+/// `def` made for bodies of about `unit` metres (0.01 for centimetre parts, 1000 for kilometre
+/// ones), so that the scene behaves like a metre scene (Box2D's lengthUnitsPerMeter):
+/// - linear_slop, speculative_distance, contact_push_max and sleep_linear_speed times `unit`;
+/// - contact_hertz divided by sqrt(unit), so that the sag is the same fraction of a body;
+/// - substeps raised (up to 64) until the spring is no stiffer than a quarter of the sub-step
+///   rate, the most the solver allows: for unit 0.01, 20 sub-steps; for 0.001, 64.
+/// Gravity, the speed limits and the time step stay as they are: they are physics, not
+/// tolerances. Below about a millimetre even 64 sub-steps cannot hold the spring the sag needs;
+/// World::create refuses a result out of range, naming the field.
+[[nodiscard]] WorldDef scale_lengths(WorldDef def, Fixed unit) noexcept;
+
 }  // namespace detsim
