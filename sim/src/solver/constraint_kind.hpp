@@ -27,7 +27,12 @@ class ConstraintKind {
   virtual void warm_start() = 0;
   /// `iterations` times per sub-step: one pass over the velocity constraints.
   virtual void solve() = 0;
-  /// `iterations` times per sub-step, after solve: one pass of position error recovery on the
+  /// Once per sub-step, after solve: the hard limits of the kind's constraints (a contact's end
+  /// of range), enforced from the ground up with the body nearer the ground held still (shock
+  /// propagation), so that a heavy body cannot drive a light one past them while the
+  /// accumulated impulses catch up.
+  virtual void hold() = 0;
+  /// `iterations` times per sub-step, after hold: one pass of position error recovery on the
   /// push-out velocities (SolverBodies::push), which move positions and are never kept.
   virtual void push_out() = 0;
   /// Once per sub-step, after the bodies moved: updates what depends on their positions (a

@@ -64,6 +64,7 @@ class ContactSolver final : public ConstraintKind {
   void prepare() override;
   void warm_start() override;
   void solve() override;
+  void hold() override;
   void push_out() override;
   void positions_moved() override;
   void relax() override;
@@ -72,6 +73,7 @@ class ContactSolver final : public ConstraintKind {
 
  private:
   void prepare_constraint(std::size_t contact_index);
+  void prepare_levels();
   void solve_contacts(bool first_pass);
   [[nodiscard]] Fixed hard_stop(Fixed separation) const;
   void solve_centre(ContactConstraint& k);
@@ -84,6 +86,12 @@ class ContactSolver final : public ConstraintKind {
   Softness soft_;
   Softness static_soft_;
   std::vector<ContactConstraint> constraints_;
+  /// The constraints between bodies of different levels (levels_), lower level first, then in
+  /// contact order: the order of hold().
+  std::vector<std::uint32_t> hold_order_;
+  /// Each body's level: 0 for a body no impulse moves (static, kinematic, asleep), then the
+  /// number of contacts to the nearest such body; kNoLevel when there is none.
+  std::vector<std::uint32_t> levels_;
 };
 
 }  // namespace detsim::sim_detail

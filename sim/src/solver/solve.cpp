@@ -4,15 +4,15 @@
 // Per step, each constraint kind prepares its rows (prepare). Then, for each of `substeps`
 // sub-steps of length h = dt / substeps: integrate velocities (gravity, forces, damping, speed
 // clamp) -> warm start (apply the accumulated impulses) -> solve (soft constraints with a
-// position bias, `iterations` passes) -> push out (overlap beyond a constraint's soft range, on
-// push-out velocities that move positions and are then dropped, `iterations` passes) -> clamp
-// speeds -> integrate positions (velocity plus push-out velocity; each kind then updates what
-// depends on positions: a contact's separations) -> relax (the same constraints without
-// bias, `iterations` passes, removing the velocity the bias added) -> restitution (contacts that
-// took their first impulse in this sub-step bounce, once per step, so a bouncing body moves away
-// for the rest of the step instead of resting on the surface until the step ends) -> clamp
-// speeds. Once per step, after the last sub-step, each kind stores its impulses for the next
-// step's warm start, and the velocities go back to the bodies.
+// position bias, `iterations` passes) -> hold (hard limits, from the ground up) -> push out
+// (overlap beyond a constraint's soft range, on push-out velocities that move positions and are
+// then dropped, `iterations` passes) -> clamp speeds -> integrate positions (velocity plus push-out
+// velocity; each kind then updates what depends on positions: a contact's separations) -> relax
+// (the same constraints without bias, `iterations` passes, removing the velocity the bias added) ->
+// restitution (contacts that took their first impulse in this sub-step bounce, once per step, so a
+// bouncing body moves away for the rest of the step instead of resting on the surface until the
+// step ends) -> clamp speeds. Once per step, after the last sub-step, each kind stores its impulses
+// for the next step's warm start, and the velocities go back to the bodies.
 //
 // The body stages (SolverBodies, bodies.hpp) run every body in ascending ID order; the constraint
 // stages run every kind in a fixed order (the `kinds` list below), each kind all of its
@@ -63,6 +63,7 @@ void solve(WorldState& s) {
     bodies.integrate_velocities();
     each_kind(kinds, &ConstraintKind::warm_start);
     each_kind(kinds, &ConstraintKind::solve, iterations);
+    each_kind(kinds, &ConstraintKind::hold);
     each_kind(kinds, &ConstraintKind::push_out, iterations);
     bodies.clamp_speeds();
     bodies.integrate_positions();
