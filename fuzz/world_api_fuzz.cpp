@@ -243,8 +243,8 @@ void trace(int op, const detsim::Status& status, const World& world) {
                  num(b.inertia.z), num(b.position.x), num(b.position.y), num(b.position.z),
                  num(b.linear_velocity.x), num(b.linear_velocity.y), num(b.linear_velocity.z),
                  num(b.angular_velocity.x), num(b.angular_velocity.y), num(b.angular_velocity.z),
-                 num(b.force.x), num(b.force.y), num(b.force.z), num(b.torque.x),
-                 num(b.torque.y), num(b.torque.z));
+                 num(b.force.x), num(b.force.y), num(b.force.z), num(b.torque.x), num(b.torque.y),
+                 num(b.torque.z));
   }
 }
 
