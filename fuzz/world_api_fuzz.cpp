@@ -4,7 +4,8 @@
 //
 // Properties checked beyond the sanitizers' (no crash, no undefined behaviour, no leak):
 // - a refused call changes nothing: the world's saved bytes are those from before the call;
-// - after every accepted call and every step, World::validate() holds;
+// - after every accepted call and every step, World::validate() holds (between steps, but for
+//   the islands' sleep, which a call that wakes one body splits until the next step);
 // - a saved state restores exactly (the restored world saves the same bytes), and a world
 //   restored from it into a second World steps to the same bytes as the original (rule 5 of
 //   docs/DETERMINISM.md).
@@ -17,6 +18,7 @@
 #include <cstdlib>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <detsim/sim/world.hpp>
@@ -248,11 +250,14 @@ void trace(int op, const detsim::Status& status, const World& world) {
   }
 }
 
-void check_valid(const World& world) {
-  if (const detsim::Status s = world.validate(); !s.ok()) {
-    std::fprintf(stderr, "world_api_fuzz: %s\n", s.message().c_str());
-    fail("World::validate() failed");
-  }
+/// World::validate() holds. Between steps, one of its invariants may not yet: a call wakes only
+/// its body, and the next step wakes the rest of the island (World::validate's "after a step").
+void check_valid(const World& world, bool after_step) {
+  const detsim::Status s = world.validate();
+  if (s.ok()) return;
+  if (!after_step && s.message().find("an island is split") != std::string::npos) return;
+  std::fprintf(stderr, "world_api_fuzz: %s\n", s.message().c_str());
+  fail("World::validate() failed");
 }
 
 /// save -> restore into a second World -> both step once -> the same bytes.
@@ -263,7 +268,7 @@ void check_restore_steps_alike(World& world) {
   if (copy.save() != bytes) fail("a restored state saves other bytes");
   world.step();
   copy.step();
-  check_valid(world);
+  check_valid(world, true);
   if (copy.save() != world.save()) fail("a restored world steps differently from the original");
 }
 
@@ -280,7 +285,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     created.emplace();
   }
   World& world = *created;
-  check_valid(world);
+  check_valid(world, true);
   const WorldDef& def = world.def();
   const std::uint64_t step_cost = std::uint64_t{def.substeps} * def.iterations;
   std::uint64_t spent = 0;
@@ -369,7 +374,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         } else {
           world.step();
         }
-        check_valid(world);
+        check_valid(world, true);
         trace(op % 17, status, world);
         continue;  // a step changes the world: nothing to compare with `before`
       }
@@ -381,7 +386,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (slot.empty()) break;
         if (!world.restore(slot)) fail("bytes this world saved were refused");
         if (world.save() != slot) fail("a restored slot saves other bytes");
-        check_valid(world);
+        check_valid(world, false);
         continue;
       }
     }
@@ -389,7 +394,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!status.ok()) {
       if (world.save() != before) fail("a refused call changed the world");
     } else {
-      check_valid(world);
+      check_valid(world, false);
     }
   }
   return 0;
