@@ -7,6 +7,9 @@
 #           build-fuzz/corpus-packet (seeded with valid datagrams), findings build-fuzz/findings-packet
 #   state   fuzz/state_restore_fuzz.cpp, World::restore (refusals change nothing, accepted bytes are
 #           canonical and step): corpus build-fuzz/corpus-state (seeded with saved scenario states)
+#   api     fuzz/world_api_fuzz.cpp, the World's API over hostile definitions and call sequences
+#           (refusals change nothing, accepted calls keep World::validate(), restore steps alike):
+#           corpus build-fuzz/corpus-api, started empty (every input decodes to calls)
 # DETSIM_FUZZ_BUILD names another build directory than build-fuzz. Exit status: 0 no finding,
 # non-zero a crash, leak, timeout or OOM was found (libFuzzer prints the reproducer's path).
 set -euo pipefail
@@ -18,15 +21,16 @@ case "$target" in
   replay) fuzzer=replay_reader_fuzz seeds=make_seeds suffix="" max_len=65536 ;;
   packet) fuzzer=net_packet_fuzz seeds=make_packet_seeds suffix=-packet max_len=1300 ;;
   state) fuzzer=state_restore_fuzz seeds=make_state_seeds suffix=-state max_len=16384 ;;
-  *) echo "usage: scripts/fuzz.sh [SECONDS] [replay|packet|state]" >&2; exit 2 ;;
+  api) fuzzer=world_api_fuzz seeds="" suffix=-api max_len=4096 ;;
+  *) echo "usage: scripts/fuzz.sh [SECONDS] [replay|packet|state|api]" >&2; exit 2 ;;
 esac
 flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
 cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" -DCMAKE_CXX_FLAGS="$flags" \
   -DDETSIM_BUILD_FUZZ=ON -DDETSIM_BUILD_TESTS=OFF -DDETSIM_BUILD_TOOLS=OFF >/dev/null
-cmake --build "$build" --target "$fuzzer" "$seeds" -j "$(nproc)"
+cmake --build "$build" --target "$fuzzer" $seeds -j "$(nproc)"
 mkdir -p "$build/corpus$suffix" "$build/findings$suffix"
-"$build/fuzz/$seeds" "$build/corpus$suffix"
+if [ -n "$seeds" ]; then "$build/fuzz/$seeds" "$build/corpus$suffix"; fi
 cd "$build/findings$suffix"
 exec "../fuzz/$fuzzer" "../corpus$suffix" -max_total_time="$seconds" -max_len="$max_len" \
   -rss_limit_mb=2048 -timeout=20 -print_final_stats=1

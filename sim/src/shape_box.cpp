@@ -21,19 +21,41 @@ std::string check(const Shape& s) {
   return check_positive_size("box half extent z", s.half_extents.z);
 }
 
-Fixed volume(const Shape& s) noexcept {
+// The formulas once, for Fixed (the simulation) and Checked (the limits): the same bits.
+// Integers as from_int, not _fx: clang does not always evaluate a consteval literal operator in a
+// function template (an undefined reference at link time).
+template <class N>
+N volume_of(const Shape& s) noexcept {
   const Vec3 h = s.half_extents;
-  return 8_fx * (h.x * h.y * h.z);
+  return Fixed::from_int(8) * (N(h.x) * h.y * h.z);
+}
+
+template <class N>
+std::array<N, 3> inertia_of(const Shape& s, N mass) noexcept {
+  // m/3 (b^2 + c^2) about each axis, with half extents.
+  const Vec3 h = s.half_extents;
+  const N x2 = N(h.x) * h.x;
+  const N y2 = N(h.y) * h.y;
+  const N z2 = N(h.z) * h.z;
+  const N third = mass / Fixed::from_int(3);
+  return {third * (y2 + z2), third * (x2 + z2), third * (x2 + y2)};
+}
+
+Fixed volume(const Shape& s) noexcept {
+  return volume_of<Fixed>(s);
 }
 
 MassProperties mass_properties(const Shape& s, Fixed mass) noexcept {
-  // m/3 (b^2 + c^2) about each axis, with half extents.
-  const Vec3 h = s.half_extents;
-  const Fixed x2 = h.x * h.x;
-  const Fixed y2 = h.y * h.y;
-  const Fixed z2 = h.z * h.z;
-  const Fixed third = mass / 3_fx;
-  return {mass, {third * (y2 + z2), third * (x2 + z2), third * (x2 + y2)}};
+  const std::array<Fixed, 3> i = inertia_of<Fixed>(s, mass);
+  return {mass, {i[0], i[1], i[2]}};
+}
+
+Checked checked_volume(const Shape& s) noexcept {
+  return volume_of<Checked>(s);
+}
+
+std::array<Checked, 3> checked_inertia(const Shape& s, Fixed mass) noexcept {
+  return inertia_of<Checked>(s, mass);
 }
 
 Fixed bounding_radius(const Shape& s) noexcept {
@@ -125,6 +147,8 @@ const ShapeKind box_kind{ShapeType::box,
                          box_shape::check,
                          box_shape::volume,
                          box_shape::mass_properties,
+                         box_shape::checked_volume,
+                         box_shape::checked_inertia,
                          box_shape::bounding_radius,
                          box_shape::smallest_dimension,
                          box_shape::aabb_extent,

@@ -22,6 +22,14 @@ MassProperties mass_properties(const Shape&, Fixed) noexcept {
   return {};
 }
 
+Checked checked_zero(const Shape&) noexcept {
+  return {};
+}
+
+std::array<Checked, 3> checked_inertia(const Shape&, Fixed) noexcept {
+  return {};
+}
+
 Vec3 aabb_extent(const Shape&, const Mat3&) noexcept {
   return {};
 }
@@ -61,6 +69,8 @@ const ShapeKind plane_kind{ShapeType::plane,
                            plane_shape::check,
                            plane_shape::zero,
                            plane_shape::mass_properties,
+                           plane_shape::checked_zero,
+                           plane_shape::checked_inertia,
                            plane_shape::zero,
                            plane_shape::zero,
                            plane_shape::aabb_extent,

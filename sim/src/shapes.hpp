@@ -12,6 +12,7 @@
 // of sizes stay far inside the Fixed range; each function keeps its own precision argument.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <span>
@@ -25,6 +26,8 @@
 #include <detsim/sim/mass.hpp>
 #include <detsim/sim/shape.hpp>
 #include <detsim/sim/shape_outline.hpp>
+
+#include "limits.hpp"
 
 namespace detsim::sim_detail {
 
@@ -50,6 +53,11 @@ struct ShapeKind {
   Fixed (*volume)(const Shape& shape) noexcept;
   /// Mass properties of the solid with total mass `mass` > 0 spread uniformly.
   MassProperties (*mass_properties)(const Shape& shape, Fixed mass) noexcept;
+  /// `volume` in Checked arithmetic (the same formula, the same bits): whether any step of it
+  /// leaves the limits of limits.hpp.
+  Checked (*checked_volume)(const Shape& shape) noexcept;
+  /// The moments of inertia of `mass_properties` (about x, y, z) in Checked arithmetic.
+  std::array<Checked, 3> (*checked_inertia)(const Shape& shape, Fixed mass) noexcept;
   /// The radius of a ball about the body's origin that holds the shape (0 when unbounded).
   Fixed (*bounding_radius)(const Shape& shape) noexcept;
   /// The smallest distance across the shape from its centre (continuous collision's "fast").

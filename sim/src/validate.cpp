@@ -1,8 +1,15 @@
 // Validation of definitions: every refusal names the field and the value it got, so a user can
 // fix the call without reading the source.
+#include <array>
+#include <cstdint>
+#include <string>
+
 #include <detsim/fixed/decimal.hpp>
 #include <detsim/fixed/math.hpp>
+#include <detsim/fixed/wide.hpp>
 
+#include "limits.hpp"
+#include "shapes.hpp"
 #include "world_state.hpp"
 
 namespace detsim::sim_detail {
@@ -23,6 +30,95 @@ std::string non_negative(const char* what, Fixed x) {
 
 }  // namespace
 
+std::string above_limit(const std::string& quantity, Checked value, Fixed limit, const char* unit) {
+  const std::string tail = ", above the limit " + str(limit) + " " + unit;
+  const Fixed v = value.value();
+  if (v == Fixed::max() || v == Fixed::min())
+    return quantity + " would be at least " + (v < Fixed::zero() ? "-" : "") + "2147483648 " +
+           unit + " (it saturates Q32.32)" + tail;
+  if (beyond(v, limit)) return quantity + " would be " + str(v) + " " + unit + tail;
+  return quantity + " would be above the limit " + str(limit) + " " + unit +
+         " (a step of its formula leaves the Q32.32 range)";
+}
+
+namespace {
+
+std::string below_limit(const std::string& quantity, Fixed value, const char* unit) {
+  return quantity + " would be " + str(value) + " " + unit + ", below the limit " + str(min_mass) +
+         " " + unit + " (the smallest whose inverse fits in Q32.32)";
+}
+
+}  // namespace
+
+std::string check_components(const char* what, Vec3 v, Fixed limit, const char* unit) {
+  const char* axes[] = {"x", "y", "z"};
+  const Fixed c[] = {v.x, v.y, v.z};
+  for (int i = 0; i < 3; ++i) {
+    if (beyond(c[i], limit))
+      return std::string(what) + " " + axes[i] + " must be within +-" + str(limit) + " " + unit +
+             ", got " + str(c[i]);
+  }
+  return {};
+}
+
+std::string check_position(Vec3 p) {
+  return check_components("position", p, max_position, "m");
+}
+
+std::string check_angular_velocity(const Shape& shape, Vec3 w, const char* what) {
+  if (auto e = check_components(what, w, max_velocity, "rad/s"); !e.empty()) return e;
+  // What prepare_body computes for the contact margins, before any speed limit applies.
+  const Checked rim = Checked(length(w)) * bounding_radius(shape);
+  if (rim.over())
+    return above_limit(
+        "rim speed (|angular velocity| * bounding radius " + str(bounding_radius(shape)) + " m)",
+        rim, max_quantity, "m/s");
+  return {};
+}
+
+namespace {
+
+/// a * b for a, b >= 0 as text, exactly (the product of two Q32.32 values has 64 fraction bits
+/// and fits in 128 bits), rounded to an integer when it is beyond the Q32.32 range.
+std::string product_text(Fixed a, Fixed b) {
+  const wide::U128 p =
+      wide::Default::mul(static_cast<std::uint64_t>(a.raw()), static_cast<std::uint64_t>(b.raw()));
+  if (p.hi <= static_cast<std::uint64_t>(max_quantity.to_int())) return str(a * b);
+  return std::to_string(p.hi + (p.lo >> 63));  // round half up: display only
+}
+
+std::string check_mass_properties(const BodyDef& def) {
+  const ShapeKind& kind = shape_kind(def.shape.type);
+  // The same arithmetic as body_mass, checked at every step.
+  Checked mass = def.mass;
+  if (def.mass <= Fixed::zero()) {
+    const Checked volume = kind.checked_volume(def.shape);
+    if (volume.over())
+      return above_limit(std::string("volume of the ") + kind.name, volume, max_quantity, "m^3");
+    mass = Checked(def.density) * volume;
+    if (mass.over())
+      return "mass would be " + product_text(def.density, volume.value()) + " kg (density " +
+             str(def.density) + " kg/m^3 * volume " + str(volume.value()) +
+             " m^3), above the limit " + str(max_quantity) + " kg" +
+             (def.type == BodyType::dynamic
+                  ? ""
+                  : "; a body that never becomes dynamic can have density 0 (no mass)");
+  } else if (mass.over()) {
+    return above_limit("mass", mass, max_quantity, "kg");
+  }
+  const std::array<Checked, 3> inertia = kind.checked_inertia(def.shape, mass.value());
+  const char* axes[] = {"x", "y", "z"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (inertia[i].over())
+      return above_limit(std::string("moment of inertia about ") + axes[i] + " (mass " +
+                             str(mass.value()) + " kg, " + kind.name + ")",
+                         inertia[i], max_quantity, "kg m^2");
+  }
+  return {};
+}
+
+}  // namespace
+
 std::string check_orientation(Quat q) {
   const Fixed l2 = length_squared(q);
   if (abs(l2 - Fixed::one()) > kUnitTolerance)
@@ -37,6 +133,15 @@ std::string check_body_def(const BodyDef& def) {
     return "unknown body type " + std::to_string(static_cast<unsigned>(def.type));
   if (auto e = check_shape(def.shape, def.type); !e.empty()) return e;
   if (auto e = check_orientation(def.orientation); !e.empty()) return e;
+  if (auto e = check_position(def.position); !e.empty()) return e;
+  if (def.type != BodyType::static_body) {  // a static body's velocities are ignored (zero)
+    if (auto e = check_components("linear velocity", def.linear_velocity, max_velocity, "m/s");
+        !e.empty())
+      return e;
+    if (auto e = check_angular_velocity(def.shape, def.angular_velocity, "angular velocity");
+        !e.empty())
+      return e;
+  }
   if (auto e = non_negative("mass", def.mass); !e.empty()) return e;
   if (auto e = non_negative("density", def.density); !e.empty()) return e;
   if (auto e = non_negative("friction", def.friction); !e.empty()) return e;
@@ -45,6 +150,7 @@ std::string check_body_def(const BodyDef& def) {
     return "restitution must be <= 1, got " + str(def.restitution);
   if (auto e = non_negative("linear damping", def.linear_damping); !e.empty()) return e;
   if (auto e = non_negative("angular damping", def.angular_damping); !e.empty()) return e;
+  if (auto e = check_mass_properties(def); !e.empty()) return e;
   if (def.type == BodyType::dynamic) {
     const MassProperties m = body_mass(def);
     if (m.mass <= Fixed::zero())
@@ -54,6 +160,18 @@ std::string check_body_def(const BodyDef& def) {
         m.inertia.z <= Fixed::zero())
       return "the body's moments of inertia round to zero (shape too small for its mass); give "
              "it a larger mass or shape";
+    return check_dynamic_mass(m);
+  }
+  return {};
+}
+
+std::string check_dynamic_mass(const MassProperties& m) {
+  if (m.mass < min_mass) return below_limit("mass", m.mass, "kg");
+  const char* axes[] = {"x", "y", "z"};
+  const Fixed moments[] = {m.inertia.x, m.inertia.y, m.inertia.z};
+  for (int i = 0; i < 3; ++i) {
+    if (moments[i] < min_mass)
+      return below_limit(std::string("moment of inertia about ") + axes[i], moments[i], "kg m^2");
   }
   return {};
 }

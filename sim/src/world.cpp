@@ -5,13 +5,16 @@
 #include <string>
 #include <utility>
 
+#include <detsim/fixed/decimal.hpp>
 #include <detsim/fixed/math.hpp>
 
+#include "limits.hpp"
 #include "shapes.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
 
+using sim_detail::Checked;
 using sim_detail::WorldState;
 
 namespace sim_detail {
@@ -203,20 +206,120 @@ Status ok() {
   return Status::success();
 }
 
-// r x f for a point given in world space.
-Vec3 moment(const BodyState& b, Vec3 point, Vec3 f) {
-  return cross(point - b.position, f);
+Status refuse(std::string message) {
+  return Status::error(std::move(message));
 }
 
-// Immediate velocity change of a dynamic body from an impulse through its centre and an angular
-// impulse, with the world-space inverse inertia of its current orientation.
-void apply_impulse(BodyState& b, Vec3 linear, Vec3 angular) {
-  if (b.type != BodyType::dynamic) return;
-  b.linear_velocity += linear / b.mass;
+std::string str(Fixed x) {
+  return to_string(x);
+}
+
+constexpr const char* kAxes[] = {"x", "y", "z"};
+
+Fixed component(Vec3 v, int i) {
+  return i == 0 ? v.x : (i == 1 ? v.y : v.z);
+}
+
+// r x f for a point given in world space, or a refusal when the lever arm or the moment leaves
+// the limits (limits.hpp).
+std::string moment(const BodyState& b, Vec3 point, Vec3 f, Vec3& out) {
+  const Vec3 r = point - b.position;
+  out = cross(r, f);
+  for (int i = 0; i < 3; ++i) {
+    const Checked arm = Checked(component(point, i)) - component(b.position, i);
+    if (arm.over())
+      return sim_detail::above_limit(std::string("lever arm (point - position) ") + kAxes[i], arm,
+                                     sim_detail::max_quantity, "m");
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (const Checked m = component(out, i); m.over())
+      return sim_detail::above_limit(std::string("moment about the centre ") + kAxes[i], m,
+                                     sim_detail::max_quantity, "N m");
+  }
+  return {};
+}
+
+// The body's force and torque with `force` and `torque` added, or a refusal: each accumulated
+// component within max_quantity, the torque's length too (its components in any frame), and the
+// accelerations they give a body that is or may become dynamic within max_acceleration (the
+// solver computes (g + F / m) h and (R I^-1 R^T T) h).
+std::string accumulate(const BodyState& b, Vec3 force, Vec3 torque, Vec3& f_out, Vec3& t_out) {
+  using sim_detail::max_acceleration;
+  using sim_detail::max_quantity;
+  using sim_detail::min_mass;
+  f_out = b.force + force;
+  t_out = b.torque + torque;
+  for (int i = 0; i < 3; ++i) {
+    if (const Checked f = Checked(component(b.force, i)) + component(force, i); f.over())
+      return sim_detail::above_limit(std::string("accumulated force ") + kAxes[i], f, max_quantity,
+                                     "N");
+    if (const Checked t = Checked(component(b.torque, i)) + component(torque, i); t.over())
+      return sim_detail::above_limit(std::string("accumulated torque ") + kAxes[i], t, max_quantity,
+                                     "N m");
+  }
+  if (b.mass >= min_mass) {
+    const Fixed inverse_mass = sim_detail::inverse_or_zero(b.mass);
+    for (int i = 0; i < 3; ++i) {
+      const Checked a = Checked(component(f_out, i)) * inverse_mass;
+      if (a.over() || sim_detail::beyond(a.value(), max_acceleration))
+        return sim_detail::above_limit(std::string("linear acceleration ") + kAxes[i] +
+                                           " (accumulated force / mass " + str(b.mass) + " kg)",
+                                       a, max_acceleration, "m/s^2");
+    }
+  }
+  const Checked length_t = length(t_out);
+  if (length_t.over())
+    return sim_detail::above_limit("|accumulated torque|", length_t, max_quantity, "N m");
+  const Fixed smallest = min(b.inertia.x, min(b.inertia.y, b.inertia.z));
+  if (smallest >= min_mass) {
+    const Checked a = length_t * sim_detail::inverse_or_zero(smallest);
+    if (a.over() || sim_detail::beyond(a.value(), max_acceleration))
+      return sim_detail::above_limit(
+          "angular acceleration (|accumulated torque| / smallest "
+          "moment of inertia " +
+              str(smallest) + " kg m^2)",
+          a, max_acceleration, "rad/s^2");
+  }
+  return {};
+}
+
+// The velocities of a dynamic body after an impulse through its centre and an angular impulse,
+// with the world-space inverse inertia of its current orientation; or a refusal when a step of
+// that leaves the limits (the new velocities within max_velocity, the rim speed within
+// max_quantity). Other bodies keep their velocities.
+std::string impulse(const BodyState& b, Vec3 linear, Vec3 angular, Vec3& v_out, Vec3& w_out) {
+  using sim_detail::max_quantity;
+  using sim_detail::max_velocity;
+  v_out = b.linear_velocity;
+  w_out = b.angular_velocity;
+  if (b.type != BodyType::dynamic) return {};
+  const Vec3 dv = linear / b.mass;
+  v_out = b.linear_velocity + dv;
   const Mat3 r = to_mat3(b.orientation);
   const Vec3 local = transpose(r) * angular;
   const Vec3 local_dw{local.x / b.inertia.x, local.y / b.inertia.y, local.z / b.inertia.z};
-  b.angular_velocity += r * local_dw;
+  const Vec3 dw = r * local_dw;
+  w_out = b.angular_velocity + dw;
+  const Fixed inertia[] = {b.inertia.x, b.inertia.y, b.inertia.z};
+  for (int i = 0; i < 3; ++i) {
+    const Checked change = Checked(component(linear, i)) / b.mass;
+    const Checked v = Checked(component(b.linear_velocity, i)) + change;
+    if (v.over() || sim_detail::beyond(v.value(), max_velocity))
+      return sim_detail::above_limit(std::string("linear velocity ") + kAxes[i] +
+                                         " after the impulse (mass " + str(b.mass) + " kg)",
+                                     v, max_velocity, "m/s");
+  }
+  for (int i = 0; i < 3; ++i) {
+    const Checked body_frame = Checked(component(local, i)) / inertia[i];
+    const Checked w = Checked(component(b.angular_velocity, i)) + component(dw, i);
+    if (body_frame.over() || Checked(component(dw, i)).over() || w.over() ||
+        sim_detail::beyond(w.value(), max_velocity))
+      return sim_detail::above_limit(std::string("angular velocity ") + kAxes[i] +
+                                         " after the impulse (moment of inertia " +
+                                         str(inertia[i]) + " kg m^2 about body " + kAxes[i] + ")",
+                                     body_frame.over() ? body_frame : w, max_velocity, "rad/s");
+  }
+  return sim_detail::check_angular_velocity(b.shape, w_out, "angular velocity after the impulse");
 }
 
 }  // namespace
@@ -232,6 +335,10 @@ Status World::set_type(BodyId id, BodyType type) {
     if (type == BodyType::dynamic && b.mass <= Fixed::zero())
       return Status::error("body " + std::to_string(id.value) +
                            " has no mass (it was created with zero mass and density)");
+    if (type == BodyType::dynamic) {
+      if (auto e = sim_detail::check_dynamic_mass({b.mass, b.inertia}); !e.empty())
+        return refuse("body " + std::to_string(id.value) + " cannot become dynamic: " + e);
+    }
     if (type == BodyType::static_body) {
       b.linear_velocity = {};
       b.angular_velocity = {};
@@ -244,6 +351,7 @@ Status World::set_type(BodyId id, BodyType type) {
 
 Status World::set_transform(BodyId id, Vec3 position, Quat orientation) {
   if (auto e = sim_detail::check_orientation(orientation); !e.empty()) return Status::error(e);
+  if (auto e = sim_detail::check_position(position); !e.empty()) return Status::error(e);
   return with_body(*s_, id, true, [&](BodyState& b) {
     b.position = position;
     b.orientation = normalize(orientation);
@@ -254,6 +362,10 @@ Status World::set_transform(BodyId id, Vec3 position, Quat orientation) {
 Status World::set_linear_velocity(BodyId id, Vec3 velocity) {
   return with_body(*s_, id, true, [&](BodyState& b) {
     if (b.type == BodyType::static_body) return Status::error("a static body cannot move");
+    if (auto e = sim_detail::check_components("linear velocity", velocity, sim_detail::max_velocity,
+                                              "m/s");
+        !e.empty())
+      return refuse(e);
     b.linear_velocity = velocity;
     return ok();
   });
@@ -262,6 +374,9 @@ Status World::set_linear_velocity(BodyId id, Vec3 velocity) {
 Status World::set_angular_velocity(BodyId id, Vec3 velocity) {
   return with_body(*s_, id, true, [&](BodyState& b) {
     if (b.type == BodyType::static_body) return Status::error("a static body cannot move");
+    if (auto e = sim_detail::check_angular_velocity(b.shape, velocity, "angular velocity");
+        !e.empty())
+      return refuse(e);
     b.angular_velocity = velocity;
     return ok();
   });
@@ -269,43 +384,68 @@ Status World::set_angular_velocity(BodyId id, Vec3 velocity) {
 
 Status World::apply_force(BodyId id, Vec3 force) {
   return with_body(*s_, id, true, [&](BodyState& b) {
-    b.force += force;
+    Vec3 f;
+    Vec3 t;
+    if (auto e = accumulate(b, force, {}, f, t); !e.empty()) return refuse(e);
+    b.force = f;
     return ok();
   });
 }
 
 Status World::apply_torque(BodyId id, Vec3 torque) {
   return with_body(*s_, id, true, [&](BodyState& b) {
-    b.torque += torque;
+    Vec3 f;
+    Vec3 t;
+    if (auto e = accumulate(b, {}, torque, f, t); !e.empty()) return refuse(e);
+    b.torque = t;
     return ok();
   });
 }
 
 Status World::apply_force_at_point(BodyId id, Vec3 force, Vec3 point) {
   return with_body(*s_, id, true, [&](BodyState& b) {
-    b.force += force;
-    b.torque += moment(b, point, force);
+    Vec3 m;
+    if (auto e = moment(b, point, force, m); !e.empty()) return refuse(e);
+    Vec3 f;
+    Vec3 t;
+    if (auto e = accumulate(b, force, m, f, t); !e.empty()) return refuse(e);
+    b.force = f;
+    b.torque = t;
     return ok();
   });
 }
 
-Status World::apply_linear_impulse(BodyId id, Vec3 impulse) {
+Status World::apply_linear_impulse(BodyId id, Vec3 linear) {
   return with_body(*s_, id, true, [&](BodyState& b) {
-    apply_impulse(b, impulse, {});
+    Vec3 v;
+    Vec3 w;
+    if (auto e = impulse(b, linear, {}, v, w); !e.empty()) return refuse(e);
+    b.linear_velocity = v;
+    b.angular_velocity = w;
     return ok();
   });
 }
 
-Status World::apply_impulse_at_point(BodyId id, Vec3 impulse, Vec3 point) {
+Status World::apply_impulse_at_point(BodyId id, Vec3 linear, Vec3 point) {
   return with_body(*s_, id, true, [&](BodyState& b) {
-    apply_impulse(b, impulse, moment(b, point, impulse));
+    Vec3 m;
+    if (auto e = moment(b, point, linear, m); !e.empty()) return refuse(e);
+    Vec3 v;
+    Vec3 w;
+    if (auto e = impulse(b, linear, m, v, w); !e.empty()) return refuse(e);
+    b.linear_velocity = v;
+    b.angular_velocity = w;
     return ok();
   });
 }
 
-Status World::apply_angular_impulse(BodyId id, Vec3 impulse) {
+Status World::apply_angular_impulse(BodyId id, Vec3 angular) {
   return with_body(*s_, id, true, [&](BodyState& b) {
-    apply_impulse(b, {}, impulse);
+    Vec3 v;
+    Vec3 w;
+    if (auto e = impulse(b, {}, angular, v, w); !e.empty()) return refuse(e);
+    b.linear_velocity = v;
+    b.angular_velocity = w;
     return ok();
   });
 }

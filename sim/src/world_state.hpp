@@ -98,6 +98,14 @@ struct WorldState {
 [[nodiscard]] std::string check_shape(const Shape& shape, BodyType type);
 [[nodiscard]] std::string check_orientation(Quat q);
 [[nodiscard]] std::string check_body_def(const BodyDef& def);
+/// The limits of limits.hpp for calls: "" when within them, else the refusal's message.
+/// Each component of v within +-limit ("<what> x must be within +-limit unit, got v").
+[[nodiscard]] std::string check_components(const char* what, Vec3 v, Fixed limit, const char* unit);
+[[nodiscard]] std::string check_position(Vec3 p);
+/// Components within max_velocity, and the rim speed |w| * bounding radius within max_quantity.
+[[nodiscard]] std::string check_angular_velocity(const Shape& shape, Vec3 w, const char* what);
+/// What a dynamic body's mass and moments need beyond being positive: inverses that fit.
+[[nodiscard]] std::string check_dynamic_mass(const MassProperties& m);
 
 /// Mass and inertia of a body of this definition (what it has whenever it is dynamic).
 [[nodiscard]] MassProperties body_mass(const BodyDef& def) noexcept;

@@ -152,8 +152,9 @@ class World {
   // ---- Bodies ----
 
   /// Creates a body; its ID is the next in sequence. An invalid definition (non-positive size or
-  /// mass, an orientation that is not a unit quaternion, a non-static plane, ...) is refused with a
-  /// message naming the field, and the world is unchanged.
+  /// mass, an orientation that is not a unit quaternion, a non-static plane, a mass, moment of
+  /// inertia or other derived quantity that would saturate: docs/SIM.md, "What is refused") is
+  /// refused with a message naming the field or quantity, and the world is unchanged.
   Expected<BodyId> create_body(const BodyDef& def);
   /// Removes a body and its contacts; wakes the bodies it touched. Unknown IDs are an error.
   Status destroy_body(BodyId id);
@@ -173,6 +174,8 @@ class World {
   Status set_angular_velocity(BodyId id, Vec3 velocity);
 
   // ---- Game inputs: accumulated until the next step. Each wakes the body. ----
+  // A call whose sums, accelerations or resulting velocities would leave the limits of docs/SIM.md
+  // ("What is refused") is refused, naming the quantity, and changes nothing.
 
   Status apply_force(BodyId id, Vec3 force);                       ///< N, at the centre
   Status apply_torque(BodyId id, Vec3 torque);                     ///< N m, world space

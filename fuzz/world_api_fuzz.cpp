@@ -1,0 +1,401 @@
+// libFuzzer target for the World's API: the input is a hostile WorldDef and a sequence of calls
+// (create_body with any shape, size, mass, density, velocity and orientation, destroy_body,
+// set_type, set_transform, set_*_velocity, the forces and impulses, wake, step, save, restore).
+//
+// Properties checked beyond the sanitizers' (no crash, no undefined behaviour, no leak):
+// - a refused call changes nothing: the world's saved bytes are those from before the call;
+// - after every accepted call and every step, World::validate() holds (between steps, but for
+//   the islands' sleep, which a call that wakes one body splits until the next step);
+// - a saved state restores exactly (the restored world saves the same bytes), and a world
+//   restored from it into a second World steps to the same bytes as the original (rule 5 of
+//   docs/DETERMINISM.md).
+// Work is bounded per input (at most 64 bodies, 16 steps, and a budget of solver passes) so that
+// one input runs in milliseconds even under the sanitizers.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <detsim/sim/world.hpp>
+
+namespace {
+
+using detsim::BodyDef;
+using detsim::BodyId;
+using detsim::BodyType;
+using detsim::Fixed;
+using detsim::Quat;
+using detsim::Shape;
+using detsim::ShapeType;
+using detsim::Vec3;
+using detsim::World;
+using detsim::WorldDef;
+
+constexpr std::size_t kMaxBodies = 64;
+constexpr int kMaxSteps = 16;
+constexpr int kMaxCalls = 256;
+// Sub-steps x iterations x (bodies + 1), summed over the steps: what the steps of one input may
+// cost in total.
+constexpr std::uint64_t kStepBudget = 40000;
+
+/// A finding: says which property broke, then aborts (libFuzzer saves the input).
+[[noreturn]] void fail(const char* what) {
+  std::fprintf(stderr, "world_api_fuzz: %s\n", what);
+  std::abort();
+}
+
+/// Reads the input from the front; past its end every read is zero.
+class Input {
+ public:
+  explicit Input(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
+
+  [[nodiscard]] bool empty() const { return pos_ >= bytes_.size(); }
+
+  std::uint8_t byte() { return pos_ < bytes_.size() ? bytes_[pos_++] : std::uint8_t{0}; }
+
+  std::uint64_t u64(int n = 8) {
+    std::uint64_t v = 0;
+    for (int i = 0; i < n; ++i)
+      v |= std::uint64_t{byte()} << (8 * i);
+    return v;
+  }
+
+  std::uint32_t u32() { return static_cast<std::uint32_t>(u64(4)); }
+
+  /// A Fixed drawn from the values that break arithmetic most often: small integers, the range's
+  /// ends, powers of two on both sides of one, the API's documented limits and their neighbours,
+  /// and raw bits.
+  Fixed fixed() {
+    const std::uint8_t kind = byte();
+    const auto signed_byte = [this] { return static_cast<std::int32_t>(byte()) - 128; };
+    switch (kind % 8) {
+      case 0:
+        return Fixed::from_int(signed_byte());
+      case 1:
+        return Fixed::from_raw(static_cast<std::int64_t>(u64()));
+      case 2: {
+        static constexpr std::array<std::int64_t, 12> specials = {0,
+                                                                  1,
+                                                                  -1,
+                                                                  2,
+                                                                  3,
+                                                                  std::int64_t{10000} << 32,
+                                                                  (std::int64_t{10000} << 32) + 1,
+                                                                  std::int64_t{1} << 62,
+                                                                  (std::int64_t{1} << 62) - 1,
+                                                                  INT64_MAX,
+                                                                  INT64_MIN,
+                                                                  INT64_MAX - 1};
+        return Fixed::from_raw(specials[byte() % specials.size()]);
+      }
+      case 3: {
+        const int shift = byte() % 63;  // 2^(shift - 32): 2^-32 .. 2^30
+        const Fixed p = Fixed::from_raw(std::int64_t{1} << shift);
+        return (kind & 0x80U) != 0 ? -p : p;
+      }
+      case 4:
+        return Fixed::from_raw(static_cast<std::int32_t>(u32()));  // within +-0.5
+      case 5:
+        return Fixed::from_int(static_cast<std::int32_t>(u32()));
+      case 6:  // a small positive size or mass with a fraction
+        return Fixed::from_raw(static_cast<std::int64_t>(u64(3)) << 16);
+      default:
+        return Fixed::from_int(signed_byte()) + Fixed::from_raw(static_cast<std::int32_t>(u32()));
+    }
+  }
+
+  Vec3 vec3() {
+    const std::uint8_t how = byte();
+    if (how % 4 == 0) return {};
+    if (how % 4 == 1) return {fixed(), {}, {}};
+    return {fixed(), fixed(), fixed()};
+  }
+
+  Quat quat() {
+    const std::uint8_t how = byte();
+    switch (how % 4) {
+      case 0:
+        return {};
+      case 1: {
+        const Vec3 axis = vec3();
+        return detsim::from_axis_angle(detsim::normalize_or(axis, Vec3::unit_x()), fixed());
+      }
+      case 2:
+        return detsim::normalize(Quat{fixed(), fixed(), fixed(), fixed()});
+      default:
+        return Quat{fixed(), fixed(), fixed(), fixed()};  // most often not a unit quaternion
+    }
+  }
+
+  BodyType body_type() { return static_cast<BodyType>(byte() % 4); }  // 3 names no type
+
+ private:
+  std::span<const std::uint8_t> bytes_;
+  std::size_t pos_ = 0;
+};
+
+WorldDef world_def(Input& in) {
+  WorldDef def;
+  const std::uint8_t fields = in.byte();
+  if ((fields & 1U) != 0) def.gravity = in.vec3();
+  if ((fields & 2U) != 0) def.dt = in.fixed();
+  if ((fields & 4U) != 0) {
+    def.substeps = in.byte() % 66U;  // 0 and 65 are refused
+    def.iterations = in.byte() % 66U;
+  }
+  if ((fields & 8U) != 0) {
+    def.max_linear_speed = in.fixed();
+    def.max_angular_speed = in.fixed();
+  }
+  if ((fields & 16U) != 0) {
+    def.contact_hertz = in.fixed();
+    def.contact_damping_ratio = in.fixed();
+    def.contact_push_max = in.fixed();
+    def.restitution_threshold = in.fixed();
+  }
+  if ((fields & 32U) != 0) {
+    def.linear_slop = in.fixed();
+    def.speculative_distance = in.fixed();
+  }
+  if ((fields & 64U) != 0) {
+    def.enable_sleep = (in.byte() & 1U) != 0;
+    def.sleep_linear_speed = in.fixed();
+    def.sleep_angular_speed = in.fixed();
+    def.time_to_sleep = in.fixed();
+  }
+  if ((fields & 128U) != 0) def.seed = in.u64();
+  return def;
+}
+
+Shape shape(Input& in) {
+  const auto type = static_cast<ShapeType>(in.byte() % 6);  // 0 and 5 name no type
+  Shape s;
+  s.type = type;
+  const std::uint8_t fields = in.byte();
+  // Mostly the fields the type uses; sometimes every field, which the checks must refuse.
+  const bool all = (fields & 0x80U) != 0;
+  if (all || type == ShapeType::sphere || type == ShapeType::capsule) s.radius = in.fixed();
+  if (all || type == ShapeType::capsule) s.half_height = in.fixed();
+  if (all || type == ShapeType::box) {
+    const Fixed h = in.fixed();
+    s.half_extents = (fields & 1U) != 0 ? Vec3{h, h, h} : Vec3{h, in.fixed(), in.fixed()};
+  }
+  return s;
+}
+
+BodyDef body_def(Input& in) {
+  BodyDef def;
+  def.type = in.body_type();
+  def.shape = shape(in);
+  const std::uint8_t fields = in.byte();
+  if ((fields & 1U) != 0) def.position = in.vec3();
+  if ((fields & 2U) != 0) def.orientation = in.quat();
+  if ((fields & 4U) != 0) {
+    def.linear_velocity = in.vec3();
+    def.angular_velocity = in.vec3();
+  }
+  if ((fields & 8U) != 0) def.mass = in.fixed();
+  if ((fields & 16U) != 0) def.density = in.fixed();
+  if ((fields & 32U) != 0) {
+    def.friction = in.fixed();
+    def.restitution = in.fixed();
+  }
+  if ((fields & 64U) != 0) {
+    def.linear_damping = in.fixed();
+    def.angular_damping = in.fixed();
+  }
+  if ((fields & 128U) != 0) {
+    def.layer = in.u32();
+    def.mask = in.u32();
+    const std::uint8_t flags = in.byte();
+    def.sensor = (flags & 1U) != 0;
+    def.ccd = (flags & 2U) != 0;
+    def.user_data = in.u64();
+  }
+  return def;
+}
+
+/// An existing body most of the time (by index), else any ID (usually unknown).
+BodyId body_id(Input& in, const World& world) {
+  const std::uint8_t pick = in.byte();
+  const std::vector<BodyId> ids = world.body_ids();
+  if ((pick & 0x80U) == 0 && !ids.empty()) return ids[pick % ids.size()];
+  return BodyId{pick % 0x80U};
+}
+
+/// With DETSIM_FUZZ_TRACE set, each call's opcode, result and the bodies after it go to stderr:
+/// a finding's input read as the calls it makes.
+void trace(int op, const detsim::Status& status, const World& world) {
+  static const bool on = std::getenv("DETSIM_FUZZ_TRACE") != nullptr;
+  if (!on) return;
+  std::fprintf(stderr, "op %d: %s\n", op, status.ok() ? "ok" : status.message().c_str());
+  const auto num = [](Fixed x) { return x.to_double(); };  // display only
+  for (const BodyId id : world.body_ids()) {
+    const detsim::BodyState b = world.body(id).value();
+    std::fprintf(stderr,
+                 "  body %u type %d shape %d awake %d mass %g inertia (%g %g %g) p (%g %g %g) "
+                 "v (%g %g %g) w (%g %g %g) f (%g %g %g) t (%g %g %g)\n",
+                 id.value, static_cast<int>(b.type), static_cast<int>(b.shape.type),
+                 static_cast<int>(b.awake), num(b.mass), num(b.inertia.x), num(b.inertia.y),
+                 num(b.inertia.z), num(b.position.x), num(b.position.y), num(b.position.z),
+                 num(b.linear_velocity.x), num(b.linear_velocity.y), num(b.linear_velocity.z),
+                 num(b.angular_velocity.x), num(b.angular_velocity.y), num(b.angular_velocity.z),
+                 num(b.force.x), num(b.force.y), num(b.force.z), num(b.torque.x), num(b.torque.y),
+                 num(b.torque.z));
+  }
+}
+
+/// World::validate() holds. Between steps, one of its invariants may not yet: a call wakes only
+/// its body, and the next step wakes the rest of the island (World::validate's "after a step").
+void check_valid(const World& world, bool after_step) {
+  const detsim::Status s = world.validate();
+  if (s.ok()) return;
+  if (!after_step && s.message().find("an island is split") != std::string::npos) return;
+  std::fprintf(stderr, "world_api_fuzz: %s\n", s.message().c_str());
+  fail("World::validate() failed");
+}
+
+/// save -> restore into a second World -> both step once -> the same bytes.
+void check_restore_steps_alike(World& world) {
+  const std::vector<std::uint8_t> bytes = world.save();
+  World copy;
+  if (!copy.restore(bytes)) fail("a saved state was refused by another World");
+  if (copy.save() != bytes) fail("a restored state saves other bytes");
+  world.step();
+  copy.step();
+  check_valid(world, true);
+  if (copy.save() != world.save()) fail("a restored world steps differently from the original");
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  Input in({data, size});
+  std::optional<World> created;
+  if ((in.byte() & 1U) != 0) {
+    auto w = World::create(world_def(in));
+    if (!w) return 0;  // a refused definition makes no world: nothing more to check
+    created.emplace(std::move(w.value()));
+  } else {
+    created.emplace();
+  }
+  World& world = *created;
+  check_valid(world, true);
+  const WorldDef& def = world.def();
+  const std::uint64_t step_cost = std::uint64_t{def.substeps} * def.iterations;
+  std::uint64_t spent = 0;
+  int steps = 0;
+  std::vector<std::vector<std::uint8_t>> slots(2);
+
+  for (int call = 0; call < kMaxCalls && !in.empty(); ++call) {
+    const std::vector<std::uint8_t> before = world.save();
+    detsim::Status status = detsim::Status::success();
+    const std::uint8_t op = in.byte();
+    switch (op % 17) {
+      case 0: {
+        const BodyDef body = body_def(in);
+        if (world.body_count() >= kMaxBodies) break;
+        auto id = world.create_body(body);
+        if (!id) status = id.status();
+        break;
+      }
+      case 1:
+        status = world.destroy_body(body_id(in, world));
+        break;
+      case 2: {
+        const BodyId id = body_id(in, world);
+        status = world.set_type(id, in.body_type());
+        break;
+      }
+      case 3: {
+        const BodyId id = body_id(in, world);
+        const Vec3 p = in.vec3();
+        status = world.set_transform(id, p, in.quat());
+        break;
+      }
+      case 4: {
+        const BodyId id = body_id(in, world);
+        status = world.set_linear_velocity(id, in.vec3());
+        break;
+      }
+      case 5: {
+        const BodyId id = body_id(in, world);
+        status = world.set_angular_velocity(id, in.vec3());
+        break;
+      }
+      case 6: {
+        const BodyId id = body_id(in, world);
+        status = world.apply_force(id, in.vec3());
+        break;
+      }
+      case 7: {
+        const BodyId id = body_id(in, world);
+        status = world.apply_torque(id, in.vec3());
+        break;
+      }
+      case 8: {
+        const BodyId id = body_id(in, world);
+        const Vec3 f = in.vec3();
+        status = world.apply_force_at_point(id, f, in.vec3());
+        break;
+      }
+      case 9: {
+        const BodyId id = body_id(in, world);
+        status = world.apply_linear_impulse(id, in.vec3());
+        break;
+      }
+      case 10: {
+        const BodyId id = body_id(in, world);
+        const Vec3 j = in.vec3();
+        status = world.apply_impulse_at_point(id, j, in.vec3());
+        break;
+      }
+      case 11: {
+        const BodyId id = body_id(in, world);
+        status = world.apply_angular_impulse(id, in.vec3());
+        break;
+      }
+      case 12:
+        status = world.wake(body_id(in, world));
+        break;
+      case 13:
+      case 14: {
+        const std::uint64_t cost = step_cost * (world.body_count() + 1);
+        if (steps >= kMaxSteps || spent + cost > kStepBudget) break;
+        ++steps;
+        spent += cost;
+        if (op % 17 == 14) {
+          check_restore_steps_alike(world);
+        } else {
+          world.step();
+        }
+        check_valid(world, true);
+        trace(op % 17, status, world);
+        continue;  // a step changes the world: nothing to compare with `before`
+      }
+      case 15:
+        slots[in.byte() % 2] = before;
+        break;
+      default: {
+        const std::vector<std::uint8_t>& slot = slots[in.byte() % 2];
+        if (slot.empty()) break;
+        if (!world.restore(slot)) fail("bytes this world saved were refused");
+        if (world.save() != slot) fail("a restored slot saves other bytes");
+        check_valid(world, false);
+        continue;
+      }
+    }
+    trace(op % 17, status, world);
+    if (!status.ok()) {
+      if (world.save() != before) fail("a refused call changed the world");
+    } else {
+      check_valid(world, false);
+    }
+  }
+  return 0;
+}
