@@ -39,6 +39,36 @@ Vec3 perpendicular(Vec3 n) {
 
 }  // namespace
 
+namespace {
+
+// The normal row at the centroid of a constraint's points. A row is linear in its anchor (d x r),
+// and so is its response (I^-1 (d x r)): the centroid's are the means of the points' rows, which
+// costs additions instead of the cross products and matrix products of make_row. The effective
+// mass follows from them as in make_row.
+[[gnu::noinline]] Row centroid_row(const ContactConstraint& k, const Derived& a, const Derived& b) {
+  if (k.count == 1) return k.points[0].normal;
+  // 1 / count: exact for 2 and 4, rounded once for 3.
+  const Fixed share = Fixed::one() / Fixed::from_int(k.count);
+  Row r;
+  for (std::size_t p = 0; p < k.count; ++p) {
+    const Row& pr = k.points[p].normal;
+    r.angular_a += pr.angular_a;
+    r.angular_b += pr.angular_b;
+    r.response_a += pr.response_a;
+    r.response_b += pr.response_b;
+  }
+  r.angular_a = r.angular_a * share;
+  r.angular_b = r.angular_b * share;
+  r.response_a = r.response_a * share;
+  r.response_b = r.response_b * share;
+  const Fixed angular =
+      DotSum{}.add(r.response_a, r.angular_a).add(r.response_b, r.angular_b).result();
+  r.mass = inverse_or_zero(a.inverse_mass + b.inverse_mass + angular);
+  return r;
+}
+
+}  // namespace
+
 ContactSolver::ContactSolver(WorldState& s, SolverBodies& bodies) : s_(s), bodies_(bodies) {
   // The contact spring may not be stiffer than a quarter of the sub-step rate (Box2D's bound),
   // or the implicit discretisation stops damping it.
@@ -68,107 +98,6 @@ void ContactSolver::prepare() {
   prepare_levels();
 }
 
-namespace {
-constexpr std::uint32_t kNoLevel = 0xFFFFFFFFU;
-}  // namespace
-
-// Levels by breadth-first search from the bodies no impulse moves, over the step's contact
-// constraints, in index order (bodies, then constraints): the same levels on every machine.
-void ContactSolver::prepare_levels() {
-  hold_order_.clear();
-  const std::size_t n = s_.bodies.size();
-  levels_.assign(n, kNoLevel);
-  // Adjacency in constraint order: for each body, the constraints it is in.
-  std::vector<std::uint32_t> start(n + 1, 0);
-  for (const ContactConstraint& k : constraints_) {
-    ++start[k.bodies.a + 1];
-    ++start[k.bodies.b + 1];
-  }
-  for (std::size_t i = 0; i < n; ++i)
-    start[i + 1] += start[i];
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-  std::vector<std::uint32_t> adjacent(start[n]);
-  for (std::size_t c = 0; c < constraints_.size(); ++c) {
-    adjacent[fill[constraints_[c].bodies.a]++] = static_cast<std::uint32_t>(c);
-    adjacent[fill[constraints_[c].bodies.b]++] = static_cast<std::uint32_t>(c);
-  }
-  std::vector<std::uint32_t> queue;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (start[i] != start[i + 1] && !bodies_.takes_impulse(i)) {
-      levels_[i] = 0;
-      queue.push_back(static_cast<std::uint32_t>(i));
-    }
-  }
-  for (std::size_t q = 0; q < queue.size(); ++q) {
-    const std::uint32_t i = queue[q];
-    for (std::uint32_t e = start[i]; e < start[i + 1]; ++e) {
-      const ContactConstraint& k = constraints_[adjacent[e]];
-      const std::size_t other = k.bodies.a == i ? k.bodies.b : k.bodies.a;
-      if (levels_[other] != kNoLevel) continue;
-      levels_[other] = levels_[i] + 1;
-      queue.push_back(static_cast<std::uint32_t>(other));
-    }
-  }
-  // hold()'s order: by the lower level of the two bodies (a stable counting sort), contact order
-  // within a level. Pairs on one level, or out of reach of every still body, are not held.
-  std::uint32_t top = 0;
-  for (const ContactConstraint& k : constraints_) {
-    const std::uint32_t la = levels_[k.bodies.a];
-    const std::uint32_t lb = levels_[k.bodies.b];
-    if (la != lb && la != kNoLevel && lb != kNoLevel) top = std::max(top, std::min(la, lb));
-  }
-  std::vector<std::uint32_t> count(top + 2, 0);
-  for (const ContactConstraint& k : constraints_) {
-    const std::uint32_t la = levels_[k.bodies.a];
-    const std::uint32_t lb = levels_[k.bodies.b];
-    if (la != lb && la != kNoLevel && lb != kNoLevel) ++count[std::min(la, lb) + 1];
-  }
-  for (std::size_t l = 0; l + 1 < count.size(); ++l)
-    count[l + 1] += count[l];
-  hold_order_.resize(count.back());
-  for (std::size_t c = 0; c < constraints_.size(); ++c) {
-    const std::uint32_t la = levels_[constraints_[c].bodies.a];
-    const std::uint32_t lb = levels_[constraints_[c].bodies.b];
-    if (la != lb && la != kNoLevel && lb != kNoLevel)
-      hold_order_[count[std::min(la, lb)]++] = static_cast<std::uint32_t>(c);
-  }
-}
-
-// Shock propagation (Guendelman, Bridson and Fedkiw 2003), for the ends of the contacts' soft
-// ranges only: from the ground up, a point closing faster than what stops it at the end of its
-// range within the sub-step is stopped there by an
-// impulse on the upper body alone, the lower one held still: a heavy body on a light one needs
-// about M / m ordinary passes to build its impulse up, and in that time drove the light one deep
-// into the ground. The impulse only takes away approach speed (it is not added to the point's
-// accumulated impulse, which booked as a load in the warm start threw the pair into the air).
-// Points within their allowance are left alone: resting contacts of ordinary scenes are not
-// touched.
-void ContactSolver::hold() {
-  const Fixed depth = s_.def.speculative_distance;
-  for (const std::uint32_t c : hold_order_) {
-    ContactConstraint& k = constraints_[c];
-    const bool a_upper = levels_[k.bodies.a] > levels_[k.bodies.b];
-    for (std::size_t p = 0; p < k.count; ++p) {
-      SolverPoint& sp = k.points[p];
-      const Fixed vn = row_speed(bodies_.velocities, k.bodies, k.normal, sp.normal);
-      // The end of the range, also for a point still apart: a speculative contact's own stop at
-      // the surface is the solve passes' business, as in every other scene.
-      const Fixed allowed = max(sp.separation + depth, Fixed::zero()) * bodies_.inv_h;
-      if (vn + allowed >= Fixed::zero()) continue;
-      // The upper body's effective mass alone.
-      const std::size_t upper = a_upper ? k.bodies.a : k.bodies.b;
-      const Fixed angular = a_upper ? dot(sp.normal.response_a, sp.normal.angular_a)
-                                    : dot(sp.normal.response_b, sp.normal.angular_b);
-      const Fixed mass = inverse_or_zero(s_.derived[upper].inverse_mass + angular);
-      const Fixed impulse = -mass * (vn + allowed);
-      k.pushed = true;
-      BodyPair one_side = k.bodies;
-      (a_upper ? one_side.takes_impulse_b : one_side.takes_impulse_a) = false;
-      apply_impulse(bodies_.velocities, one_side, k.normal, sp.normal, impulse);
-    }
-  }
-}
-
 void ContactSolver::prepare_constraint(std::size_t ci) {
   const Contact& c = s_.contacts[ci];
   const std::size_t ia = c.index_a;
@@ -192,8 +121,7 @@ void ContactSolver::prepare_constraint(std::size_t ci) {
   k.count = c.point_count;
   k.pushed = false;
   k.bounced = false;
-  Vec3 sum_a;
-  Vec3 sum_b;
+  k.loaded = false;
   for (std::size_t p = 0; p < c.point_count; ++p) {
     const ContactPoint& mp = c.manifold.points[p];
     SolverPoint& sp = k.points[p];
@@ -205,18 +133,16 @@ void ContactSolver::prepare_constraint(std::size_t ci) {
     sp.normal = make_row(da, db, anchor_a, anchor_b, normal);
     sp.tangent_1 = make_row(da, db, anchor_a, anchor_b, tangent_1);
     sp.tangent_2 = make_row(da, db, anchor_a, anchor_b, tangent_2);
-    sum_a += anchor_a;
-    sum_b += anchor_b;
     sp.normal_impulse = c.cached[p].normal_impulse;
+    k.loaded = k.loaded || sp.normal_impulse > Fixed::zero();
     sp.tangent_impulse_1 = c.cached[p].tangent_impulse_1;
     sp.tangent_impulse_2 = c.cached[p].tangent_impulse_2;
   }
   k.bounce = {};
-  // The centroid's row: the whole manifold's first push (solve_centre), and restitution's.
-  if (c.point_count > 1 || k.restitution != Fixed::zero()) {
-    const Fixed count = Fixed::from_int(c.point_count);
-    k.bounce.normal = make_row(da, db, sum_a / count, sum_b / count, normal);
-  }
+  // The centroid's row: restitution's, and the whole manifold's first push (solve_centre, which
+  // makes it when it first needs it: most resting manifolds never do).
+  k.centre_ready = k.restitution != Fixed::zero();
+  if (k.centre_ready) k.bounce.normal = centroid_row(k, da, db);
   if (k.restitution != Fixed::zero())
     k.bounce.relative_velocity = row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
   bodies_.in_contact[ia] = true;
@@ -299,11 +225,27 @@ inline Fixed ContactSolver::hard_stop(Fixed separation) const {
 // start. Only a push is applied here: taking load off is left to each point's own row.
 inline void ContactSolver::solve_centre(ContactConstraint& k) {
   if (k.count < 2) return;
+  // A manifold that carried load in the last step and whose points all overlap within the soft
+  // range is resting: its springs share the load point by point, its warm start already holds
+  // it, and the centroid would only cost time. A new one (a body arriving) is not.
+  const Fixed depth = -s_.def.speculative_distance;
   Fixed gap = k.points[0].separation;
-  for (std::size_t p = 1; p < k.count; ++p)
-    gap = min(gap, k.points[p].separation);
+  bool resting = true;
+  for (std::size_t p = 0; p < k.count; ++p) {
+    const Fixed separation = k.points[p].separation;
+    gap = min(gap, separation);
+    resting = resting && separation <= Fixed::zero() && separation >= depth;
+  }
+  if (resting && k.loaded) return;
+  if (!k.centre_ready) {
+    k.bounce.normal = centroid_row(k, s_.derived[k.bodies.a], s_.derived[k.bodies.b]);
+    k.centre_ready = true;
+  }
   const Fixed bias = hard_stop(gap) * bodies_.inv_h;
   const Fixed vn = row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
+  // Only an approach that would cross the whole soft range within the sub-step: slower ones
+  // (bodies landing on a pile) are the springs' to take, point by point, as they always were.
+  if (vn + s_.def.speculative_distance * bodies_.inv_h >= Fixed::zero()) return;
   const Fixed impulse = -k.bounce.normal.mass * (vn + bias);
   if (impulse <= Fixed::zero()) return;
   const Fixed share = impulse / Fixed::from_int(k.count);

@@ -44,10 +44,12 @@ struct ContactConstraint {
   Fixed friction;
   Fixed restitution;
   std::uint8_t count;
-  bool pushed;   ///< some point has pushed in this step
-  bool bounced;  ///< restitution applied this step
+  bool pushed;        ///< some point has pushed in this step
+  bool bounced;       ///< restitution applied this step
+  bool loaded;        ///< some point carried a normal impulse from the last step (warm start)
+  bool centre_ready;  ///< bounce.normal, the centroid's row, is made
   std::array<SolverPoint, 4> points;
-  Bounce bounce;  ///< the centroid's row: set when there are 2 or more points or restitution
+  Bounce bounce;  ///< the centroid's row (when centre_ready) and restitution's approach speed
 };
 
 /// The contacts of the step, in contact order (ascending ID pair), point order within a contact.
