@@ -230,15 +230,51 @@ TEST(CoincidentSpawn, NeverGainsMoreEnergyThanThePushOutCapAllows) {
         for (int i = 0; i < count; ++i)
           ids.push_back(add(w, box({}, 0.25_fx, 1_fx)));
       },
-      4, {},
+      6, {},
       [&](World& w, int f) {
         double energy = 0;
         for (const BodyId id : ids)
           energy += kinetic_energy(w, id, edge);
         most = std::max(most, energy);
         EXPECT_LE(energy, cap) << "frame " << f;
+        // The cost is bounded: each body in at most pair_budget pairs, not every body with
+        // every other (124 750 pairs).
+        EXPECT_LE(w.contacts().size(), std::size_t{count} * pair_budget / 2) << "frame " << f;
       });
   RecordProperty("most_energy_j", std::to_string(most));
+}
+
+// A large body carrying more small ones than the pair budget: the budget counts only bodies of
+// comparable size, so none of the 100 crates on a dynamic 20 m deck falls through it.
+TEST(PairBudget, ALargeBodyCarriesMoreSmallOnesThanTheBudget) {
+  const WorldDef def;
+  const Fixed half = 0.25_fx;
+  std::vector<BodyId> crates;
+  BodyId deck;
+  run(
+      def,
+      [&](World& w) {
+        crates.clear();
+        add_ground(w);
+        BodyDef d;
+        d.shape = Shape::box({10_fx, 0.5_fx, 10_fx});
+        d.position = {{}, 0.5_fx, {}};
+        d.density = 100_fx;
+        deck = add(w, d);
+        for (int x = 0; x < 10; ++x) {
+          for (int z = 0; z < 10; ++z) {
+            const Vec3 p{Fixed::from_int(2 * x - 9), 1_fx + half, Fixed::from_int(2 * z - 9)};
+            crates.push_back(add(w, box(p, half, 1_fx)));
+          }
+        }
+      },
+      60, {},
+      [&](World& w, int f) {
+        const Fixed top = state(w, deck).position.y + 0.5_fx;
+        for (const BodyId id : crates) {
+          EXPECT_GT(state(w, id).position.y, top) << "frame " << f << ": crate " << id.value;
+        }
+      });
 }
 
 // --- A scene of millimetres behaves like a scene of metres -------------------------------------

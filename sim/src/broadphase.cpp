@@ -9,6 +9,7 @@
 
 #include <detsim/fixed/math.hpp>
 
+#include "shapes.hpp"
 #include "world_state.hpp"
 
 namespace detsim::sim_detail {
@@ -152,6 +153,41 @@ void merge_contacts(WorldState& s, const std::vector<std::uint64_t>& pairs) {
   s.contacts = std::move(merged);
 }
 
+// The pair budget (pair_budget, world_def.hpp): bodies spawned into one another (a level loaded
+// with overlapping props, a burst of spawns at one point) make a pair of every two of them,
+// n^2 / 2 in all, and each pair a manifold and a constraint: 500 boxes at one point took about a
+// second per step. So a dynamic body takes part in at most pair_budget pairs with other dynamic
+// bodies of comparable size (a bounding radius at least half its own), in ascending pair order;
+// further pairs wait for a later step, by which time push-out has moved the first ones apart. No
+// ordinary scene comes near it (a box in a dense heap has at most 26 neighbours whose boxes
+// overlap its own), and a large body carrying many small ones (a deck with crates) does not
+// count them.
+void keep_within_budget(const WorldState& s, std::vector<std::uint64_t>& pairs) {
+  std::vector<std::uint32_t> used;
+  std::vector<Fixed> radius;
+  std::size_t kept = 0;
+  for (const std::uint64_t pair : pairs) {
+    const auto i = static_cast<std::uint32_t>(pair >> 32);
+    const auto j = static_cast<std::uint32_t>(pair & 0xFFFFFFFFU);
+    if (s.bodies[i].type == BodyType::dynamic && s.bodies[j].type == BodyType::dynamic) {
+      if (used.empty()) {
+        used.assign(s.bodies.size(), 0);
+        radius.resize(s.bodies.size());
+        for (std::size_t b = 0; b < s.bodies.size(); ++b)
+          radius[b] = bounding_radius(s.bodies[b].shape);
+      }
+      // Each counts the other if the other is at least half its size.
+      const bool i_counts = radius[j] << 1 >= radius[i];
+      const bool j_counts = radius[i] << 1 >= radius[j];
+      if ((i_counts && used[i] == pair_budget) || (j_counts && used[j] == pair_budget)) continue;
+      used[i] += i_counts ? 1 : 0;
+      used[j] += j_counts ? 1 : 0;
+    }
+    pairs[kept++] = pair;
+  }
+  pairs.resize(kept);
+}
+
 }  // namespace
 
 void update_contacts(WorldState& s) {
@@ -183,6 +219,7 @@ void update_contacts(WorldState& s) {
     }
   }
   std::sort(pairs.begin(), pairs.end());
+  keep_within_budget(s, pairs);
   merge_contacts(s, pairs);
 }
 

@@ -48,6 +48,13 @@ struct WorldDef {
   friend constexpr bool operator==(const WorldDef&, const WorldDef&) noexcept = default;
 };
 
+/// The pair budget: in one step, a dynamic body takes part in at most this many pairs with other
+/// dynamic bodies of comparable size (a bounding radius at least half its own), chosen in
+/// ascending ID pair order; further pairs wait for a later step. It bounds the cost of bodies
+/// spawned into one another (n of them at one point would make n^2 / 2 pairs). Ordinary scenes
+/// stay far below it, and a large body carrying many small ones does not count them.
+inline constexpr std::uint32_t pair_budget = 64;
+
 /// The defaults are made for bodies about a metre across: a 2 cm contact range and a 0.24 mm
 /// slop are larger than a millimetre body, and tiny beside a kilometre one; and a contact spring
 /// of a given stiffness sags by g / omega^2 under its load whatever the body's size. This returns
