@@ -163,7 +163,17 @@ void merge_contacts(WorldState& s, const std::vector<std::uint64_t>& pairs) {
 // overlap its own), and a large body carrying many small ones (a deck with crates) does not
 // count them.
 void keep_within_budget(const WorldState& s, std::vector<std::uint64_t>& pairs) {
-  std::vector<std::uint32_t> used;
+  // Most steps: no body has that many pairs at all, and nothing is left out.
+  std::vector<std::uint32_t> used(s.bodies.size(), 0);
+  bool over = false;
+  for (const std::uint64_t pair : pairs) {
+    const auto i = static_cast<std::uint32_t>(pair >> 32);
+    const auto j = static_cast<std::uint32_t>(pair & 0xFFFFFFFFU);
+    if (s.bodies[i].type != BodyType::dynamic || s.bodies[j].type != BodyType::dynamic) continue;
+    over = over || ++used[i] > pair_budget || ++used[j] > pair_budget;
+  }
+  if (!over) return;
+  used.clear();
   std::vector<Fixed> radius;
   std::size_t kept = 0;
   for (const std::uint64_t pair : pairs) {
