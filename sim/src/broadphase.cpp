@@ -187,8 +187,8 @@ void keep_within_budget(const WorldState& s, std::vector<std::uint64_t>& pairs) 
           radius[b] = bounding_radius(s.bodies[b].shape);
       }
       // Each counts the other if the other is at least half its size.
-      const bool i_counts = radius[j] << 1 >= radius[i];
-      const bool j_counts = radius[i] << 1 >= radius[j];
+      const bool i_counts = (radius[j] << 1) >= radius[i];
+      const bool j_counts = (radius[i] << 1) >= radius[j];
       if ((i_counts && used[i] == pair_budget) || (j_counts && used[j] == pair_budget)) continue;
       used[i] += i_counts ? 1 : 0;
       used[j] += j_counts ? 1 : 0;
