@@ -440,6 +440,27 @@ TEST_F(RejectedRestore, OtherInvalidValues) {
   d = decoded_;
   d.sets[sphere_set].friction = -Fixed::epsilon();
   expect_rejected(target_, encode(d));
+
+  // What create_body refuses, restore refuses too (docs/SIM.md, "What is refused"): a mass at the
+  // top of the range (saturated), a dynamic body whose mass or inertia has no inverse in range
+  // (2 ulp: 1 / x = 2^31), and a velocity component beyond 2^30.
+  d = decoded_;
+  d.sets[sphere_set].mass = Fixed::max();
+  message = expect_rejected(target_, encode(d));
+  EXPECT_TRUE(contains(message, "mass")) << message;
+  d = decoded_;
+  d.sets[sphere_set].inertia.y = Fixed::from_raw(2);
+  message = expect_rejected(target_, encode(d));
+  EXPECT_TRUE(contains(message, "inertia")) << message;
+  d = decoded_;
+  d.bodies[1].linear_velocity.x = Fixed::from_int(1 << 30) + Fixed::epsilon();
+  message = expect_rejected(target_, encode(d));
+  EXPECT_TRUE(contains(message, "velocity")) << message;
+  // Just inside each limit: accepted.
+  d = decoded_;
+  d.bodies[1].linear_velocity.x = Fixed::from_int(1 << 30);
+  World w = make_world(WorldDef{});
+  EXPECT_TRUE(w.restore(encode(d)).ok());
 }
 
 }  // namespace

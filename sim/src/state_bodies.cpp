@@ -13,8 +13,10 @@
 #include <unordered_set>
 
 #include <detsim/core/assert.hpp>
+#include <detsim/fixed/decimal.hpp>
 
 #include "body_fields.hpp"
+#include "limits.hpp"
 #include "shapes.hpp"
 #include "state_io.hpp"
 
@@ -207,13 +209,24 @@ void read_properties(ByteReader& r, BodyState& b) {
     b.*layout.flags[bit]->flag = ((flags >> bit) & 1U) != 0;
 }
 
-// Semantic checks of a property set read from bytes; "" when valid.
+// Semantic checks of a property set read from bytes; "" when valid. The limits are the API's
+// (limits.hpp, docs/SIM.md "What is refused") for what a step never changes: a restored world
+// holds nothing that create_body would have refused.
 std::string check_properties(const BodyState& p) {
   if (auto e = check_shape(p.shape, p.type); !e.empty()) return e;
   if (p.mass < Fixed::zero()) return "mass must be >= 0";
   if (p.type == BodyType::dynamic && (p.mass <= Fixed::zero() || p.inertia.x <= Fixed::zero() ||
                                       p.inertia.y <= Fixed::zero() || p.inertia.z <= Fixed::zero()))
     return "a dynamic body needs a positive mass and moments of inertia";
+  if (p.mass > max_quantity || p.inertia.x > max_quantity || p.inertia.y > max_quantity ||
+      p.inertia.z > max_quantity)
+    return "mass and moments of inertia must be <= " + to_string(max_quantity) + ", got " +
+           to_string(p.mass) + " kg and " + to_string(p.inertia.x) + ", " + to_string(p.inertia.y) +
+           ", " + to_string(p.inertia.z) + " kg m^2";
+  if (p.type == BodyType::dynamic && (p.mass < min_mass || p.inertia.x < min_mass ||
+                                      p.inertia.y < min_mass || p.inertia.z < min_mass))
+    return "a dynamic body's mass and moments of inertia must be >= " + to_string(min_mass) +
+           " (their inverses must fit)";
   if (p.friction < Fixed::zero() || p.restitution < Fixed::zero() || p.restitution > Fixed::one() ||
       p.linear_damping < Fixed::zero() || p.angular_damping < Fixed::zero())
     return "material or damping out of range";
@@ -265,6 +278,13 @@ void read_record(ByteReader& r, BodyState& b, std::uint32_t& id_step, std::uint3
 // Semantic checks of a body's moving part; "" when valid.
 std::string check_record(const BodyState& b) {
   if (auto e = check_orientation(b.orientation); !e.empty()) return e;
+  // Velocities: what the API accepts (a step only clamps them lower). Positions are not limited
+  // here: a body may travel past max_position by stepping, and what was saved must restore.
+  for (const Vec3 v : {b.linear_velocity, b.angular_velocity}) {
+    if (beyond(v.x, max_velocity) || beyond(v.y, max_velocity) || beyond(v.z, max_velocity))
+      return "velocity components must be within +-" + to_string(max_velocity) + ", got (" +
+             to_string(v.x) + ", " + to_string(v.y) + ", " + to_string(v.z) + ")";
+  }
   if (b.sleep_time < Fixed::zero()) return "sleep time must be >= 0";
   if (b.type == BodyType::static_body && b.awake) return "a static body cannot be awake";
   return {};
