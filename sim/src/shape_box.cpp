@@ -24,39 +24,24 @@ std::string check(const Shape& s) {
 // The formulas once, for Fixed (the simulation) and Checked (the limits): the same bits.
 // Integers as from_int, not _fx: clang does not always evaluate a consteval literal operator in a
 // function template (an undefined reference at link time).
-template <class N>
-N volume_of(const Shape& s) noexcept {
-  const Vec3 h = s.half_extents;
-  return Fixed::from_int(8) * (N(h.x) * h.y * h.z);
-}
+struct Formulas {
+  template <class N>
+  static N volume(const Shape& s) noexcept {
+    const Vec3 h = s.half_extents;
+    return Fixed::from_int(8) * (N(h.x) * h.y * h.z);
+  }
 
-template <class N>
-std::array<N, 3> inertia_of(const Shape& s, N mass) noexcept {
-  // m/3 (b^2 + c^2) about each axis, with half extents.
-  const Vec3 h = s.half_extents;
-  const N x2 = N(h.x) * h.x;
-  const N y2 = N(h.y) * h.y;
-  const N z2 = N(h.z) * h.z;
-  const N third = mass / Fixed::from_int(3);
-  return {third * (y2 + z2), third * (x2 + z2), third * (x2 + y2)};
-}
-
-Fixed volume(const Shape& s) noexcept {
-  return volume_of<Fixed>(s);
-}
-
-MassProperties mass_properties(const Shape& s, Fixed mass) noexcept {
-  const std::array<Fixed, 3> i = inertia_of<Fixed>(s, mass);
-  return {mass, {i[0], i[1], i[2]}};
-}
-
-Checked checked_volume(const Shape& s) noexcept {
-  return volume_of<Checked>(s);
-}
-
-std::array<Checked, 3> checked_inertia(const Shape& s, Fixed mass) noexcept {
-  return inertia_of<Checked>(s, mass);
-}
+  template <class N>
+  static std::array<N, 3> inertia(const Shape& s, N mass) noexcept {
+    // m/3 (b^2 + c^2) about each axis, with half extents.
+    const Vec3 h = s.half_extents;
+    const N x2 = N(h.x) * h.x;
+    const N y2 = N(h.y) * h.y;
+    const N z2 = N(h.z) * h.z;
+    const N third = mass / Fixed::from_int(3);
+    return {third * (y2 + z2), third * (x2 + z2), third * (x2 + y2)};
+  }
+};
 
 Fixed bounding_radius(const Shape& s) noexcept {
   return length(s.half_extents);
@@ -145,10 +130,10 @@ const ShapeKind box_kind{ShapeType::box,
                          false,
                          true,
                          box_shape::check,
-                         box_shape::volume,
-                         box_shape::mass_properties,
-                         box_shape::checked_volume,
-                         box_shape::checked_inertia,
+                         MassEntries<box_shape::Formulas>::volume,
+                         MassEntries<box_shape::Formulas>::mass_properties,
+                         MassEntries<box_shape::Formulas>::checked_volume,
+                         MassEntries<box_shape::Formulas>::checked_inertia,
                          box_shape::bounding_radius,
                          box_shape::smallest_dimension,
                          box_shape::aabb_extent,

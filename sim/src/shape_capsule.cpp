@@ -23,54 +23,39 @@ std::string check(const Shape& s) {
 // The formulas once, for Fixed (the simulation) and Checked (the limits): the same bits.
 // Integers as from_int, not _fx: clang does not always evaluate a consteval literal operator in a
 // function template (an undefined reference at link time).
-template <class N>
-N volume_of(const Shape& s) noexcept {
-  const N r2 = N(s.radius) * s.radius;
-  // pi r^2 (2 h) + 4/3 pi r^3 = pi r^2 (2 h + 4/3 r)
-  return Fixed::pi() * r2 *
-         (Fixed::from_int(2) * N(s.half_height) +
-          Fixed::from_int(4) * N(s.radius) / Fixed::from_int(3));
-}
+struct Formulas {
+  template <class N>
+  static N volume(const Shape& s) noexcept {
+    const N r2 = N(s.radius) * s.radius;
+    // pi r^2 (2 h) + 4/3 pi r^3 = pi r^2 (2 h + 4/3 r)
+    return Fixed::pi() * r2 *
+           (Fixed::from_int(2) * N(s.half_height) +
+            Fixed::from_int(4) * N(s.radius) / Fixed::from_int(3));
+  }
 
-/// The moments about x, y (the axis) and z.
-template <class N>
-std::array<N, 3> inertia_of(const Shape& s, N mass) noexcept {
-  // Cylinder of half height h and two hemispheres of radius r. Their volumes are in the ratio
-  // 2 h : 4/3 r = 3 h : 2 r, so the cylinder carries 3h / (3h + 2r) of the mass.
-  const N r = s.radius;
-  const N h = s.half_height;
-  const N r2 = r * r;
-  const N h2 = h * h;
-  const N parts = Fixed::from_int(3) * h + Fixed::from_int(2) * r;
-  const N cylinder = mass * (Fixed::from_int(3) * h) / parts;
-  const N caps = mass - cylinder;
-  // About the axis: cylinder m r^2 / 2, hemispheres 2/5 m r^2.
-  const N axial =
-      cylinder * r2 / Fixed::from_int(2) + Fixed::from_int(2) * caps * r2 / Fixed::from_int(5);
-  // Across the axis: cylinder m (r^2 / 4 + (2h)^2 / 12); the hemisphere pair, whose centres
-  // of mass sit 3r/8 beyond the segment ends, m (2/5 r^2 + h^2 + 3/4 h r) (parallel axes).
-  const N across = cylinder * (r2 / Fixed::from_int(4) + h2 / Fixed::from_int(3)) +
-                   caps * (Fixed::from_int(2) * r2 / Fixed::from_int(5) + h2 +
-                           Fixed::from_int(3) * h * r / Fixed::from_int(4));
-  return {across, axial, across};
-}
-
-Fixed volume(const Shape& s) noexcept {
-  return volume_of<Fixed>(s);
-}
-
-MassProperties mass_properties(const Shape& s, Fixed mass) noexcept {
-  const std::array<Fixed, 3> i = inertia_of<Fixed>(s, mass);
-  return {mass, {i[0], i[1], i[2]}};
-}
-
-Checked checked_volume(const Shape& s) noexcept {
-  return volume_of<Checked>(s);
-}
-
-std::array<Checked, 3> checked_inertia(const Shape& s, Fixed mass) noexcept {
-  return inertia_of<Checked>(s, mass);
-}
+  /// The moments about x, y (the axis) and z.
+  template <class N>
+  static std::array<N, 3> inertia(const Shape& s, N mass) noexcept {
+    // Cylinder of half height h and two hemispheres of radius r. Their volumes are in the ratio
+    // 2 h : 4/3 r = 3 h : 2 r, so the cylinder carries 3h / (3h + 2r) of the mass.
+    const N r = s.radius;
+    const N h = s.half_height;
+    const N r2 = r * r;
+    const N h2 = h * h;
+    const N parts = Fixed::from_int(3) * h + Fixed::from_int(2) * r;
+    const N cylinder = mass * (Fixed::from_int(3) * h) / parts;
+    const N caps = mass - cylinder;
+    // About the axis: cylinder m r^2 / 2, hemispheres 2/5 m r^2.
+    const N axial =
+        cylinder * r2 / Fixed::from_int(2) + Fixed::from_int(2) * caps * r2 / Fixed::from_int(5);
+    // Across the axis: cylinder m (r^2 / 4 + (2h)^2 / 12); the hemisphere pair, whose centres
+    // of mass sit 3r/8 beyond the segment ends, m (2/5 r^2 + h^2 + 3/4 h r) (parallel axes).
+    const N across = cylinder * (r2 / Fixed::from_int(4) + h2 / Fixed::from_int(3)) +
+                     caps * (Fixed::from_int(2) * r2 / Fixed::from_int(5) + h2 +
+                             Fixed::from_int(3) * h * r / Fixed::from_int(4));
+    return {across, axial, across};
+  }
+};
 
 Fixed bounding_radius(const Shape& s) noexcept {
   return s.radius + s.half_height;
@@ -149,10 +134,10 @@ const ShapeKind capsule_kind{ShapeType::capsule,
                              false,
                              true,
                              capsule_shape::check,
-                             capsule_shape::volume,
-                             capsule_shape::mass_properties,
-                             capsule_shape::checked_volume,
-                             capsule_shape::checked_inertia,
+                             MassEntries<capsule_shape::Formulas>::volume,
+                             MassEntries<capsule_shape::Formulas>::mass_properties,
+                             MassEntries<capsule_shape::Formulas>::checked_volume,
+                             MassEntries<capsule_shape::Formulas>::checked_inertia,
                              capsule_shape::bounding_radius,
                              capsule_shape::smallest_dimension,
                              capsule_shape::aabb_extent,

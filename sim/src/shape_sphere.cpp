@@ -42,35 +42,21 @@ std::string check(const Shape& s) {
 // The formulas once, for Fixed (the simulation) and Checked (the limits): the same bits.
 // Integers as from_int, not _fx: clang does not always evaluate a consteval literal operator in a
 // function template (an undefined reference at link time).
-template <class N>
-N volume_of(const Shape& s) noexcept {
-  // 4/3 pi r^3
-  return (Fixed::from_int(4) * Fixed::pi() / Fixed::from_int(3)) *
-         (N(s.radius * s.radius) * s.radius);
-}
+struct Formulas {
+  template <class N>
+  static N volume(const Shape& s) noexcept {
+    // 4/3 pi r^3
+    return (Fixed::from_int(4) * Fixed::pi() / Fixed::from_int(3)) *
+           (N(s.radius * s.radius) * s.radius);
+  }
 
-template <class N>
-N inertia_of(const Shape& s, N mass) noexcept {
-  return Fixed::from_int(2) * mass * (s.radius * s.radius) / Fixed::from_int(5);  // 2/5 m r^2
-}
-
-Fixed volume(const Shape& s) noexcept {
-  return volume_of<Fixed>(s);
-}
-
-MassProperties mass_properties(const Shape& s, Fixed mass) noexcept {
-  const Fixed i = inertia_of<Fixed>(s, mass);
-  return {mass, {i, i, i}};
-}
-
-Checked checked_volume(const Shape& s) noexcept {
-  return volume_of<Checked>(s);
-}
-
-std::array<Checked, 3> checked_inertia(const Shape& s, Fixed mass) noexcept {
-  const Checked i = inertia_of<Checked>(s, mass);
-  return {i, i, i};
-}
+  template <class N>
+  static std::array<N, 3> inertia(const Shape& s, N mass) noexcept {
+    const N i =
+        Fixed::from_int(2) * mass * (s.radius * s.radius) / Fixed::from_int(5);  // 2/5 m r^2
+    return {i, i, i};
+  }
+};
 
 Fixed radius(const Shape& s) noexcept {
   return s.radius;
@@ -108,10 +94,10 @@ const ShapeKind sphere_kind{ShapeType::sphere,
                             false,
                             true,
                             sphere_shape::check,
-                            sphere_shape::volume,
-                            sphere_shape::mass_properties,
-                            sphere_shape::checked_volume,
-                            sphere_shape::checked_inertia,
+                            MassEntries<sphere_shape::Formulas>::volume,
+                            MassEntries<sphere_shape::Formulas>::mass_properties,
+                            MassEntries<sphere_shape::Formulas>::checked_volume,
+                            MassEntries<sphere_shape::Formulas>::checked_inertia,
                             sphere_shape::radius,
                             sphere_shape::radius,
                             sphere_shape::aabb_extent,

@@ -39,6 +39,25 @@ struct LocalHit {
   Vec3 normal;
 };
 
+/// The four mass entries of a ShapeKind (volume, mass_properties, checked_volume,
+/// checked_inertia) from a kind's formulas, written once as templates over the number type:
+/// `Formulas::volume<N>(shape)` and `Formulas::inertia<N>(shape, mass)` (the moments about x, y
+/// and z), for N = Fixed (what the simulation uses) and N = Checked (the limits, the same bits).
+template <class Formulas>
+struct MassEntries {
+  static Fixed volume(const Shape& s) noexcept { return Formulas::template volume<Fixed>(s); }
+  static MassProperties mass_properties(const Shape& s, Fixed mass) noexcept {
+    const std::array<Fixed, 3> i = Formulas::template inertia<Fixed>(s, mass);
+    return {mass, {i[0], i[1], i[2]}};
+  }
+  static Checked checked_volume(const Shape& s) noexcept {
+    return Formulas::template volume<Checked>(s);
+  }
+  static std::array<Checked, 3> checked_inertia(const Shape& s, Fixed mass) noexcept {
+    return Formulas::template inertia<Checked>(s, mass);
+  }
+};
+
 /// What the library does with one type of shape. Every function takes a shape of this type that
 /// `check` has accepted, except `check` itself and `read`.
 struct ShapeKind {
