@@ -292,12 +292,13 @@ void ContactSolver::solve() {
   solve_contacts(true);
 }
 
-// Overlap recovery (split impulses, Catto 2006; Bullet's split impulse; Jolt's position
-// iterations): each point overlapping by more than linear_slop asks its bodies' push-out
-// velocities to separate at the spring's rate, bias_rate * overlap (contact_hertz and the damping
-// ratio, stiffer against static bodies), up to contact_push_max. The push-out velocities move the
-// positions in integrate_positions and are then dropped: recovery never adds kinetic energy, and
-// the velocity constraints (solve, relax) stay rigid, so no load can press a body further in.
+// Overlap recovery beyond the soft range (split impulses, as in Bullet's split impulse and Jolt's
+// position iterations): each point overlapping by more than the range (the speculative distance)
+// asks its bodies' push-out velocities to separate at the spring's rate times the excess
+// (contact_hertz and the damping ratio, stiffer against static bodies), up to contact_push_max.
+// The push-out velocities move the positions in integrate_positions and are then dropped:
+// recovery never adds kinetic energy, however many overlaps a body has. Within the range the
+// soft spring's own bias pushes, as before.
 void ContactSolver::push_out() {
   const Fixed depth = s_.def.speculative_distance;
   const Fixed push_max = s_.def.contact_push_max;
