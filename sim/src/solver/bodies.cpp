@@ -10,8 +10,6 @@ Vec3 halve(Vec3 v) {
   return {v.x >> 1, v.y >> 1, v.z >> 1};
 }
 
-// `inline`: called twice per body per sub-step; the hint keeps it inlined as it was when it was a
-// member function defined in its class.
 // The result's length never exceeds the limit: v * (limit / |v|) can round a few ulp above it, so
 // the factor steps down by one ulp until it does not (one or two steps; each shortens the result
 // by |v| ulp, more than the rounding it makes up for). Out of line: it is the rare path.

@@ -138,13 +138,14 @@ void ContactSolver::prepare_constraint(std::size_t ci) {
     sp.tangent_impulse_1 = c.cached[p].tangent_impulse_1;
     sp.tangent_impulse_2 = c.cached[p].tangent_impulse_2;
   }
-  k.bounce = {};
+  k.centroid = {};
   // The centroid's row: restitution's, and the whole manifold's first push (solve_centre, which
   // makes it when it first needs it: most resting manifolds never do).
-  k.centre_ready = k.restitution != Fixed::zero();
-  if (k.centre_ready) k.bounce.normal = centroid_row(k, da, db);
+  k.centroid_ready = k.restitution != Fixed::zero();
+  if (k.centroid_ready) k.centroid.normal = centroid_row(k, da, db);
   if (k.restitution != Fixed::zero())
-    k.bounce.relative_velocity = row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
+    k.centroid.relative_velocity =
+        row_speed(bodies_.velocities, k.bodies, k.normal, k.centroid.normal);
   bodies_.in_contact[ia] = true;
   bodies_.in_contact[ib] = true;
 }
@@ -207,6 +208,12 @@ inline void ContactSolver::solve_normal(ContactConstraint& k, const Softness& so
   }
 }
 
+inline const Softness& ContactSolver::softness(const ContactConstraint& k) const {
+  const bool against_static = s_.derived[k.bodies.a].inverse_mass == Fixed::zero() ||
+                              s_.derived[k.bodies.b].inverse_mass == Fixed::zero();
+  return against_static ? static_soft_ : soft_;
+}
+
 // How far a point at `separation` may still close within a sub-step: to the surface when apart
 // (a speculative contact), to the end of the soft range (the speculative distance) when
 // overlapping within it, not at all beyond.
@@ -237,22 +244,22 @@ inline void ContactSolver::solve_centre(ContactConstraint& k) {
     resting = resting && separation <= Fixed::zero() && separation >= depth;
   }
   if (resting && k.loaded) return;
-  if (!k.centre_ready) {
-    k.bounce.normal = centroid_row(k, s_.derived[k.bodies.a], s_.derived[k.bodies.b]);
-    k.centre_ready = true;
+  if (!k.centroid_ready) {
+    k.centroid.normal = centroid_row(k, s_.derived[k.bodies.a], s_.derived[k.bodies.b]);
+    k.centroid_ready = true;
   }
   const Fixed bias = hard_stop(gap) * bodies_.inv_h;
-  const Fixed vn = row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
+  const Fixed vn = row_speed(bodies_.velocities, k.bodies, k.normal, k.centroid.normal);
   // Only an approach that would cross the whole soft range within the sub-step: slower ones
   // (bodies landing on a pile) are the springs' to take, point by point, as they always were.
   if (vn + s_.def.speculative_distance * bodies_.inv_h >= Fixed::zero()) return;
-  const Fixed impulse = -k.bounce.normal.mass * (vn + bias);
+  const Fixed impulse = -k.centroid.normal.mass * (vn + bias);
   if (impulse <= Fixed::zero()) return;
   const Fixed share = impulse / Fixed::from_int(k.count);
   for (std::size_t p = 0; p < k.count; ++p)
     k.points[p].normal_impulse += share;
   k.pushed = true;
-  apply_impulse(bodies_.velocities, k.bodies, k.normal, k.bounce.normal,
+  apply_impulse(bodies_.velocities, k.bodies, k.normal, k.centroid.normal,
                 share * Fixed::from_int(k.count));
 }
 
@@ -303,9 +310,7 @@ void ContactSolver::push_out() {
   const Fixed depth = s_.def.speculative_distance;
   const Fixed push_max = s_.def.contact_push_max;
   for (ContactConstraint& k : constraints_) {
-    const bool against_static = s_.derived[k.bodies.a].inverse_mass == Fixed::zero() ||
-                                s_.derived[k.bodies.b].inverse_mass == Fixed::zero();
-    const Fixed rate = against_static ? static_soft_.bias_rate : soft_.bias_rate;
+    const Fixed rate = softness(k).bias_rate;
     for (std::size_t p = 0; p < k.count; ++p) {
       SolverPoint& sp = k.points[p];
       const Fixed overlap = -(sp.separation + depth);  // beyond the soft range
@@ -329,12 +334,10 @@ void ContactSolver::solve_contacts(bool first_pass) {
     // Until the contact first pushes, its approach speed (at the centroid, before any point is
     // solved) is what restitution must reverse.
     if (first_pass && !k.pushed && k.restitution != Fixed::zero())
-      k.bounce.relative_velocity =
-          row_speed(bodies_.velocities, k.bodies, k.normal, k.bounce.normal);
-    const bool against_static = s_.derived[k.bodies.a].inverse_mass == Fixed::zero() ||
-                                s_.derived[k.bodies.b].inverse_mass == Fixed::zero();
+      k.centroid.relative_velocity =
+          row_speed(bodies_.velocities, k.bodies, k.normal, k.centroid.normal);
     solve_centre(k);
-    solve_normal(k, against_static ? static_soft_ : soft_, first_pass);
+    solve_normal(k, softness(k), first_pass);
     solve_friction(k);
   }
 }
@@ -374,7 +377,7 @@ void ContactSolver::restitution() {
   const Fixed threshold = s_.def.restitution_threshold;
   for (ContactConstraint& k : constraints_) {
     if (k.restitution == Fixed::zero() || k.bounced || !k.pushed) continue;
-    const Bounce& c = k.bounce;
+    const Centroid& c = k.centroid;
     if (c.relative_velocity > -threshold) continue;
     k.bounced = true;
     const Fixed vn = row_speed(bodies_.velocities, k.bodies, k.normal, c.normal);

@@ -28,8 +28,9 @@ struct SolverPoint {
   Fixed push_impulse;  ///< accumulated on the push-out velocities, this sub-step
 };
 
-/// Restitution acts once per contact, along the normal at the centroid of its points.
-struct Bounce {
+/// The normal row at the centroid of a contact's points: the manifold's first push
+/// (solve_centre), and restitution, which acts once per contact along it.
+struct Centroid {
   Row normal;
   Fixed relative_velocity;  ///< normal approach speed before the first push
 };
@@ -44,12 +45,12 @@ struct ContactConstraint {
   Fixed friction;
   Fixed restitution;
   std::uint8_t count;
-  bool pushed;        ///< some point has pushed in this step
-  bool bounced;       ///< restitution applied this step
-  bool loaded;        ///< some point carried a normal impulse from the last step (warm start)
-  bool centre_ready;  ///< bounce.normal, the centroid's row, is made
+  bool pushed;          ///< some point has pushed in this step
+  bool bounced;         ///< restitution applied this step
+  bool loaded;          ///< some point carried a normal impulse from the last step (warm start)
+  bool centroid_ready;  ///< centroid.normal is made
   std::array<SolverPoint, 4> points;
-  Bounce bounce;  ///< the centroid's row (when centre_ready) and restitution's approach speed
+  Centroid centroid;  ///< its row when centroid_ready; restitution's approach speed
 };
 
 /// The contacts of the step, in contact order (ascending ID pair), point order within a contact.
@@ -78,6 +79,8 @@ class ContactSolver final : public ConstraintKind {
   void prepare_levels();
   void solve_contacts(bool first_pass);
   [[nodiscard]] Fixed hard_stop(Fixed separation) const;
+  /// The contact spring of `k`: stiffer against a body that no impulse moves.
+  [[nodiscard]] const Softness& softness(const ContactConstraint& k) const;
   void solve_centre(ContactConstraint& k);
   void solve_normal(ContactConstraint& k, const Softness& soft, bool use_bias);
   void solve_friction(ContactConstraint& k);
