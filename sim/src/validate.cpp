@@ -176,6 +176,52 @@ std::string check_dynamic_mass(const MassProperties& m) {
   return {};
 }
 
+namespace {
+
+std::string check_joint_body(const WorldState& s, const char* field, BodyId id) {
+  if (id.is_null()) return std::string(field) + " must name a body, got the null ID 0";
+  if (s.find(id.value) < 0)
+    return std::string(field) + " names no body: no body with ID " + std::to_string(id.value);
+  return {};
+}
+
+}  // namespace
+
+std::string check_joint_def(const WorldState& s, const JointDef& def) {
+  if (static_cast<unsigned>(def.type) > static_cast<unsigned>(JointType::swing_twist))
+    return "unknown joint type " + std::to_string(static_cast<unsigned>(def.type));
+  if (auto e = check_joint_body(s, "body_a", def.body_a); !e.empty()) return e;
+  if (auto e = check_joint_body(s, "body_b", def.body_b); !e.empty()) return e;
+  if (def.body_a == def.body_b)
+    return "body_a and body_b must differ, both are body " + std::to_string(def.body_a.value);
+  const BodyState& a = s.bodies[static_cast<std::size_t>(s.find(def.body_a.value))];
+  const BodyState& b = s.bodies[static_cast<std::size_t>(s.find(def.body_b.value))];
+  if (a.type == BodyType::static_body && b.type == BodyType::static_body)
+    return "body_a (" + std::to_string(def.body_a.value) + ") and body_b (" +
+           std::to_string(def.body_b.value) + ") are both static: at most one may be";
+  if (auto e = check_components("anchor", def.anchor, max_position, "m"); !e.empty()) return e;
+  const Fixed l2 = length_squared(def.axis);
+  if (abs(l2 - Fixed::one()) > kUnitTolerance)
+    return "axis must be a unit vector (|axis|^2 within 2^-20 of 1), got |axis|^2 = " + str(l2);
+  if (def.limit_lower > def.limit_upper)
+    return "limit_lower must be <= limit_upper, got limit_lower " + str(def.limit_lower) +
+           " > limit_upper " + str(def.limit_upper);
+  if (auto e = non_negative("swing_limit", def.swing_limit); !e.empty()) return e;
+  if (def.swing_limit > Fixed::pi())
+    return "swing_limit must be <= pi, got " + str(def.swing_limit);
+  if (auto e = non_negative("motor_max_force", def.motor_max_force); !e.empty()) return e;
+  if (auto e = non_negative("min_length", def.min_length); !e.empty()) return e;
+  if (auto e = non_negative("max_length", def.max_length); !e.empty()) return e;
+  if (def.min_length > def.max_length)
+    return "min_length must be <= max_length, got min_length " + str(def.min_length) +
+           " > max_length " + str(def.max_length);
+  if (auto e = non_negative("spring_frequency", def.spring_frequency); !e.empty()) return e;
+  if (auto e = non_negative("spring_damping_ratio", def.spring_damping_ratio); !e.empty()) return e;
+  if (auto e = non_negative("break_force", def.break_force); !e.empty()) return e;
+  if (auto e = non_negative("break_torque", def.break_torque); !e.empty()) return e;
+  return {};
+}
+
 std::string check_world_def(const WorldDef& def) {
   if (def.dt <= Fixed::zero() || def.dt > Fixed::one())
     return "dt must be in (0, 1] seconds, got " + str(def.dt);

@@ -6,6 +6,7 @@
 #include <detsim/sim/body.hpp>
 #include <detsim/sim/driver.hpp>
 #include <detsim/sim/inject.hpp>
+#include <detsim/sim/joint.hpp>
 #include <detsim/sim/mass.hpp>
 #include <detsim/sim/shape.hpp>
 #include <detsim/sim/shape_outline.hpp>

@@ -17,6 +17,7 @@
 #include <detsim/core/rng.hpp>
 #include <detsim/core/status.hpp>
 #include <detsim/sim/body.hpp>
+#include <detsim/sim/joint.hpp>
 #include <detsim/sim/state_sections.hpp>
 #include <detsim/sim/world_def.hpp>
 
@@ -156,7 +157,8 @@ class World {
   /// inertia or other derived quantity that would saturate: docs/SIM.md, "What is refused") is
   /// refused with a message naming the field or quantity, and the world is unchanged.
   Expected<BodyId> create_body(const BodyDef& def);
-  /// Removes a body and its contacts; wakes the bodies it touched. Unknown IDs are an error.
+  /// Removes a body, its contacts and its joints; wakes the bodies it touched or was joined to.
+  /// Unknown IDs are an error.
   Status destroy_body(BodyId id);
   [[nodiscard]] bool contains(BodyId id) const noexcept;
   [[nodiscard]] std::size_t body_count() const noexcept;
@@ -172,6 +174,20 @@ class World {
   Status set_transform(BodyId id, Vec3 position, Quat orientation);
   Status set_linear_velocity(BodyId id, Vec3 velocity);
   Status set_angular_velocity(BodyId id, Vec3 velocity);
+
+  // ---- Joints (work in progress: docs/JOINTS-WIP.md; not yet in save/restore/hashes) ----
+
+  /// Creates a joint; its ID is the next in joint sequence. An invalid definition (unknown or
+  /// identical bodies, two static bodies, an axis that is not a unit vector, lower > upper,
+  /// negative lengths, forces or frequencies) is refused with a message naming the field, and the
+  /// world is unchanged. Wakes both bodies.
+  Expected<JointId> create_joint(const JointDef& def);
+  /// Removes a joint; wakes its bodies. Unknown IDs are an error.
+  Status destroy_joint(JointId id);
+  /// A copy of a joint's definition and run-time state, or an error for an unknown ID.
+  [[nodiscard]] Expected<JointState> joint(JointId id) const;
+  /// Every joint's ID, ascending.
+  [[nodiscard]] std::vector<JointId> joint_ids() const;
 
   // ---- Game inputs: accumulated until the next step. Each wakes the body. ----
   // A call whose sums, accelerations or resulting velocities would leave the limits of docs/SIM.md
