@@ -2,7 +2,9 @@
 // change nothing, IDs ascend, a destroyed body takes its joints along) and the physics of the
 // solved joint types, with expectations derived from formulas (stated beside each), never from a
 // previous run's output.
+#include <cmath>
 #include <cstdint>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -152,6 +154,115 @@ TEST(SimJoint, DestroyingABodyRemovesItsJoints) {
   EXPECT_EQ(w.joint_ids(), std::vector<JointId>{side});
   EXPECT_FALSE(w.joint(top).ok());
   EXPECT_FALSE(w.joint(middle).ok());
+}
+
+// ---- Ball joints ----
+
+// The anchors' distance, world space: where the joint's anchor is on body a, and on body b.
+Fixed anchor_gap(const World& w, JointId id) {
+  const JointState j = *w.joint(id);
+  const BodyState a = state(w, j.def.body_a);
+  const BodyState b = state(w, j.def.body_b);
+  const Vec3 pa = a.position + rotate(a.orientation, j.local_anchor_a);
+  const Vec3 pb = b.position + rotate(b.orientation, j.local_anchor_b);
+  return length(pb - pa);
+}
+
+TEST(SimBallJoint, PendulumSwingsWithThePeriodOfThePendulumFormula) {
+  // A 1 kg sphere of radius r on a ball joint L = 2 m above its centre, released at rest 10
+  // degrees from the vertical: a physical pendulum about the joint, with I = m L^2 + 2/5 m r^2
+  // (the sphere turns with the swing). Small-amplitude period 2 pi sqrt(I / (m g L)), corrected
+  // for the amplitude by (1 + theta0^2 / 16) (the next term, 11 theta0^4 / 3072, is 3e-6 here).
+  // No damping: the amplitude should stay (the soft joint's spring may lose a little).
+  World w = make_world();
+  const Vec3 pivot{0_fx, 10_fx, 0_fx};
+  const Fixed length = 2_fx;
+  const Fixed radius = 0.1_fx;
+  const Fixed theta0 = Fixed::pi() / 18_fx;  // 10 degrees
+  const BodyId top = add(w, anchor_at(pivot));
+  const BodyId bob =
+      add(w, ball_at(pivot + Vec3{length * sin(theta0), -length * cos(theta0), 0_fx}, radius));
+  JointDef d;
+  d.body_a = top;
+  d.body_b = bob;
+  d.anchor = pivot;
+  const JointId joint = join(w, d);
+
+  const double g = -w.def().gravity.y.to_double();
+  const double L = length.to_double();
+  const double r = radius.to_double();
+  const double t0 = theta0.to_double();
+  const double inertia = L * L + 0.4 * r * r;  // per kg
+  const double period = 2.0 * M_PI * std::sqrt(inertia / (g * L)) * (1.0 + t0 * t0 / 16.0);
+  const double dt = w.def().dt.to_double();
+
+  // The angle from the vertical, sampled every step; upward zero crossings (theta from < 0 to
+  // >= 0) are timed by linear interpolation between the two steps.
+  const auto angle = [&] {
+    const Vec3 p = state(w, bob).position - pivot;
+    return std::atan2(p.x.to_double(), -p.y.to_double());
+  };
+  std::vector<double> crossings;
+  double previous = angle();
+  double first_peak = 0.0;
+  double last_peak = 0.0;
+  const std::int32_t steps = static_cast<std::int32_t>(11.5 * period / dt);
+  for (std::int32_t i = 1; i <= steps; ++i) {
+    w.step();
+    const double theta = angle();
+    if (previous < 0.0 && theta >= 0.0)
+      crossings.push_back(dt * (i - 1 + previous / (previous - theta)));
+    if (crossings.empty()) first_peak = std::max(first_peak, std::abs(theta));
+    if (crossings.size() >= 10) last_peak = std::max(last_peak, std::abs(theta));
+    previous = theta;
+  }
+  ASSERT_GE(crossings.size(), 11U);
+  const double measured = (crossings[10] - crossings[0]) / 10.0;
+  const double period_error = std::abs(measured - period) / period;
+  EXPECT_LT(period_error, 0.01) << "measured " << measured << " s, expected " << period << " s";
+  // The first swing starts at theta0 itself; the peaks after ten swings are those of the eleventh.
+  const double loss = 1.0 - last_peak / first_peak;
+  EXPECT_LT(loss, 0.02) << "first peak " << first_peak << ", after ten swings " << last_peak;
+  EXPECT_LT(anchor_gap(w, joint), 0.005_fx);
+  std::cout << "[ pendulum ] period " << measured << " s, formula " << period << " s, error "
+            << period_error * 100.0 << " %, amplitude loss " << loss * 100.0 << " %\n";
+}
+
+TEST(SimBallJoint, ThirtyLinkChainHoldsTogether) {
+  // 30 links (1 kg spheres, anchors half a link either side of the centre), the first joined to a
+  // static body, released horizontally: after 10 s of swinging down and hanging, every joint's
+  // anchors are within 5 mm (the joint is a stiff spring: its sag under the whole chain's weight
+  // is a fraction of a millimetre).
+  World w = make_world();
+  const Fixed link = 0.5_fx;
+  const Vec3 top{0_fx, 20_fx, 0_fx};
+  BodyId previous = add(w, anchor_at(top));
+  std::vector<JointId> joints;
+  for (std::int32_t i = 0; i < 30; ++i) {
+    const Fixed x = link * Fixed::from_int(i);
+    const BodyId body = add(w, ball_at(top + Vec3{x + link / 2_fx, 0_fx, 0_fx}));
+    JointDef d;
+    d.body_a = previous;
+    d.body_b = body;
+    d.anchor = top + Vec3{x, 0_fx, 0_fx};
+    joints.push_back(join(w, d));
+    previous = body;
+  }
+  Fixed worst;
+  for (std::int32_t i = 0; i < 600; ++i) {
+    w.step();
+    for (const JointId j : joints)
+      worst = max(worst, anchor_gap(w, j));
+  }
+  EXPECT_TRUE(w.validate().ok()) << w.validate().message();
+  Fixed end;
+  for (const JointId j : joints) {
+    const Fixed gap = anchor_gap(w, j);
+    EXPECT_LT(gap, 0.005_fx) << "joint " << j.value;
+    end = max(end, gap);
+  }
+  std::cout << "[ chain ] largest anchor gap at 10 s " << to_string(end)
+            << " m, largest during the run " << to_string(worst) << " m\n";
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 // Narrowphase driving, warm-start matching, islands and sleep.
 //
 // Islands are not stored: they are recomputed when needed with a union-find over the touching
-// contacts between dynamic bodies, rooted at the lowest body index (so at the lowest ID), which
-// makes them a pure function of the saved state.
+// contacts and the unbroken joints between dynamic bodies, rooted at the lowest body index (so at
+// the lowest ID), which makes them a pure function of the saved state.
 #include <algorithm>
 #include <numeric>
 #include <vector>
@@ -92,7 +92,23 @@ UnionFind islands(const WorldState& s) {
     if (a.type == BodyType::dynamic && b.type == BodyType::dynamic && !a.sensor && !b.sensor)
       uf.join(static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
   }
+  // Joined bodies are one island: they sleep and wake together.
+  for (const JointState& j : s.joints) {
+    if (j.broken) continue;
+    const std::size_t ia = index_of(s, j.def.body_a.value);
+    const std::size_t ib = index_of(s, j.def.body_b.value);
+    if (s.bodies[ia].type == BodyType::dynamic && s.bodies[ib].type == BodyType::dynamic)
+      uf.join(static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
+  }
   return uf;
+}
+
+// `f(ia, ib)` for the body indices of every unbroken joint, in joint order.
+template <class F>
+void each_joint(const WorldState& s, F&& f) {
+  for (const JointState& j : s.joints) {
+    if (!j.broken) f(index_of(s, j.def.body_a.value), index_of(s, j.def.body_b.value));
+  }
 }
 
 }  // namespace
@@ -123,6 +139,13 @@ void wake_touched_islands(WorldState& s) {
     if (moving(s.bodies[ib]) && s.bodies[ia].type == BodyType::dynamic)
       wake[uf.root(static_cast<std::uint32_t>(ia))] = true;
   }
+  // So does one joined to a dynamic body.
+  each_joint(s, [&](std::size_t ia, std::size_t ib) {
+    if (moving(s.bodies[ia]) && s.bodies[ib].type == BodyType::dynamic)
+      wake[uf.root(static_cast<std::uint32_t>(ib))] = true;
+    if (moving(s.bodies[ib]) && s.bodies[ia].type == BodyType::dynamic)
+      wake[uf.root(static_cast<std::uint32_t>(ia))] = true;
+  });
   bool woke_any = false;
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
     BodyState& b = s.bodies[i];
@@ -212,6 +235,12 @@ void update_sleep(WorldState& s) {
     if (s.bodies[ib].type == BodyType::kinematic && moving(s.bodies[ib]))
       keep_awake[uf.root(static_cast<std::uint32_t>(ia))] = true;
   }
+  each_joint(s, [&](std::size_t ia, std::size_t ib) {
+    if (s.bodies[ia].type == BodyType::kinematic && moving(s.bodies[ia]))
+      keep_awake[uf.root(static_cast<std::uint32_t>(ib))] = true;
+    if (s.bodies[ib].type == BodyType::kinematic && moving(s.bodies[ib]))
+      keep_awake[uf.root(static_cast<std::uint32_t>(ia))] = true;
+  });
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
     BodyState& b = s.bodies[i];
     if (b.type != BodyType::dynamic || !b.awake) continue;

@@ -38,6 +38,15 @@ std::string validate_world(const WorldState& s) {
     if (c.touching != (c.point_count > 0)) return pair + "touching disagrees with its points";
     if (c.reported && !c.touching) return pair + "reported without points";
   }
+  for (std::size_t k = 0; k < s.joints.size(); ++k) {
+    const JointState& j = s.joints[k];
+    const std::string joint = "joint " + std::to_string(j.id.value) + ": ";
+    if (j.id.value == 0 || j.id.value >= s.next_joint_id)
+      return joint + "ID outside 1.." + std::to_string(s.next_joint_id - 1);
+    if (k > 0 && s.joints[k - 1].id >= j.id) return joint + "IDs are not ascending";
+    if (s.find(j.def.body_a.value) < 0 || s.find(j.def.body_b.value) < 0)
+      return joint + "names a body that does not exist";
+  }
   // Islands sleep and wake as a whole: no touching pair of dynamic bodies is half asleep.
   if (s.def.enable_sleep) {
     for (const Contact& c : s.contacts) {
@@ -48,6 +57,14 @@ std::string validate_world(const WorldState& s) {
           a.awake != b.awake)
         return "contact (" + std::to_string(c.a) + ", " + std::to_string(c.b) +
                "): one body of a touching pair sleeps, the other is awake (an island is split)";
+    }
+    for (const JointState& j : s.joints) {
+      if (j.broken) continue;
+      const BodyState& a = s.bodies[static_cast<std::size_t>(s.find(j.def.body_a.value))];
+      const BodyState& b = s.bodies[static_cast<std::size_t>(s.find(j.def.body_b.value))];
+      if (a.type == BodyType::dynamic && b.type == BodyType::dynamic && a.awake != b.awake)
+        return "joint " + std::to_string(j.id.value) +
+               ": one body sleeps, the other is awake (an island is split)";
     }
   }
   return {};

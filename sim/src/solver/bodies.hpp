@@ -50,7 +50,8 @@ struct SolverBodies {
   /// so pushing overlapping bodies apart never gives them kinetic energy.
   std::vector<Velocity> push;
   std::vector<Vec3> half_kick;  ///< half of this sub-step's velocity change from gravity and forces
-  /// The body has contact points this step (set by the contact kind's prepare).
+  /// The body has contact points or solved joints this step (set by the contact and joint kinds'
+  /// prepare): it moves by plain semi-implicit Euler.
   std::vector<bool> in_contact;
 };
 

@@ -17,9 +17,10 @@
 // The body stages (SolverBodies, bodies.hpp) run every body in ascending ID order; the constraint
 // stages run every kind in a fixed order (the `kinds` list below), each kind all of its
 // constraints in ascending ID order, through the ConstraintKind interface (constraint_kind.hpp).
-// Contacts are the first kind. Joints are the next entry in the list: a kind of their own with
-// rows from rows.hpp, solved beside contacts in each pass (Box2D v3's stage list prepares joints
-// before contacts; where joints go in this list is part of the results, and fixed once chosen).
+// Contacts are the first kind, joints (joint_solver.cpp) the second: each pass solves every
+// contact, then every joint (Box2D v3's stage list prepares joints before contacts; here they come
+// after, so that a world without joints gives the bits it gave before joints existed; the order
+// is part of the results, and fixed now that it is chosen).
 // Particle couplings and wheel contacts follow the same way. Wide (SIMD) rows do not change this
 // file: a kind's stage function will loop over batches of constraints (4 or 8 side by side, from a
 // deterministic graph colouring, each lane giving the scalar path's bits) instead of one constraint
@@ -31,12 +32,13 @@
 #include "bodies.hpp"
 #include "constraint_kind.hpp"
 #include "contact_solver.hpp"
+#include "joint_solver.hpp"
 
 namespace detsim::sim_detail {
 
 namespace {
 
-using Kinds = std::array<ConstraintKind*, 1>;
+using Kinds = std::array<ConstraintKind*, 2>;
 
 // One stage of every kind, in kind order.
 void each_kind(const Kinds& kinds, void (ConstraintKind::*stage)()) {
@@ -55,7 +57,8 @@ void each_kind(const Kinds& kinds, void (ConstraintKind::*stage)(), std::uint32_
 void solve(WorldState& s) {
   SolverBodies bodies(s);
   ContactSolver contacts(s, bodies);
-  const Kinds kinds{&contacts};  // the kind order: part of the results
+  JointSolver joints(s, bodies);
+  const Kinds kinds{&contacts, &joints};  // the kind order: part of the results
   const std::uint32_t iterations = s.def.iterations;
 
   each_kind(kinds, &ConstraintKind::prepare);

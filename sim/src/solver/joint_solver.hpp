@@ -1,0 +1,74 @@
+// Joints as a constraint kind (joint_solver.cpp), run after contacts in every stage (solve.cpp).
+// Work in progress (docs/JOINTS-WIP.md): ball and distance joints are solved; the other types are
+// skipped. Internal to detsim::sim.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include <detsim/fixed/mat3.hpp>
+
+#include "../world_state.hpp"
+#include "bodies.hpp"
+#include "constraint_kind.hpp"
+#include "rows.hpp"
+
+namespace detsim::sim_detail {
+
+/// One joint's constraint for the step.
+struct JointConstraint {
+  std::size_t joint;  ///< index in WorldState::joints
+  BodyPair bodies;
+  JointType type;
+  Vec3 anchor_a;  ///< the anchor relative to body a's centre, world frame, at the present pose
+  Vec3 anchor_b;
+  /// Ball: the anchors' separation (b's minus a's), world frame, at the present poses.
+  Vec3 separation;
+  /// Ball: the point rows along world x, y and z (directions fixed for the step, rows at the
+  /// present anchors).
+  std::array<Direction, 3> axes;
+  std::array<Row, 3> rows;
+  /// Ball: K^-1, the inverse of the point constraint's 3x3 effective mass matrix
+  /// K_ij = J_i M^-1 J_j^T at the present anchors.
+  Mat3 point_mass;
+  Vec3 impulse;  ///< ball: accumulated along x, y, z
+  // Distance: one row along the anchors' direction, at the present poses.
+  Direction axial;
+  Row axial_row;
+  Fixed length;      ///< the anchors' present distance
+  Fixed min_length;  ///< the range held; equal ends: a rigid rod
+  Fixed max_length;
+  Fixed lower_impulse;  ///< pushing apart (length >= min_length), >= 0
+  Fixed upper_impulse;  ///< pulling together (length <= max_length), >= 0
+  Fixed rigid_impulse;  ///< a rigid rod's, either sign
+};
+
+/// The joints of the step, in ascending joint ID.
+class JointSolver final : public ConstraintKind {
+ public:
+  JointSolver(WorldState& s, SolverBodies& bodies);
+
+  void prepare() override;
+  void warm_start() override;
+  void solve() override;
+  void hold() override;
+  void push_out() override;
+  void positions_moved() override;
+  void relax() override;
+  void restitution() override;
+  void store_impulses() override;
+
+ private:
+  void update_geometry(JointConstraint& k);
+  void solve_joints(bool use_bias);
+  void solve_ball(JointConstraint& k, bool use_bias);
+  void solve_distance(JointConstraint& k, bool use_bias);
+
+  WorldState& s_;
+  SolverBodies& bodies_;
+  Softness soft_;
+  std::vector<JointConstraint> constraints_;
+};
+
+}  // namespace detsim::sim_detail
