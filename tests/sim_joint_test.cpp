@@ -265,5 +265,143 @@ TEST(SimBallJoint, ThirtyLinkChainHoldsTogether) {
             << " m, largest during the run " << to_string(worst) << " m\n";
 }
 
+TEST(SimJoint, JoinedBodiesCollideOnlyWhenCollideConnected) {
+  // Two overlapping spheres (0.5 m apart, radius 0.5): a contact, unless a joint joins them
+  // without collide_connected.
+  for (const bool collide : {false, true}) {
+    WorldDef def;
+    def.gravity = {};
+    World w = make_world(def);
+    const BodyId a = add(w, ball_at({0_fx, 0_fx, 0_fx}, 0.5_fx));
+    const BodyId b = add(w, ball_at({0.5_fx, 0_fx, 0_fx}, 0.5_fx));
+    JointDef d;
+    d.body_a = a;
+    d.body_b = b;
+    d.anchor = {0.25_fx, 0_fx, 0_fx};
+    d.collide_connected = collide;
+    join(w, d);
+    w.step();
+    EXPECT_EQ(w.contacts().size(), collide ? 1U : 0U) << "collide_connected " << collide;
+    // Without a contact, the joint holds them where they are.
+    if (!collide) {
+      EXPECT_EQ(state(w, b).position, (Vec3{0.5_fx, 0_fx, 0_fx}));
+    }
+  }
+}
+
+TEST(SimJoint, JoinedBodiesSleepAndWakeAsOneIsland) {
+  // Two spheres hanging in a line from a static body, at rest: they fall asleep together (the
+  // invariants hold after every step), and waking the lower one wakes the upper one at the next
+  // step, though they never touch.
+  World w = make_world();
+  const BodyId top = add(w, anchor_at({0_fx, 10_fx, 0_fx}));
+  const BodyId upper = add(w, ball_at({0_fx, 9_fx, 0_fx}));
+  const BodyId lower = add(w, ball_at({0_fx, 8_fx, 0_fx}));
+  JointDef d;
+  d.body_a = top;
+  d.body_b = upper;
+  d.anchor = {0_fx, 10_fx, 0_fx};
+  join(w, d);
+  d.body_a = upper;
+  d.body_b = lower;
+  d.anchor = {0_fx, 8.5_fx, 0_fx};
+  join(w, d);
+  std::int32_t steps = 0;
+  while (state(w, upper).awake && steps < 600) {
+    w.step();
+    ++steps;
+    ASSERT_TRUE(w.validate().ok()) << w.validate().message();
+  }
+  EXPECT_FALSE(state(w, upper).awake);
+  EXPECT_FALSE(state(w, lower).awake);
+  EXPECT_TRUE(w.apply_linear_impulse(lower, {1_fx, 0_fx, 0_fx}).ok());
+  EXPECT_FALSE(state(w, upper).awake);
+  w.step();
+  EXPECT_TRUE(state(w, upper).awake);
+  EXPECT_TRUE(w.validate().ok()) << w.validate().message();
+}
+
+// ---- Distance joints ----
+
+TEST(SimDistanceJoint, RigidRodSwingsWithTheSimplePendulumPeriod) {
+  // A distance joint holds the sphere's centre L = 2 m from the pivot and leaves its rotation
+  // free: a simple pendulum, period 2 pi sqrt(L / g) (1 + theta0^2 / 16) at 10 degrees.
+  World w = make_world();
+  const Vec3 pivot{0_fx, 10_fx, 0_fx};
+  const Fixed length = 2_fx;
+  const Fixed theta0 = Fixed::pi() / 18_fx;
+  const BodyId top = add(w, anchor_at(pivot));
+  const BodyId bob =
+      add(w, ball_at(pivot + Vec3{length * sin(theta0), -length * cos(theta0), 0_fx}));
+  JointDef d;
+  d.type = JointType::distance;
+  d.body_a = top;
+  d.body_b = bob;
+  d.anchor = pivot;
+  const JointId joint = join(w, d);
+  EXPECT_TRUE(near(w.joint(joint)->length, length, 0.000001_fx));
+
+  const double g = -w.def().gravity.y.to_double();
+  const double L = length.to_double();
+  const double t0 = theta0.to_double();
+  const double period = 2.0 * M_PI * std::sqrt(L / g) * (1.0 + t0 * t0 / 16.0);
+  const double dt = w.def().dt.to_double();
+  const auto angle = [&] {
+    const Vec3 p = state(w, bob).position - pivot;
+    return std::atan2(p.x.to_double(), -p.y.to_double());
+  };
+  std::vector<double> crossings;
+  double previous = angle();
+  double first_peak = 0.0;
+  double last_peak = 0.0;
+  const std::int32_t steps = static_cast<std::int32_t>(11.5 * period / dt);
+  for (std::int32_t i = 1; i <= steps; ++i) {
+    w.step();
+    const double theta = angle();
+    if (previous < 0.0 && theta >= 0.0)
+      crossings.push_back(dt * (i - 1 + previous / (previous - theta)));
+    if (crossings.empty()) first_peak = std::max(first_peak, std::abs(theta));
+    if (crossings.size() >= 10) last_peak = std::max(last_peak, std::abs(theta));
+    previous = theta;
+  }
+  ASSERT_GE(crossings.size(), 11U);
+  const double measured = (crossings[10] - crossings[0]) / 10.0;
+  const double period_error = std::abs(measured - period) / period;
+  const double loss = 1.0 - last_peak / first_peak;
+  EXPECT_LT(period_error, 0.01) << "measured " << measured << " s, expected " << period << " s";
+  EXPECT_LT(loss, 0.02) << "first peak " << first_peak << ", after ten swings " << last_peak;
+  EXPECT_TRUE(near(distance(state(w, bob).position, pivot), length, 0.005_fx));
+  std::cout << "[ rod ] period " << measured << " s, formula " << period << " s, error "
+            << period_error * 100.0 << " %, amplitude loss " << loss * 100.0 << " %\n";
+}
+
+TEST(SimDistanceJoint, RopeIsSlackBelowItsLengthAndHoldsAtIt) {
+  // A rope of 2 m (min_length 0, max_length 2) to a sphere released at rest 1 m below the pivot:
+  // slack, so the sphere falls freely, y(t) = y0 - g t^2 / 2, until it has fallen 1 m
+  // (t = sqrt(2 / g) = 0.45 s); then the rope holds it 2 m below the pivot.
+  World w = make_world();
+  const Vec3 pivot{0_fx, 10_fx, 0_fx};
+  const BodyId top = add(w, anchor_at(pivot));
+  const BodyId bob = add(w, ball_at(pivot - Vec3{0_fx, 1_fx, 0_fx}));
+  JointDef d;
+  d.type = JointType::distance;
+  d.body_a = top;
+  d.body_b = bob;
+  d.anchor = pivot;
+  d.min_length = 0_fx;
+  d.max_length = 2_fx;
+  join(w, d);
+  const Fixed g = -w.def().gravity.y;
+  for (std::int32_t i = 1; i <= 24; ++i) {  // 0.4 s: still falling freely
+    w.step();
+    const Fixed t = w.def().dt * Fixed::from_int(i);
+    EXPECT_TRUE(near(state(w, bob).position.y, 9_fx - g * t * t / 2_fx, 0.0001_fx)) << i;
+  }
+  for (std::int32_t i = 0; i < 300; ++i)
+    w.step();
+  EXPECT_TRUE(near(state(w, bob).position.y, 8_fx, 0.005_fx));
+  EXPECT_TRUE(w.validate().ok()) << w.validate().message();
+}
+
 }  // namespace
 }  // namespace detsim

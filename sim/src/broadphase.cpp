@@ -229,6 +229,15 @@ void update_contacts(WorldState& s) {
     }
   }
   std::sort(pairs.begin(), pairs.end());
+  // Bodies joined without collide_connected never collide (nor use up each other's budget).
+  if (!s.joints.empty()) {
+    const std::vector<std::uint64_t> joined = joined_pairs(s);
+    if (!joined.empty()) {
+      std::erase_if(pairs, [&](std::uint64_t pair) {
+        return std::binary_search(joined.begin(), joined.end(), pair);
+      });
+    }
+  }
   keep_within_budget(s, pairs);
   merge_contacts(s, pairs);
 }

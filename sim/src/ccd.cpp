@@ -20,6 +20,8 @@
 // target gap, or gives up after a fixed number of iterations (a fixed bound: the same work and
 // result on every machine) and keeps the last safe time.
 #include <algorithm>
+#include <cstdint>
+#include <vector>
 
 #include <detsim/fixed/math.hpp>
 #include <detsim/fixed/quat.hpp>
@@ -85,7 +87,8 @@ bool box_overlap(Vec3 amin, Vec3 amax, Vec3 bmin, Vec3 bmax) {
 }  // namespace
 
 void continuous(WorldState& s) {
-  const Fixed target = s.def.linear_slop;  // stop this close to the surface
+  const Fixed target = s.def.linear_slop;                     // stop this close to the surface
+  const std::vector<std::uint64_t> joined = joined_pairs(s);  // these never collide
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
     BodyState& body = s.bodies[i];
     if (body.type != BodyType::dynamic || !body.awake || body.sensor) continue;
@@ -121,6 +124,7 @@ void continuous(WorldState& s) {
       const BodyState& other = s.bodies[j];
       if (other.sensor) continue;
       if ((body.layer & other.mask) == 0 || (other.layer & body.mask) == 0) continue;
+      if (is_joined_pair(joined, i, j)) continue;
       // The other body moves too, from its pose at the start of the step to its pose now: the
       // sweep is of the pair, both at the same time t, so a body that moves along with this one
       // is never hit, and one that this body passed during the step always is.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <detsim/fixed/math.hpp>
 
@@ -34,6 +35,26 @@ void wake_body(WorldState& s, BodyId id) {
 }
 
 }  // namespace
+
+std::vector<std::uint64_t> joined_pairs(const WorldState& s) {
+  std::vector<std::uint64_t> pairs;
+  for (const JointState& j : s.joints) {
+    if (j.broken || j.def.collide_connected) continue;
+    const auto ia = static_cast<std::uint64_t>(s.find(j.def.body_a.value));
+    const auto ib = static_cast<std::uint64_t>(s.find(j.def.body_b.value));
+    pairs.push_back((std::min(ia, ib) << 32) | std::max(ia, ib));
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+bool is_joined_pair(const std::vector<std::uint64_t>& pairs, std::size_t i,
+                    std::size_t j) noexcept {
+  if (pairs.empty()) return false;
+  const std::uint64_t lo = std::min(i, j);
+  const std::uint64_t hi = std::max(i, j);
+  return std::binary_search(pairs.begin(), pairs.end(), (lo << 32) | hi);
+}
 
 void destroy_joints_of(WorldState& s, BodyId id) {
   for (const JointState& j : s.joints) {

@@ -138,6 +138,13 @@ void check_after_step(const WorldState& s);
 /// prepare_bodies for body i alone (derived already sized): when a body wakes in mid-step.
 void prepare_body(WorldState& s, std::size_t i);
 
+/// The pairs of bodies that a joint keeps from colliding (unbroken, collide_connected false), as
+/// (lower index << 32 | higher index) into `bodies`, ascending (joints.cpp). Empty without joints.
+[[nodiscard]] std::vector<std::uint64_t> joined_pairs(const WorldState& s);
+/// Whether (i, j), in either order, is in a list from joined_pairs.
+[[nodiscard]] bool is_joined_pair(const std::vector<std::uint64_t>& pairs, std::size_t i,
+                                  std::size_t j) noexcept;
+
 /// Removes the joints of body `id`, waking the other body of each (joints.cpp).
 void destroy_joints_of(WorldState& s, BodyId id);
 

@@ -116,11 +116,17 @@ void JointSolver::prepare() {
     k.rigid_impulse = j.axial_impulse;
     if (k.min_length < k.max_length) k.rigid_impulse = Fixed::zero();
     update_geometry(k);
-    // Jointed bodies move by plain semi-implicit Euler, like bodies in contact (bodies.hpp): the
-    // trapezoidal step of free flight would sink a hanging body by half a gravity kick per
-    // sub-step, for the spring to hold up again.
-    bodies_.in_contact[ia] = true;
-    bodies_.in_contact[ib] = true;
+    // Bodies held by a joint move by plain semi-implicit Euler, like bodies in contact
+    // (bodies.hpp): the trapezoidal step of free flight would sink a hanging body by half a
+    // gravity kick per sub-step, for the spring to hold up again. A slack rope (no end of its
+    // range reached at the step's start) holds nothing: its bodies fly freely.
+    const bool slack = k.type == JointType::distance && k.min_length < k.max_length &&
+                       k.length > k.min_length + s_.def.linear_slop &&
+                       k.length < k.max_length - s_.def.linear_slop;
+    if (!slack) {
+      bodies_.in_contact[ia] = true;
+      bodies_.in_contact[ib] = true;
+    }
   }
 }
 
