@@ -403,5 +403,91 @@ TEST(SimDistanceJoint, RopeIsSlackBelowItsLengthAndHoldsAtIt) {
   EXPECT_TRUE(w.validate().ok()) << w.validate().message();
 }
 
+// ---- Hinge joints ----
+
+TEST(SimHingeJoint, PendulumAboutItsAxisSwingsWithThePendulumFormula) {
+  // The ball joint's pendulum on a hinge about z, the axis it swings about: the hinge leaves that
+  // rotation free, so the period is the same physical pendulum's, 2 pi sqrt(I / (m g L))
+  // (1 + theta0^2 / 16) with I = m L^2 + 2/5 m r^2.
+  World w = make_world();
+  const Vec3 pivot{0_fx, 10_fx, 0_fx};
+  const Fixed length = 2_fx;
+  const Fixed radius = 0.1_fx;
+  const Fixed theta0 = Fixed::pi() / 18_fx;
+  const BodyId top = add(w, anchor_at(pivot));
+  const BodyId bob =
+      add(w, ball_at(pivot + Vec3{length * sin(theta0), -length * cos(theta0), 0_fx}, radius));
+  JointDef d;
+  d.type = JointType::hinge;
+  d.body_a = top;
+  d.body_b = bob;
+  d.anchor = pivot;
+  d.axis = {0_fx, 0_fx, 1_fx};
+  const JointId joint = join(w, d);
+  const double g = -w.def().gravity.y.to_double();
+  const double L = length.to_double();
+  const double r = radius.to_double();
+  const double t0 = theta0.to_double();
+  const double period =
+      2.0 * M_PI * std::sqrt((L * L + 0.4 * r * r) / (g * L)) * (1.0 + t0 * t0 / 16.0);
+  const double dt = w.def().dt.to_double();
+  const auto angle = [&] {
+    const Vec3 p = state(w, bob).position - pivot;
+    return std::atan2(p.x.to_double(), -p.y.to_double());
+  };
+  std::vector<double> crossings;
+  double previous = angle();
+  const std::int32_t steps = static_cast<std::int32_t>(10.5 * period / dt);
+  for (std::int32_t i = 1; i <= steps; ++i) {
+    w.step();
+    const double theta = angle();
+    if (previous < 0.0 && theta >= 0.0)
+      crossings.push_back(dt * (i - 1 + previous / (previous - theta)));
+    previous = theta;
+  }
+  ASSERT_GE(crossings.size(), 10U);
+  const double measured = (crossings[9] - crossings[0]) / 9.0;
+  EXPECT_LT(std::abs(measured - period) / period, 0.01)
+      << "measured " << measured << " s, expected " << period << " s";
+  EXPECT_LT(anchor_gap(w, joint), 0.005_fx);
+  // It stays in the plane across the axis.
+  EXPECT_LT(abs(state(w, bob).position.z), 0.001_fx);
+}
+
+TEST(SimHingeJoint, DoorHoldsItsAxisAndTurnsFreelyAboutIt) {
+  // A 10 kg door (1 m x 2 m x 0.1 m) on a vertical hinge along its edge, spun at 1 rad/s about
+  // the hinge: gravity pulls the door's far edge down (a torque of m g 0.5 m across the axis),
+  // which the hinge holds, and nothing acts about the axis, so the door keeps turning at 1 rad/s
+  // (angular momentum about a fixed axis) with its axis vertical.
+  World w = make_world();
+  const BodyId post = add(w, anchor_at({0_fx, 1_fx, 0_fx}));
+  BodyDef door;
+  door.shape = Shape::box({0.5_fx, 1_fx, 0.05_fx});
+  door.position = {0.6_fx, 1_fx, 0_fx};
+  door.mass = 10_fx;
+  const BodyId body = add(w, door);
+  JointDef d;
+  d.type = JointType::hinge;
+  d.body_a = post;
+  d.body_b = body;
+  d.anchor = {0.1_fx, 1_fx, 0_fx};
+  d.axis = {0_fx, 1_fx, 0_fx};
+  const JointId joint = join(w, d);
+  // The door's velocities for 1 rad/s about the hinge line: w = (0, 1, 0), v = w x (c - anchor).
+  EXPECT_TRUE(w.set_angular_velocity(body, {0_fx, 1_fx, 0_fx}).ok());
+  EXPECT_TRUE(
+      w.set_linear_velocity(body, cross(Vec3{0_fx, 1_fx, 0_fx}, Vec3{0.5_fx, 0_fx, 0_fx})).ok());
+  for (std::int32_t i = 0; i < 180; ++i) {
+    w.step();
+    const BodyState b = state(w, body);
+    const Vec3 up = rotate(b.orientation, Vec3{0_fx, 1_fx, 0_fx});
+    // Within 1 degree of vertical: cos(1 deg) = 0.99985.
+    ASSERT_GT(up.y, 0.99985_fx) << "step " << i;
+  }
+  EXPECT_LT(anchor_gap(w, joint), 0.005_fx);
+  EXPECT_TRUE(near(state(w, body).angular_velocity.y, 1_fx, 0.02_fx));
+  EXPECT_TRUE(near(state(w, body).position.y, 1_fx, 0.005_fx));
+}
+
 }  // namespace
 }  // namespace detsim

@@ -1,6 +1,6 @@
 // Joints, the second constraint kind (after contacts, solve.cpp): soft point constraints of the
 // sub-stepped solver, as Box2D v3 solves its joints, in 3D. Work in progress
-// (docs/JOINTS-WIP.md): ball and distance joints; the other types are not solved yet.
+// (docs/JOINTS-WIP.md): ball, hinge and distance joints; the other types are not solved yet.
 //
 // Unlike a contact, whose anchors stay fixed for the step, a joint's anchors turn with its bodies:
 // after every sub-step's position update (positions_moved) the anchors are rotated from each
@@ -17,6 +17,11 @@
 // impulses. In solve, the block is a soft constraint (a damped spring of joint_hertz and
 // joint_damping_ratio on the anchors' separation, Box2D v3's joint softness); in relax, a rigid
 // one without bias, which removes the velocity the spring added.
+//
+// A hinge joint is a ball joint plus two angular rows about the directions across its axis (as
+// body a carries it), solved as one 2x2 block before the point block (Jolt's hinge: rotation,
+// then point), soft in the same way. Their error is the small angle between the axis as each
+// body carries it, (axis_a x axis_b) across each direction. Rotation about the axis is free.
 //
 // A distance joint is one row along the anchors' direction. With min_length == max_length it is a
 // rigid rod (soft as above, either sign); otherwise each end of the range is a one-sided row: the
@@ -74,8 +79,31 @@ void apply_impulses(std::vector<Velocity>& v, const BodyPair& k, const std::arra
 }
 
 bool solved_type(JointType t) {
-  return t == JointType::ball || t == JointType::distance;
+  return t == JointType::ball || t == JointType::hinge || t == JointType::distance;
 }
+
+// A unit vector perpendicular to the unit vector n, chosen by n's components only (the contact
+// kind's, contact_solver.cpp).
+Vec3 perpendicular(Vec3 n) {
+  const Fixed threshold = Fixed::from_raw(2479700525);  // 0.57735 ~ 1/sqrt(3)
+  if (abs(n.x) >= threshold) return normalize(Vec3{n.y, -n.x, Fixed::zero()});
+  return normalize(Vec3{Fixed::zero(), n.z, -n.y});
+}
+
+// The row of a relative rotation about the unit vector u: J = (0, -u, 0, u), with its effective
+// mass 1 / (u . I_a^-1 u + u . I_b^-1 u). Its linear parts are a zero Direction.
+Row angular_row(const Derived& a, const Derived& b, Vec3 u) {
+  Row r;
+  r.angular_a = -u;
+  r.angular_b = u;
+  r.response_a = a.inverse_inertia_world * r.angular_a;
+  r.response_b = b.inverse_inertia_world * r.angular_b;
+  r.mass = inverse_or_zero(
+      DotSum{}.add(r.response_a, r.angular_a).add(r.response_b, r.angular_b).result());
+  return r;
+}
+
+const Direction no_direction{};
 
 }  // namespace
 
@@ -116,6 +144,12 @@ void JointSolver::prepare() {
     k.rigid_impulse = j.axial_impulse;
     if (k.min_length < k.max_length) k.rigid_impulse = Fixed::zero();
     update_geometry(k);
+    // The hinge's angular impulse is kept as a world vector: its rows' directions turn with body
+    // a, and last step's impulse is projected onto this step's.
+    if (k.type == JointType::hinge) {
+      k.angular_impulse_1 = dot(j.angular_impulse, k.across[0]);
+      k.angular_impulse_2 = dot(j.angular_impulse, k.across[1]);
+    }
     // Bodies held by a joint move by plain semi-implicit Euler, like bodies in contact
     // (bodies.hpp): the trapezoidal step of free flight would sink a hanging body by half a
     // gravity kick per sub-step, for the spring to hold up again. A slack rope (no end of its
@@ -140,7 +174,33 @@ void JointSolver::update_geometry(JointConstraint& k) {
   k.anchor_a = rotate(a.orientation, j.local_anchor_a);
   k.anchor_b = rotate(b.orientation, j.local_anchor_b);
   const Vec3 separation = (b.position + k.anchor_b) - (a.position + k.anchor_a);
-  if (k.type == JointType::ball) {
+  if (k.type == JointType::hinge) {
+    k.axis_a = rotate(a.orientation, j.local_axis_a);
+    k.axis_b = rotate(b.orientation, j.local_axis_b);
+    k.across[0] = perpendicular(k.axis_a);
+    k.across[1] = cross(k.axis_a, k.across[0]);
+    Fixed entries[2][2];
+    for (std::size_t i = 0; i < 2; ++i)
+      k.angular_rows[i] = angular_row(da, db, k.across[i]);
+    for (std::size_t i = 0; i < 2; ++i) {
+      for (std::size_t c = 0; c < 2; ++c) {
+        const Row& ri = k.angular_rows[i];
+        const Row& rc = k.angular_rows[c];
+        entries[i][c] =
+            DotSum{}.add(ri.angular_a, rc.response_a).add(ri.angular_b, rc.response_b).result();
+      }
+    }
+    // The 2x2 block inverted as the upper left of a 3x3 with a unit third row and column: each
+    // entry the exact cofactor over the exact determinant (try_inverse), however small K is.
+    const Mat3 K{{Vec3{entries[0][0], entries[0][1], Fixed::zero()},
+                  Vec3{entries[1][0], entries[1][1], Fixed::zero()},
+                  Vec3{Fixed::zero(), Fixed::zero(), Fixed::one()}}};
+    k.angular_mass = inverse(K);
+    const Vec3 misalignment = cross(k.axis_a, k.axis_b);
+    k.angular_error_1 = dot(misalignment, k.across[0]);
+    k.angular_error_2 = dot(misalignment, k.across[1]);
+  }
+  if (k.type == JointType::ball || k.type == JointType::hinge) {
     k.separation = separation;
     for (std::size_t i = 0; i < 3; ++i)
       k.rows[i] = make_row(da, db, k.anchor_a, k.anchor_b, axis(i));
@@ -171,7 +231,11 @@ void JointSolver::update_geometry(JointConstraint& k) {
 
 void JointSolver::warm_start() {
   for (JointConstraint& k : constraints_) {
-    if (k.type == JointType::ball) {
+    if (k.type == JointType::hinge) {
+      apply_impulses(bodies_.velocities, k.bodies, no_direction, k.angular_rows[0],
+                     k.angular_impulse_1, no_direction, k.angular_rows[1], k.angular_impulse_2);
+    }
+    if (k.type == JointType::ball || k.type == JointType::hinge) {
       apply_impulses(bodies_.velocities, k.bodies, k.axes, k.rows, k.impulse);
       continue;
     }
@@ -190,6 +254,23 @@ inline void JointSolver::solve_ball(JointConstraint& k, bool use_bias) {
                : -(k.point_mass * cdot);
   k.impulse += impulse;
   apply_impulses(bodies_.velocities, k.bodies, k.axes, k.rows, impulse);
+}
+
+// The hinge's two angular rows as one block: -K^-1 (J w + bias), soft like the point rows.
+inline void JointSolver::solve_hinge_axes(JointConstraint& k, bool use_bias) {
+  const Vec3 cdot{row_speed(bodies_.velocities, k.bodies, no_direction, k.angular_rows[0]),
+                  row_speed(bodies_.velocities, k.bodies, no_direction, k.angular_rows[1]),
+                  Fixed::zero()};
+  const Vec3 accumulated{k.angular_impulse_1, k.angular_impulse_2, Fixed::zero()};
+  const Vec3 error{k.angular_error_1, k.angular_error_2, Fixed::zero()};
+  const Vec3 impulse =
+      use_bias ? -(k.angular_mass * (cdot + error * soft_.bias_rate)) * soft_.mass_scale -
+                     accumulated * soft_.impulse_scale
+               : -(k.angular_mass * cdot);
+  k.angular_impulse_1 += impulse.x;
+  k.angular_impulse_2 += impulse.y;
+  apply_impulses(bodies_.velocities, k.bodies, no_direction, k.angular_rows[0], impulse.x,
+                 no_direction, k.angular_rows[1], impulse.y);
 }
 
 inline void JointSolver::solve_distance(JointConstraint& k, bool use_bias) {
@@ -230,7 +311,10 @@ inline void JointSolver::solve_distance(JointConstraint& k, bool use_bias) {
 
 void JointSolver::solve_joints(bool use_bias) {
   for (JointConstraint& k : constraints_) {
-    if (k.type == JointType::ball) {
+    if (k.type == JointType::hinge) {
+      solve_hinge_axes(k, use_bias);
+      solve_ball(k, use_bias);
+    } else if (k.type == JointType::ball) {
       solve_ball(k, use_bias);
     } else {
       solve_distance(k, use_bias);
@@ -266,6 +350,8 @@ void JointSolver::store_impulses() {
   for (const JointConstraint& k : constraints_) {
     JointState& j = s_.joints[k.joint];
     j.linear_impulse = k.impulse;
+    if (k.type == JointType::hinge)
+      j.angular_impulse = k.across[0] * k.angular_impulse_1 + k.across[1] * k.angular_impulse_2;
     j.axial_impulse = k.rigid_impulse + k.lower_impulse - k.upper_impulse;
   }
 }

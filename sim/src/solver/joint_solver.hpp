@@ -1,6 +1,6 @@
 // Joints as a constraint kind (joint_solver.cpp), run after contacts in every stage (solve.cpp).
-// Work in progress (docs/JOINTS-WIP.md): ball and distance joints are solved; the other types are
-// skipped. Internal to detsim::sim.
+// Work in progress (docs/JOINTS-WIP.md): ball, hinge and distance joints are solved (no limits,
+// motors, springs or breaking yet); the other types are skipped. Internal to detsim::sim.
 #pragma once
 
 #include <array>
@@ -32,7 +32,18 @@ struct JointConstraint {
   /// Ball: K^-1, the inverse of the point constraint's 3x3 effective mass matrix
   /// K_ij = J_i M^-1 J_j^T at the present anchors.
   Mat3 point_mass;
-  Vec3 impulse;  ///< ball: accumulated along x, y, z
+  Vec3 impulse;  ///< ball, hinge: accumulated along x, y, z
+  // Hinge: two angular rows about the directions perpendicular to body a's axis, at the present
+  // poses, solved as one 2x2 block.
+  Vec3 axis_a;                 ///< the hinge axis as body a carries it, world frame
+  Vec3 axis_b;                 ///< as body b carries it
+  std::array<Vec3, 2> across;  ///< unit, perpendicular to axis_a and to each other
+  std::array<Row, 2> angular_rows;
+  Mat3 angular_mass;      ///< the 2x2 block's inverse (upper left; the rest is the identity)
+  Fixed angular_error_1;  ///< (axis_a x axis_b) . across: the small angle between the axes
+  Fixed angular_error_2;
+  Fixed angular_impulse_1;
+  Fixed angular_impulse_2;
   // Distance: one row along the anchors' direction, at the present poses.
   Direction axial;
   Row axial_row;
@@ -63,6 +74,7 @@ class JointSolver final : public ConstraintKind {
   void update_geometry(JointConstraint& k);
   void solve_joints(bool use_bias);
   void solve_ball(JointConstraint& k, bool use_bias);
+  void solve_hinge_axes(JointConstraint& k, bool use_bias);
   void solve_distance(JointConstraint& k, bool use_bias);
 
   WorldState& s_;
