@@ -489,5 +489,37 @@ TEST(SimHingeJoint, DoorHoldsItsAxisAndTurnsFreelyAboutIt) {
   EXPECT_TRUE(near(state(w, body).position.y, 1_fx, 0.005_fx));
 }
 
+TEST(SimJoint, BreaksBeyondItsBreakForce) {
+  // A 1 kg sphere hanging on a ball joint with break_force 20 N: its weight (9.81 N) does not
+  // break it; pulled down by 15 N more (24.81 N in all) it breaks, and the sphere then falls
+  // freely (over 1 s, at least g / 2 * 1 s^2 = 4.9 m, more with the extra force).
+  World w = make_world();
+  const Vec3 pivot{0_fx, 10_fx, 0_fx};
+  const BodyId top = add(w, anchor_at(pivot));
+  const BodyId bob = add(w, ball_at({0_fx, 8_fx, 0_fx}));
+  JointDef d;
+  d.body_a = top;
+  d.body_b = bob;
+  d.anchor = pivot;
+  d.break_force = 20_fx;
+  const JointId joint = join(w, d);
+  for (std::int32_t i = 0; i < 60; ++i)
+    w.step();
+  EXPECT_FALSE(w.joint(joint)->broken);
+  EXPECT_TRUE(near(state(w, bob).position.y, 8_fx, 0.005_fx));
+  std::int32_t steps = 0;
+  while (!w.joint(joint)->broken && steps < 30) {
+    EXPECT_TRUE(w.apply_force(bob, {0_fx, -15_fx, 0_fx}).ok());
+    w.step();
+    ++steps;
+  }
+  EXPECT_TRUE(w.joint(joint)->broken);
+  EXPECT_LT(steps, 10);  // the spring takes up the extra load within a few steps
+  for (std::int32_t i = 0; i < 60; ++i)
+    w.step();
+  EXPECT_LT(state(w, bob).position.y, 8_fx - 4.9_fx);
+  EXPECT_TRUE(w.validate().ok()) << w.validate().message();
+}
+
 }  // namespace
 }  // namespace detsim

@@ -346,9 +346,24 @@ void JointSolver::relax() {
 // Joints do not bounce.
 void JointSolver::restitution() {}
 
+// Breaking: the accumulated impulses act once per sub-step (warm start, then each pass's
+// correction), so the force a joint carries is its impulse times the sub-step rate (Box2D v3's
+// constraint force). Beyond break_force (or break_torque, on the angular rows), the joint breaks
+// at the end of the step: it stays in the list with `broken` set, and is no longer solved, nor
+// joins its bodies' islands, nor keeps them from colliding.
 void JointSolver::store_impulses() {
   for (const JointConstraint& k : constraints_) {
     JointState& j = s_.joints[k.joint];
+    const Fixed force = k.type == JointType::distance
+                            ? abs(k.rigid_impulse + k.lower_impulse - k.upper_impulse)
+                            : length(k.impulse);
+    const Fixed torque = k.type == JointType::hinge
+                             ? hypot(k.angular_impulse_1, k.angular_impulse_2)
+                             : Fixed::zero();
+    if (j.def.break_force > Fixed::zero() && force * bodies_.inv_h > j.def.break_force)
+      j.broken = true;
+    if (j.def.break_torque > Fixed::zero() && torque * bodies_.inv_h > j.def.break_torque)
+      j.broken = true;
     j.linear_impulse = k.impulse;
     if (k.type == JointType::hinge)
       j.angular_impulse = k.across[0] * k.angular_impulse_1 + k.across[1] * k.angular_impulse_2;

@@ -76,11 +76,14 @@ struct JointState {
   Vec3 local_axis_a{};    ///< the axis in body_a's frame
   Vec3 local_axis_b{};    ///< in body_b's frame
   Fixed length{};         ///< distance joint: the anchors' distance at creation, m
-  /// Accumulated impulses of the last step (warm start), N s: the point rows' (world x, y, z).
+  /// Accumulated impulses of the last step (warm start), N s per sub-step (the force they carry
+  /// is impulse * substeps / dt): the point rows' (world x, y, z).
   Vec3 linear_impulse{};
-  Vec3 angular_impulse{};  ///< the angular rows' (hinge, fixed, ...), N m s
+  Vec3 angular_impulse{};  ///< the angular rows' (hinge, ...) as a world vector, N m s
   Fixed axial_impulse{};   ///< the distance row's (or a limit's along the axis), N s
-  bool broken = false;     ///< broke under break_force or break_torque; no longer solved
+  /// Broke under break_force or break_torque (at the end of a step): no longer solved, joins no
+  /// island, does not keep its bodies from colliding.
+  bool broken = false;
 
   friend constexpr bool operator==(const JointState&, const JointState&) noexcept = default;
 };
