@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -519,6 +520,70 @@ TEST(SimJoint, BreaksBeyondItsBreakForce) {
     w.step();
   EXPECT_LT(state(w, bob).position.y, 8_fx - 4.9_fx);
   EXPECT_TRUE(w.validate().ok()) << w.validate().message();
+}
+
+// ---- Fixed joints ----
+
+TEST(SimFixedJoint, CantileverHoldsItsPoseUnderGravity) {
+  // A 10 kg beam (2 m x 0.2 m x 0.2 m) welded at its end to a static body, horizontal: the weld
+  // carries its weight and the torque m g 1 m, so the beam stays where it was made (within the
+  // joint spring's give: its anchors within 5 mm, its axis within 1 degree of horizontal).
+  World w = make_world();
+  const BodyId wall = add(w, anchor_at({0_fx, 5_fx, 0_fx}));
+  BodyDef beam;
+  beam.shape = Shape::box({1_fx, 0.1_fx, 0.1_fx});
+  beam.position = {1.2_fx, 5_fx, 0_fx};
+  beam.mass = 10_fx;
+  const BodyId body = add(w, beam);
+  JointDef d;
+  d.type = JointType::fixed;
+  d.body_a = wall;
+  d.body_b = body;
+  d.anchor = {0.2_fx, 5_fx, 0_fx};
+  const JointId joint = join(w, d);
+  for (std::int32_t i = 0; i < 120; ++i) {
+    w.step();
+    const Vec3 along = rotate(state(w, body).orientation, Vec3{1_fx, 0_fx, 0_fx});
+    ASSERT_GT(along.x, 0.99985_fx) << "step " << i;  // cos(1 degree)
+  }
+  EXPECT_LT(anchor_gap(w, joint), 0.005_fx);
+  EXPECT_TRUE(w.validate().ok()) << w.validate().message();
+}
+
+TEST(SimFixedJoint, WeldedPairTumblesAsOneBody) {
+  // Two spheres welded side by side, thrown spinning in zero gravity: they keep their relative
+  // pose (the second stays 1 m from the first along the first's x axis, within 5 mm).
+  WorldDef def;
+  def.gravity = {};
+  World w = make_world(def);
+  const BodyId a = add(w, ball_at({0_fx, 0_fx, 0_fx}, 0.3_fx));
+  const BodyId b = add(w, ball_at({1_fx, 0_fx, 0_fx}, 0.3_fx));
+  JointDef d;
+  d.type = JointType::fixed;
+  d.body_a = a;
+  d.body_b = b;
+  d.anchor = {0.5_fx, 0_fx, 0_fx};
+  join(w, d);
+  // Spinning about z through the pair's centre at 2 rad/s: v = w x r for each.
+  const Vec3 spin{0_fx, 0_fx, 2_fx};
+  for (const auto& [id, r] :
+       {std::pair{a, Vec3{-0.5_fx, 0_fx, 0_fx}}, std::pair{b, Vec3{0.5_fx, 0_fx, 0_fx}}}) {
+    EXPECT_TRUE(w.set_angular_velocity(id, spin).ok());
+    EXPECT_TRUE(w.set_linear_velocity(id, cross(spin, r) + Vec3{1_fx, 0_fx, 0_fx}).ok());
+  }
+  for (std::int32_t i = 0; i < 120; ++i)
+    w.step();
+  const BodyState sa = state(w, a);
+  const BodyState sb = state(w, b);
+  const Vec3 expected = sa.position + rotate(sa.orientation, Vec3{1_fx, 0_fx, 0_fx});
+  EXPECT_LT(length(sb.position - expected), 0.005_fx);
+  // The orientations agree, and the pair has turned as one rigid body: 2 rad/s for 2 s, 4 rad
+  // about z.
+  const Quat relative = conjugate(sa.orientation) * sb.orientation;
+  EXPECT_GT(abs(relative.w), 0.9999_fx);
+  const Vec3 along = rotate(sa.orientation, Vec3{1_fx, 0_fx, 0_fx});
+  EXPECT_TRUE(near(along.x, cos(4_fx), 0.02_fx));
+  EXPECT_TRUE(near(along.y, sin(4_fx), 0.02_fx));
 }
 
 }  // namespace

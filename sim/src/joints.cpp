@@ -99,6 +99,7 @@ Expected<JointId> World::create_joint(const JointDef& def) {
   } else {
     j.local_anchor_b = to_local(b, def.anchor - b.position);
   }
+  j.relative_orientation = normalize(conjugate(a.orientation) * b.orientation);
   j.local_axis_a = to_local(a, j.def.axis);
   j.local_axis_b = to_local(b, j.def.axis);
   s_->joints.push_back(j);  // IDs only grow: appending keeps the order

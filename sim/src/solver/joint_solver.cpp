@@ -1,6 +1,7 @@
 // Joints, the second constraint kind (after contacts, solve.cpp): soft point constraints of the
 // sub-stepped solver, as Box2D v3 solves its joints, in 3D. Work in progress
-// (docs/JOINTS-WIP.md): ball, hinge and distance joints; the other types are not solved yet.
+// (docs/JOINTS-WIP.md): ball, hinge, fixed and distance joints; slider and swing_twist are not
+// solved yet.
 //
 // Unlike a contact, whose anchors stay fixed for the step, a joint's anchors turn with its bodies:
 // after every sub-step's position update (positions_moved) the anchors are rotated from each
@@ -22,6 +23,10 @@
 // body a carries it), solved as one 2x2 block before the point block (Jolt's hinge: rotation,
 // then point), soft in the same way. Their error is the small angle between the axis as each
 // body carries it, (axis_a x axis_b) across each direction. Rotation about the axis is free.
+//
+// A fixed joint is a ball joint plus three angular rows about world x, y and z holding body b's
+// orientation relative to body a at creation, solved as a 3x3 block before the point block. The
+// error is the small-angle vector of the rotation from where b should be to where it is.
 //
 // A distance joint is one row along the anchors' direction. With min_length == max_length it is a
 // rigid rod (soft as above, either sign); otherwise each end of the range is a one-sided row: the
@@ -79,7 +84,8 @@ void apply_impulses(std::vector<Velocity>& v, const BodyPair& k, const std::arra
 }
 
 bool solved_type(JointType t) {
-  return t == JointType::ball || t == JointType::hinge || t == JointType::distance;
+  return t == JointType::ball || t == JointType::hinge || t == JointType::fixed ||
+         t == JointType::distance;
 }
 
 // A unit vector perpendicular to the unit vector n, chosen by n's components only (the contact
@@ -146,6 +152,7 @@ void JointSolver::prepare() {
     update_geometry(k);
     // The hinge's angular impulse is kept as a world vector: its rows' directions turn with body
     // a, and last step's impulse is projected onto this step's.
+    k.weld_impulse = j.angular_impulse;  // a fixed joint's rows are the world axes
     if (k.type == JointType::hinge) {
       k.angular_impulse_1 = dot(j.angular_impulse, k.across[0]);
       k.angular_impulse_2 = dot(j.angular_impulse, k.across[1]);
@@ -200,7 +207,29 @@ void JointSolver::update_geometry(JointConstraint& k) {
     k.angular_error_1 = dot(misalignment, k.across[0]);
     k.angular_error_2 = dot(misalignment, k.across[1]);
   }
-  if (k.type == JointType::ball || k.type == JointType::hinge) {
+  if (k.type == JointType::fixed) {
+    for (std::size_t i = 0; i < 3; ++i)
+      k.weld_rows[i] = angular_row(da, db, axis(i));
+    // K = I_a^-1 + I_b^-1 (world), from the rows as for the point block.
+    Mat3 K;
+    for (std::size_t i = 0; i < 3; ++i) {
+      Fixed entries[3];
+      for (std::size_t c = 0; c < 3; ++c) {
+        const Row& ri = k.weld_rows[i];
+        const Row& rc = k.weld_rows[c];
+        entries[c] =
+            DotSum{}.add(ri.angular_a, rc.response_a).add(ri.angular_b, rc.response_b).result();
+      }
+      K.rows[i] = {entries[0], entries[1], entries[2]};
+    }
+    k.weld_mass = inverse(K);
+    // The rotation from where b should be (q_a times the relative orientation at creation) to
+    // where it is, q_b conj(q_a q_rel), as a small-angle vector 2 vec(q) (the shorter way round).
+    const Quat e = b.orientation * conjugate(a.orientation * j.relative_orientation);
+    const Vec3 v = e.vector() * Fixed::from_int(2);
+    k.weld_error = e.w < Fixed::zero() ? -v : v;
+  }
+  if (k.type == JointType::ball || k.type == JointType::hinge || k.type == JointType::fixed) {
     k.separation = separation;
     for (std::size_t i = 0; i < 3; ++i)
       k.rows[i] = make_row(da, db, k.anchor_a, k.anchor_b, axis(i));
@@ -235,7 +264,11 @@ void JointSolver::warm_start() {
       apply_impulses(bodies_.velocities, k.bodies, no_direction, k.angular_rows[0],
                      k.angular_impulse_1, no_direction, k.angular_rows[1], k.angular_impulse_2);
     }
-    if (k.type == JointType::ball || k.type == JointType::hinge) {
+    if (k.type == JointType::fixed) {
+      const std::array<Direction, 3> none{};
+      apply_impulses(bodies_.velocities, k.bodies, none, k.weld_rows, k.weld_impulse);
+    }
+    if (k.type == JointType::ball || k.type == JointType::hinge || k.type == JointType::fixed) {
       apply_impulses(bodies_.velocities, k.bodies, k.axes, k.rows, k.impulse);
       continue;
     }
@@ -271,6 +304,20 @@ inline void JointSolver::solve_hinge_axes(JointConstraint& k, bool use_bias) {
   k.angular_impulse_2 += impulse.y;
   apply_impulses(bodies_.velocities, k.bodies, no_direction, k.angular_rows[0], impulse.x,
                  no_direction, k.angular_rows[1], impulse.y);
+}
+
+// The fixed joint's three angular rows as one block, soft like the point rows.
+inline void JointSolver::solve_weld(JointConstraint& k, bool use_bias) {
+  const Vec3 cdot{row_speed(bodies_.velocities, k.bodies, no_direction, k.weld_rows[0]),
+                  row_speed(bodies_.velocities, k.bodies, no_direction, k.weld_rows[1]),
+                  row_speed(bodies_.velocities, k.bodies, no_direction, k.weld_rows[2])};
+  const Vec3 impulse =
+      use_bias ? -(k.weld_mass * (cdot + k.weld_error * soft_.bias_rate)) * soft_.mass_scale -
+                     k.weld_impulse * soft_.impulse_scale
+               : -(k.weld_mass * cdot);
+  k.weld_impulse += impulse;
+  const std::array<Direction, 3> none{};
+  apply_impulses(bodies_.velocities, k.bodies, none, k.weld_rows, impulse);
 }
 
 inline void JointSolver::solve_distance(JointConstraint& k, bool use_bias) {
@@ -313,6 +360,9 @@ void JointSolver::solve_joints(bool use_bias) {
   for (JointConstraint& k : constraints_) {
     if (k.type == JointType::hinge) {
       solve_hinge_axes(k, use_bias);
+      solve_ball(k, use_bias);
+    } else if (k.type == JointType::fixed) {
+      solve_weld(k, use_bias);
       solve_ball(k, use_bias);
     } else if (k.type == JointType::ball) {
       solve_ball(k, use_bias);
@@ -357,9 +407,9 @@ void JointSolver::store_impulses() {
     const Fixed force = k.type == JointType::distance
                             ? abs(k.rigid_impulse + k.lower_impulse - k.upper_impulse)
                             : length(k.impulse);
-    const Fixed torque = k.type == JointType::hinge
-                             ? hypot(k.angular_impulse_1, k.angular_impulse_2)
-                             : Fixed::zero();
+    Fixed torque;
+    if (k.type == JointType::hinge) torque = hypot(k.angular_impulse_1, k.angular_impulse_2);
+    if (k.type == JointType::fixed) torque = length(k.weld_impulse);
     if (j.def.break_force > Fixed::zero() && force * bodies_.inv_h > j.def.break_force)
       j.broken = true;
     if (j.def.break_torque > Fixed::zero() && torque * bodies_.inv_h > j.def.break_torque)
@@ -367,6 +417,7 @@ void JointSolver::store_impulses() {
     j.linear_impulse = k.impulse;
     if (k.type == JointType::hinge)
       j.angular_impulse = k.across[0] * k.angular_impulse_1 + k.across[1] * k.angular_impulse_2;
+    if (k.type == JointType::fixed) j.angular_impulse = k.weld_impulse;
     j.axial_impulse = k.rigid_impulse + k.lower_impulse - k.upper_impulse;
   }
 }

@@ -1,6 +1,6 @@
 // Joints as a constraint kind (joint_solver.cpp), run after contacts in every stage (solve.cpp).
-// Work in progress (docs/JOINTS-WIP.md): ball, hinge and distance joints are solved (no limits,
-// motors, springs or breaking yet); the other types are skipped. Internal to detsim::sim.
+// Work in progress (docs/JOINTS-WIP.md): ball, hinge, fixed and distance joints are solved (no
+// limits, motors, springs or breaking yet); the other types are skipped. Internal to detsim::sim.
 #pragma once
 
 #include <array>
@@ -44,6 +44,11 @@ struct JointConstraint {
   Fixed angular_error_2;
   Fixed angular_impulse_1;
   Fixed angular_impulse_2;
+  // Fixed: three angular rows about world x, y, z, solved as one 3x3 block.
+  std::array<Row, 3> weld_rows;
+  Mat3 weld_mass;     ///< K^-1 of the three angular rows
+  Vec3 weld_error;    ///< the small rotation from where body b should be to where it is, world
+  Vec3 weld_impulse;  ///< accumulated about x, y, z
   // Distance: one row along the anchors' direction, at the present poses.
   Direction axial;
   Row axial_row;
@@ -75,6 +80,7 @@ class JointSolver final : public ConstraintKind {
   void solve_joints(bool use_bias);
   void solve_ball(JointConstraint& k, bool use_bias);
   void solve_hinge_axes(JointConstraint& k, bool use_bias);
+  void solve_weld(JointConstraint& k, bool use_bias);
   void solve_distance(JointConstraint& k, bool use_bias);
 
   WorldState& s_;

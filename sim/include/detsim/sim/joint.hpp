@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include <detsim/fixed/fixed.hpp>
+#include <detsim/fixed/quat.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
 
@@ -75,7 +76,9 @@ struct JointState {
   Vec3 local_anchor_b{};  ///< in body_b's frame (a distance joint: body_b's centre, zero)
   Vec3 local_axis_a{};    ///< the axis in body_a's frame
   Vec3 local_axis_b{};    ///< in body_b's frame
-  Fixed length{};         ///< distance joint: the anchors' distance at creation, m
+  /// Body b's orientation in body a's frame at creation, conj(q_a) q_b: what a fixed joint holds.
+  Quat relative_orientation{};
+  Fixed length{};  ///< distance joint: the anchors' distance at creation, m
   /// Accumulated impulses of the last step (warm start), N s per sub-step (the force they carry
   /// is impulse * substeps / dt): the point rows' (world x, y, z).
   Vec3 linear_impulse{};
