@@ -522,6 +522,71 @@ TEST(SimJoint, BreaksBeyondItsBreakForce) {
   EXPECT_TRUE(w.validate().ok()) << w.validate().message();
 }
 
+TEST(SimHingeJoint, MotorSpinsUpAtItsMaxTorqueThenHoldsItsSpeed) {
+  // A 10 kg sphere of radius 0.5 m (I = 2/5 m r^2 = 1 kg m^2) hinged at its centre about z, its
+  // motor at 5 rad/s with at most 2 N m: it spins up at tau / I = 2 rad/s^2 (2 rad/s at 1 s),
+  // reaches 5 rad/s at 2.5 s and holds it.
+  World w = make_world();
+  const BodyId post = add(w, anchor_at({0_fx, 5_fx, 0_fx}));
+  const BodyId wheel = add(w, ball_at({0_fx, 5_fx, 0_fx}, 0.5_fx, 10_fx));
+  JointDef d;
+  d.type = JointType::hinge;
+  d.body_a = post;
+  d.body_b = wheel;
+  d.anchor = {0_fx, 5_fx, 0_fx};
+  d.axis = {0_fx, 0_fx, 1_fx};
+  d.motor_enabled = true;
+  d.motor_speed = 5_fx;
+  d.motor_max_force = 2_fx;
+  const JointId joint = join(w, d);
+  for (std::int32_t i = 0; i < 60; ++i)
+    w.step();
+  EXPECT_TRUE(near(state(w, wheel).angular_velocity.z, 2_fx, 0.04_fx));
+  for (std::int32_t i = 0; i < 180; ++i)
+    w.step();
+  EXPECT_TRUE(near(state(w, wheel).angular_velocity.z, 5_fx, 0.01_fx));
+  EXPECT_TRUE(near(state(w, wheel).angular_velocity.x, 0_fx, 0.001_fx));
+  EXPECT_LT(anchor_gap(w, joint), 0.005_fx);
+}
+
+TEST(SimHingeJoint, LimitStopsTheSwing) {
+  // A hinge pendulum (L = 2 m) hanging at rest, its limit +-0.1 rad, kicked sideways at 3 m/s:
+  // free, it would swing to acos(1 - v^2 / (2 g L)) = 0.69 rad; the limit stops it at 0.1 rad
+  // (within 0.01 rad, the soft stop's give) on both sides.
+  World w = make_world();
+  const Vec3 pivot{0_fx, 10_fx, 0_fx};
+  const BodyId top = add(w, anchor_at(pivot));
+  BodyDef bob = ball_at({0_fx, 8_fx, 0_fx});
+  bob.linear_velocity = {3_fx, 0_fx, 0_fx};
+  const BodyId body = add(w, bob);
+  JointDef d;
+  d.type = JointType::hinge;
+  d.body_a = top;
+  d.body_b = body;
+  d.anchor = pivot;
+  d.axis = {0_fx, 0_fx, 1_fx};
+  d.limit_enabled = true;
+  d.limit_lower = -0.1_fx;
+  d.limit_upper = 0.1_fx;
+  join(w, d);
+  double largest = 0.0;
+  double smallest = 0.0;
+  for (std::int32_t i = 0; i < 180; ++i) {
+    w.step();
+    const Vec3 p = state(w, body).position - pivot;
+    const double theta = std::atan2(p.x.to_double(), -p.y.to_double());
+    largest = std::max(largest, theta);
+    smallest = std::min(smallest, theta);
+  }
+  EXPECT_LT(largest, 0.11);
+  EXPECT_GT(largest, 0.09);  // it did reach the limit
+  EXPECT_GT(smallest, -0.11);
+  // The stops take energy out (soft, damped), never put it in: the bob is slower than its kick.
+  EXPECT_LT(length(state(w, body).linear_velocity), 3_fx);
+  std::cout << "[ limit ] swing between " << smallest << " and " << largest << " rad, speed at 3 s "
+            << to_string(length(state(w, body).linear_velocity)) << " m/s\n";
+}
+
 // ---- Fixed joints ----
 
 TEST(SimFixedJoint, CantileverHoldsItsPoseUnderGravity) {

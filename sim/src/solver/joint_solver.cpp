@@ -24,6 +24,10 @@
 // then point), soft in the same way. Their error is the small angle between the axis as each
 // body carries it, (axis_a x axis_b) across each direction. Rotation about the axis is free.
 //
+// A hinge's motor and limit are rows about its axis, solved before the hinge's other rows (Jolt's
+// and Box2D's order: motor, limit, then the rest), the motor without bias and clamped to its
+// torque, the limit one-sided at each end.
+//
 // A fixed joint is a ball joint plus three angular rows about world x, y and z holding body b's
 // orientation relative to body a at creation, solved as a 3x3 block before the point block. The
 // error is the small-angle vector of the rotation from where b should be to where it is.
@@ -156,6 +160,11 @@ void JointSolver::prepare() {
     if (k.type == JointType::hinge) {
       k.angular_impulse_1 = dot(j.angular_impulse, k.across[0]);
       k.angular_impulse_2 = dot(j.angular_impulse, k.across[1]);
+      k.motor_impulse = j.def.motor_enabled ? j.motor_impulse : Fixed::zero();
+      k.lower_limit_impulse =
+          j.def.limit_enabled ? max(j.limit_impulse, Fixed::zero()) : Fixed::zero();
+      k.upper_limit_impulse =
+          j.def.limit_enabled ? max(-j.limit_impulse, Fixed::zero()) : Fixed::zero();
     }
     // Bodies held by a joint move by plain semi-implicit Euler, like bodies in contact
     // (bodies.hpp): the trapezoidal step of free flight would sink a hanging body by half a
@@ -203,6 +212,16 @@ void JointSolver::update_geometry(JointConstraint& k) {
                   Vec3{entries[1][0], entries[1][1], Fixed::zero()},
                   Vec3{Fixed::zero(), Fixed::zero(), Fixed::one()}}};
     k.angular_mass = inverse(K);
+    const JointDef& def = j.def;
+    if (def.motor_enabled || def.limit_enabled) {
+      k.twist_row = angular_row(da, db, k.axis_a);
+      // The rotation from b's pose at creation relative to a to its present one, about axis_a:
+      // twice the angle of the error quaternion's part along the axis (the shorter way round).
+      const Quat e = b.orientation * conjugate(a.orientation * j.relative_orientation);
+      const Fixed along = dot(e.vector(), k.axis_a);
+      k.angle = e.w < Fixed::zero() ? atan2(-along, -e.w) * Fixed::from_int(2)
+                                    : atan2(along, e.w) * Fixed::from_int(2);
+    }
     const Vec3 misalignment = cross(k.axis_a, k.axis_b);
     k.angular_error_1 = dot(misalignment, k.across[0]);
     k.angular_error_2 = dot(misalignment, k.across[1]);
@@ -249,6 +268,22 @@ void JointSolver::update_geometry(JointConstraint& k) {
       K.rows[i] = {entries[0], entries[1], entries[2]};
     }
     k.point_mass = inverse(K);  // K is positive definite: one body is dynamic
+    if (k.type == JointType::hinge && (j.def.motor_enabled || j.def.limit_enabled)) {
+      // The twist row's coupling to the point rows, b_i = J_point_i M^-1 J_twist^T (the twist
+      // row has no linear part), and its effective mass with the point rows held.
+      const Row& t = k.twist_row;
+      Vec3 coupling;
+      Fixed* entries[3] = {&coupling.x, &coupling.y, &coupling.z};
+      for (std::size_t i = 0; i < 3; ++i)
+        *entries[i] = DotSum{}
+                          .add(k.rows[i].angular_a, t.response_a)
+                          .add(k.rows[i].angular_b, t.response_b)
+                          .result();
+      k.twist_coupling = k.point_mass * coupling;
+      const Fixed own =
+          DotSum{}.add(t.angular_a, t.response_a).add(t.angular_b, t.response_b).result();
+      k.twist_mass = inverse_or_zero(own - dot(coupling, k.twist_coupling));
+    }
     return;
   }
   // Distance: along the anchors' direction (any fixed one when they coincide).
@@ -260,9 +295,33 @@ void JointSolver::update_geometry(JointConstraint& k) {
 
 void JointSolver::warm_start() {
   for (JointConstraint& k : constraints_) {
+    // An end of a range (a hinge limit, a rope's length) that the bodies have come away from
+    // carries no load: re-applying its old impulse (an impact's, most often) would throw the
+    // bodies back a second time, as the contact kind's warm start says of points that separated.
+    // A hinge whose limit stopped a 3 m/s swing rebounded at 5 m/s before this rule.
+    if (k.type == JointType::hinge && s_.joints[k.joint].def.limit_enabled) {
+      const JointDef& def = s_.joints[k.joint].def;
+      Fixed dropped;  // the twist impulse dropped, whose point compensation goes with it
+      if (k.angle > def.limit_lower) {
+        dropped += k.lower_limit_impulse;
+        k.lower_limit_impulse = Fixed::zero();
+      }
+      if (k.angle < def.limit_upper) {
+        dropped -= k.upper_limit_impulse;
+        k.upper_limit_impulse = Fixed::zero();
+      }
+      k.impulse += k.twist_coupling * dropped;
+    }
+    if (k.type == JointType::distance && k.min_length < k.max_length) {
+      if (k.length > k.min_length) k.lower_impulse = Fixed::zero();
+      if (k.length < k.max_length) k.upper_impulse = Fixed::zero();
+    }
     if (k.type == JointType::hinge) {
       apply_impulses(bodies_.velocities, k.bodies, no_direction, k.angular_rows[0],
                      k.angular_impulse_1, no_direction, k.angular_rows[1], k.angular_impulse_2);
+      const Fixed twist = k.motor_impulse + k.lower_limit_impulse - k.upper_limit_impulse;
+      if (twist != Fixed::zero())
+        apply_impulse(bodies_.velocities, k.bodies, no_direction, k.twist_row, twist);
     }
     if (k.type == JointType::fixed) {
       const std::array<Direction, 3> none{};
@@ -304,6 +363,59 @@ inline void JointSolver::solve_hinge_axes(JointConstraint& k, bool use_bias) {
   k.angular_impulse_2 += impulse.y;
   apply_impulses(bodies_.velocities, k.bodies, no_direction, k.angular_rows[0], impulse.x,
                  no_direction, k.angular_rows[1], impulse.y);
+}
+
+// An impulse about the hinge's axis together with the point impulses that keep the anchors'
+// relative velocity as it was (booked to the point rows' accumulated impulses, so that the warm
+// start carries them too). Alone, an impulse about the axis on a body at the end of an arm
+// mostly spins the body about its own centre, which the point rows then undo: a limit on a 2 m
+// pendulum let it swing 2.5 times past its end.
+void JointSolver::apply_twist(JointConstraint& k, Fixed impulse) {
+  if (impulse == Fixed::zero()) return;
+  const Vec3 point = -(k.twist_coupling * impulse);
+  k.impulse += point;
+  apply_impulses(bodies_.velocities, k.bodies, k.axes, k.rows, point);
+  apply_impulse(bodies_.velocities, k.bodies, no_direction, k.twist_row, impulse);
+}
+
+// The hinge motor: drives the relative speed about the axis to motor_speed with at most
+// motor_max_force (a torque, N m) over each sub-step (Box2D v3's revolute motor).
+inline void JointSolver::solve_hinge_motor(JointConstraint& k) {
+  const JointDef& def = s_.joints[k.joint].def;
+  const Fixed speed = row_speed(bodies_.velocities, k.bodies, no_direction, k.twist_row);
+  const Fixed max_impulse = def.motor_max_force * bodies_.h;
+  const Fixed next =
+      clamp(k.motor_impulse - k.twist_mass * (speed - def.motor_speed), -max_impulse, max_impulse);
+  const Fixed impulse = next - k.motor_impulse;
+  k.motor_impulse = next;
+  apply_twist(k, impulse);
+}
+
+// The hinge limit: each end a one-sided row about the axis, as the distance joint's range
+// (speculative while apart from the end, soft at it while biased, rigid in relax). Solved with
+// the other rows, not yet held in hold() from the ground up.
+inline void JointSolver::solve_hinge_limit(JointConstraint& k, bool use_bias) {
+  const JointDef& def = s_.joints[k.joint].def;
+  const Row& row = k.twist_row;
+  const Fixed mass = k.twist_mass;
+  const auto one_sided = [&](Fixed c, Fixed sign, Fixed& accumulated) {
+    const Fixed cdot = sign * row_speed(bodies_.velocities, k.bodies, no_direction, row);
+    Fixed impulse;
+    if (c > Fixed::zero()) {
+      impulse = -mass * (cdot + c * bodies_.inv_h);
+    } else if (use_bias) {
+      impulse = -mass * soft_.mass_scale * (cdot + soft_.bias_rate * c) -
+                soft_.impulse_scale * accumulated;
+    } else {
+      impulse = -mass * cdot;
+    }
+    const Fixed next = max(accumulated + impulse, Fixed::zero());
+    impulse = next - accumulated;
+    accumulated = next;
+    apply_twist(k, sign * impulse);
+  };
+  one_sided(k.angle - def.limit_lower, Fixed::one(), k.lower_limit_impulse);
+  one_sided(def.limit_upper - k.angle, -Fixed::one(), k.upper_limit_impulse);
 }
 
 // The fixed joint's three angular rows as one block, soft like the point rows.
@@ -359,8 +471,11 @@ inline void JointSolver::solve_distance(JointConstraint& k, bool use_bias) {
 void JointSolver::solve_joints(bool use_bias) {
   for (JointConstraint& k : constraints_) {
     if (k.type == JointType::hinge) {
+      const JointDef& def = s_.joints[k.joint].def;
+      if (def.motor_enabled) solve_hinge_motor(k);
       solve_hinge_axes(k, use_bias);
       solve_ball(k, use_bias);
+      if (def.limit_enabled) solve_hinge_limit(k, use_bias);
     } else if (k.type == JointType::fixed) {
       solve_weld(k, use_bias);
       solve_ball(k, use_bias);
@@ -418,6 +533,10 @@ void JointSolver::store_impulses() {
     if (k.type == JointType::hinge)
       j.angular_impulse = k.across[0] * k.angular_impulse_1 + k.across[1] * k.angular_impulse_2;
     if (k.type == JointType::fixed) j.angular_impulse = k.weld_impulse;
+    if (k.type == JointType::hinge) {
+      j.motor_impulse = k.motor_impulse;
+      j.limit_impulse = k.lower_limit_impulse - k.upper_limit_impulse;
+    }
     j.axial_impulse = k.rigid_impulse + k.lower_impulse - k.upper_impulse;
   }
 }

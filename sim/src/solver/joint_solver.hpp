@@ -44,6 +44,17 @@ struct JointConstraint {
   Fixed angular_error_2;
   Fixed angular_impulse_1;
   Fixed angular_impulse_2;
+  // Hinge motor and limit: one row about axis_a.
+  Row twist_row;
+  /// The twist row with the point rows held: point impulses -twist_coupling per unit of twist
+  /// impulse keep the anchors' relative velocity as it was, and twist_mass is the effective mass
+  /// of the pair, 1 / (c - b . K^-1 b) (the Schur complement of the point block).
+  Vec3 twist_coupling;
+  Fixed twist_mass;
+  Fixed angle;  ///< b's rotation about axis_a since creation, radians in [-pi, pi]
+  Fixed motor_impulse;
+  Fixed lower_limit_impulse;  ///< >= 0
+  Fixed upper_limit_impulse;  ///< >= 0
   // Fixed: three angular rows about world x, y, z, solved as one 3x3 block.
   std::array<Row, 3> weld_rows;
   Mat3 weld_mass;     ///< K^-1 of the three angular rows
@@ -80,6 +91,9 @@ class JointSolver final : public ConstraintKind {
   void solve_joints(bool use_bias);
   void solve_ball(JointConstraint& k, bool use_bias);
   void solve_hinge_axes(JointConstraint& k, bool use_bias);
+  void solve_hinge_motor(JointConstraint& k);
+  void solve_hinge_limit(JointConstraint& k, bool use_bias);
+  void apply_twist(JointConstraint& k, Fixed impulse);
   void solve_weld(JointConstraint& k, bool use_bias);
   void solve_distance(JointConstraint& k, bool use_bias);
 

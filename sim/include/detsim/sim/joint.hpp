@@ -84,6 +84,8 @@ struct JointState {
   Vec3 linear_impulse{};
   Vec3 angular_impulse{};  ///< the angular rows' (hinge, ...) as a world vector, N m s
   Fixed axial_impulse{};   ///< the distance row's (or a limit's along the axis), N s
+  Fixed motor_impulse{};   ///< the hinge motor's, N m s
+  Fixed limit_impulse{};   ///< the hinge limit's: lower end's minus upper end's, N m s
   /// Broke under break_force or break_torque (at the end of a step): no longer solved, joins no
   /// island, does not keep its bodies from colliding.
   bool broken = false;
