@@ -154,9 +154,10 @@ void JointSolver::prepare() {
     k.rigid_impulse = j.axial_impulse;
     if (k.min_length < k.max_length) k.rigid_impulse = Fixed::zero();
     update_geometry(k);
-    // The hinge's angular impulse is kept as a world vector: its rows' directions turn with body
-    // a, and last step's impulse is projected onto this step's.
-    k.weld_impulse = j.angular_impulse;  // a fixed joint's rows are the world axes
+    // Angular impulses are kept as a world vector. A fixed joint's rows are the world axes: the
+    // vector is its impulse. A hinge's rows turn with body a: last step's impulse is projected
+    // onto this step's.
+    k.weld_impulse = j.angular_impulse;
     if (k.type == JointType::hinge) {
       k.angular_impulse_1 = dot(j.angular_impulse, k.across[0]);
       k.angular_impulse_2 = dot(j.angular_impulse, k.across[1]);
