@@ -587,6 +587,41 @@ TEST(SimHingeJoint, LimitStopsTheSwing) {
             << to_string(length(state(w, body).linear_velocity)) << " m/s\n";
 }
 
+// ---- Slider joints ----
+
+TEST(SimSliderJoint, SlidesDownItsAxisWithoutFrictionAndHoldsEverythingElse) {
+  // A 2 kg box on a slider from a static body, the axis 30 degrees below horizontal, released at
+  // rest: the slider carries the weight across the axis, so the box slides along it with the
+  // frictionless incline's acceleration g sin 30 = g / 2, s(t) = g t^2 / 4, without turning or
+  // leaving the axis (the joint spring's give: 5 mm).
+  World w = make_world();
+  const Vec3 start{0_fx, 10_fx, 0_fx};
+  const BodyId rail = add(w, anchor_at({-1_fx, 10_fx, 0_fx}));
+  BodyDef box;
+  box.shape = Shape::box({0.2_fx, 0.1_fx, 0.1_fx});
+  box.position = start;
+  box.mass = 2_fx;
+  const BodyId body = add(w, box);
+  const Fixed angle = Fixed::pi() / 6_fx;
+  const Vec3 axis{cos(angle), -sin(angle), 0_fx};
+  JointDef d;
+  d.type = JointType::slider;
+  d.body_a = rail;
+  d.body_b = body;
+  d.anchor = start;
+  d.axis = axis;
+  join(w, d);
+  for (std::int32_t i = 0; i < 60; ++i)
+    w.step();
+  const BodyState b = state(w, body);
+  const Vec3 moved = b.position - start;
+  const Fixed g = -w.def().gravity.y;
+  const Fixed expected = g / 4_fx;  // t = 1 s
+  EXPECT_TRUE(near(dot(moved, axis), expected, expected * 0.01_fx));
+  EXPECT_LT(length(moved - axis * dot(moved, axis)), 0.005_fx);
+  EXPECT_GT(abs(b.orientation.w), 0.99998_fx);  // turned by less than 0.5 degree
+}
+
 // ---- Fixed joints ----
 
 TEST(SimFixedJoint, CantileverHoldsItsPoseUnderGravity) {

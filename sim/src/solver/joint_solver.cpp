@@ -1,7 +1,7 @@
 // Joints, the second constraint kind (after contacts, solve.cpp): soft point constraints of the
 // sub-stepped solver, as Box2D v3 solves its joints, in 3D. Work in progress
-// (docs/JOINTS-WIP.md): ball, hinge, fixed and distance joints; slider and swing_twist are not
-// solved yet.
+// (docs/JOINTS-WIP.md): ball, hinge, slider, fixed and distance joints; swing_twist is not solved
+// yet.
 //
 // Unlike a contact, whose anchors stay fixed for the step, a joint's anchors turn with its bodies:
 // after every sub-step's position update (positions_moved) the anchors are rotated from each
@@ -31,6 +31,10 @@
 // A fixed joint is a ball joint plus three angular rows about world x, y and z holding body b's
 // orientation relative to body a at creation, solved as a 3x3 block before the point block. The
 // error is the small-angle vector of the rotation from where b should be to where it is.
+//
+// A slider is the fixed joint's three angular rows plus two linear rows across its axis (as body
+// a carries it), from body a's centre to body b's anchor (Box2D's prismatic rows), solved as a
+// 2x2 block after the angular block. Translation along the axis is free (no limit or motor yet).
 //
 // A distance joint is one row along the anchors' direction. With min_length == max_length it is a
 // rigid rod (soft as above, either sign); otherwise each end of the range is a one-sided row: the
@@ -88,8 +92,8 @@ void apply_impulses(std::vector<Velocity>& v, const BodyPair& k, const std::arra
 }
 
 bool solved_type(JointType t) {
-  return t == JointType::ball || t == JointType::hinge || t == JointType::fixed ||
-         t == JointType::distance;
+  return t == JointType::ball || t == JointType::hinge || t == JointType::slider ||
+         t == JointType::fixed || t == JointType::distance;
 }
 
 // A unit vector perpendicular to the unit vector n, chosen by n's components only (the contact
@@ -114,6 +118,15 @@ Row angular_row(const Derived& a, const Derived& b, Vec3 u) {
 }
 
 const Direction no_direction{};
+
+// The inverse of the symmetric 2x2 block [[k11, k12], [k12, k22]], as the upper left of a 3x3
+// with a unit third row and column: each entry the exact cofactor over the exact determinant
+// (try_inverse), however small the block is.
+Mat3 inverse_2x2(Fixed k11, Fixed k12, Fixed k22) {
+  const Mat3 K{{Vec3{k11, k12, Fixed::zero()}, Vec3{k12, k22, Fixed::zero()},
+                Vec3{Fixed::zero(), Fixed::zero(), Fixed::one()}}};
+  return inverse(K);
+}
 
 }  // namespace
 
@@ -158,6 +171,10 @@ void JointSolver::prepare() {
     // vector is its impulse. A hinge's rows turn with body a: last step's impulse is projected
     // onto this step's.
     k.weld_impulse = j.angular_impulse;
+    if (k.type == JointType::slider) {  // its linear rows turn with body a too
+      k.slide_impulse_1 = dot(j.linear_impulse, k.across[0]);
+      k.slide_impulse_2 = dot(j.linear_impulse, k.across[1]);
+    }
     if (k.type == JointType::hinge) {
       k.angular_impulse_1 = dot(j.angular_impulse, k.across[0]);
       k.angular_impulse_2 = dot(j.angular_impulse, k.across[1]);
@@ -227,7 +244,34 @@ void JointSolver::update_geometry(JointConstraint& k) {
     k.angular_error_1 = dot(misalignment, k.across[0]);
     k.angular_error_2 = dot(misalignment, k.across[1]);
   }
-  if (k.type == JointType::fixed) {
+  if (k.type == JointType::slider) {
+    k.axis_a = rotate(a.orientation, j.local_axis_a);
+    k.across[0] = perpendicular(k.axis_a);
+    k.across[1] = cross(k.axis_a, k.across[0]);
+    // Box2D's prismatic rows: at body a, the arm reaches b's anchor (anchor_a + separation).
+    const Vec3 arm_a = k.anchor_a + separation;
+    for (std::size_t i = 0; i < 2; ++i) {
+      k.slide_directions[i] = make_direction(da, db, k.across[i]);
+      k.slide_rows[i] = make_row(da, db, arm_a, k.anchor_b, k.across[i]);
+    }
+    Fixed entries[2][2];
+    for (std::size_t i = 0; i < 2; ++i) {
+      for (std::size_t c = 0; c < 2; ++c) {
+        const Row& ri = k.slide_rows[i];
+        const Row& rc = k.slide_rows[c];
+        entries[i][c] = DotSum{}
+                            .add(k.slide_directions[i].linear_a, k.slide_directions[c].response_a)
+                            .add(k.slide_directions[i].linear_b, k.slide_directions[c].response_b)
+                            .add(ri.angular_a, rc.response_a)
+                            .add(ri.angular_b, rc.response_b)
+                            .result();
+      }
+    }
+    k.slide_mass = inverse_2x2(entries[0][0], entries[0][1], entries[1][1]);
+    k.slide_error_1 = dot(separation, k.across[0]);
+    k.slide_error_2 = dot(separation, k.across[1]);
+  }
+  if (k.type == JointType::fixed || k.type == JointType::slider) {
     for (std::size_t i = 0; i < 3; ++i)
       k.weld_rows[i] = angular_row(da, db, axis(i));
     // K = I_a^-1 + I_b^-1 (world), from the rows as for the point block.
@@ -324,9 +368,14 @@ void JointSolver::warm_start() {
       if (twist != Fixed::zero())
         apply_impulse(bodies_.velocities, k.bodies, no_direction, k.twist_row, twist);
     }
-    if (k.type == JointType::fixed) {
+    if (k.type == JointType::fixed || k.type == JointType::slider) {
       const std::array<Direction, 3> none{};
       apply_impulses(bodies_.velocities, k.bodies, none, k.weld_rows, k.weld_impulse);
+    }
+    if (k.type == JointType::slider) {
+      apply_impulses(bodies_.velocities, k.bodies, k.slide_directions[0], k.slide_rows[0],
+                     k.slide_impulse_1, k.slide_directions[1], k.slide_rows[1], k.slide_impulse_2);
+      continue;
     }
     if (k.type == JointType::ball || k.type == JointType::hinge || k.type == JointType::fixed) {
       apply_impulses(bodies_.velocities, k.bodies, k.axes, k.rows, k.impulse);
@@ -433,6 +482,23 @@ inline void JointSolver::solve_weld(JointConstraint& k, bool use_bias) {
   apply_impulses(bodies_.velocities, k.bodies, none, k.weld_rows, impulse);
 }
 
+// The slider's two rows across its axis as one block, soft like the point rows.
+inline void JointSolver::solve_slide(JointConstraint& k, bool use_bias) {
+  const Vec3 cdot{row_speed(bodies_.velocities, k.bodies, k.slide_directions[0], k.slide_rows[0]),
+                  row_speed(bodies_.velocities, k.bodies, k.slide_directions[1], k.slide_rows[1]),
+                  Fixed::zero()};
+  const Vec3 accumulated{k.slide_impulse_1, k.slide_impulse_2, Fixed::zero()};
+  const Vec3 error{k.slide_error_1, k.slide_error_2, Fixed::zero()};
+  const Vec3 impulse = use_bias
+                           ? -(k.slide_mass * (cdot + error * soft_.bias_rate)) * soft_.mass_scale -
+                                 accumulated * soft_.impulse_scale
+                           : -(k.slide_mass * cdot);
+  k.slide_impulse_1 += impulse.x;
+  k.slide_impulse_2 += impulse.y;
+  apply_impulses(bodies_.velocities, k.bodies, k.slide_directions[0], k.slide_rows[0], impulse.x,
+                 k.slide_directions[1], k.slide_rows[1], impulse.y);
+}
+
 inline void JointSolver::solve_distance(JointConstraint& k, bool use_bias) {
   const Row& row = k.axial_row;
   const Fixed mass = row.mass;
@@ -477,6 +543,9 @@ void JointSolver::solve_joints(bool use_bias) {
       solve_hinge_axes(k, use_bias);
       solve_ball(k, use_bias);
       if (def.limit_enabled) solve_hinge_limit(k, use_bias);
+    } else if (k.type == JointType::slider) {
+      solve_weld(k, use_bias);
+      solve_slide(k, use_bias);
     } else if (k.type == JointType::fixed) {
       solve_weld(k, use_bias);
       solve_ball(k, use_bias);
@@ -520,12 +589,13 @@ void JointSolver::restitution() {}
 void JointSolver::store_impulses() {
   for (const JointConstraint& k : constraints_) {
     JointState& j = s_.joints[k.joint];
-    const Fixed force = k.type == JointType::distance
-                            ? abs(k.rigid_impulse + k.lower_impulse - k.upper_impulse)
-                            : length(k.impulse);
+    Fixed force = length(k.impulse);
+    if (k.type == JointType::distance)
+      force = abs(k.rigid_impulse + k.lower_impulse - k.upper_impulse);
+    if (k.type == JointType::slider) force = hypot(k.slide_impulse_1, k.slide_impulse_2);
     Fixed torque;
     if (k.type == JointType::hinge) torque = hypot(k.angular_impulse_1, k.angular_impulse_2);
-    if (k.type == JointType::fixed) torque = length(k.weld_impulse);
+    if (k.type == JointType::fixed || k.type == JointType::slider) torque = length(k.weld_impulse);
     if (j.def.break_force > Fixed::zero() && force * bodies_.inv_h > j.def.break_force)
       j.broken = true;
     if (j.def.break_torque > Fixed::zero() && torque * bodies_.inv_h > j.def.break_torque)
@@ -533,7 +603,10 @@ void JointSolver::store_impulses() {
     j.linear_impulse = k.impulse;
     if (k.type == JointType::hinge)
       j.angular_impulse = k.across[0] * k.angular_impulse_1 + k.across[1] * k.angular_impulse_2;
-    if (k.type == JointType::fixed) j.angular_impulse = k.weld_impulse;
+    if (k.type == JointType::fixed || k.type == JointType::slider)
+      j.angular_impulse = k.weld_impulse;
+    if (k.type == JointType::slider)
+      j.linear_impulse = k.across[0] * k.slide_impulse_1 + k.across[1] * k.slide_impulse_2;
     if (k.type == JointType::hinge) {
       j.motor_impulse = k.motor_impulse;
       j.limit_impulse = k.lower_limit_impulse - k.upper_limit_impulse;

@@ -1,6 +1,7 @@
 // Joints as a constraint kind (joint_solver.cpp), run after contacts in every stage (solve.cpp).
-// Work in progress (docs/JOINTS-WIP.md): ball, hinge, fixed and distance joints are solved (no
-// limits, motors, springs or breaking yet); the other types are skipped. Internal to detsim::sim.
+// Work in progress (docs/JOINTS-WIP.md): ball, hinge, slider, fixed and distance joints are solved
+// (no limits, motors, springs or breaking yet); the other types are skipped. Internal to
+// detsim::sim.
 #pragma once
 
 #include <array>
@@ -60,6 +61,15 @@ struct JointConstraint {
   Mat3 weld_mass;     ///< K^-1 of the three angular rows
   Vec3 weld_error;    ///< the small rotation from where body b should be to where it is, world
   Vec3 weld_impulse;  ///< accumulated about x, y, z
+  // Slider: two linear rows across the axis (as body a carries it), from body a's centre to body
+  // b's anchor, solved as one 2x2 block; its rotation is held by the fixed joint's rows.
+  std::array<Direction, 2> slide_directions;
+  std::array<Row, 2> slide_rows;
+  Mat3 slide_mass;      ///< the 2x2 block's inverse (upper left; the rest is the identity)
+  Fixed slide_error_1;  ///< the anchors' separation across the axis
+  Fixed slide_error_2;
+  Fixed slide_impulse_1;
+  Fixed slide_impulse_2;
   // Distance: one row along the anchors' direction, at the present poses.
   Direction axial;
   Row axial_row;
@@ -95,6 +105,7 @@ class JointSolver final : public ConstraintKind {
   void solve_hinge_limit(JointConstraint& k, bool use_bias);
   void apply_twist(JointConstraint& k, Fixed impulse);
   void solve_weld(JointConstraint& k, bool use_bias);
+  void solve_slide(JointConstraint& k, bool use_bias);
   void solve_distance(JointConstraint& k, bool use_bias);
 
   WorldState& s_;
