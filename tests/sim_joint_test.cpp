@@ -157,6 +157,36 @@ TEST(SimJoint, DestroyingABodyRemovesItsJoints) {
   EXPECT_FALSE(w.joint(middle).ok());
 }
 
+TEST(SimJoint, ACopiedWorldStepsLikeTheOriginal) {
+  // A world copy carries its joints (definitions and warm-start impulses): the copy and the
+  // original give the same bytes and the same joint states step after step. (A save and restore
+  // does not yet: joints are not in the saved state, docs/JOINTS-WIP.md.)
+  World w = make_world();
+  BodyId previous = add(w, anchor_at({0_fx, 10_fx, 0_fx}));
+  for (std::int32_t i = 0; i < 5; ++i) {
+    const BodyId body = add(w, ball_at({Fixed::from_int(i) + 0.5_fx, 10_fx, 0_fx}));
+    JointDef d;
+    d.type = i % 2 == 0 ? JointType::ball : JointType::hinge;
+    d.axis = {0_fx, 0_fx, 1_fx};
+    d.body_a = previous;
+    d.body_b = body;
+    d.anchor = {Fixed::from_int(i), 10_fx, 0_fx};
+    join(w, d);
+    previous = body;
+  }
+  for (std::int32_t i = 0; i < 30; ++i)
+    w.step();
+  World copy = w;
+  for (std::int32_t i = 0; i < 60; ++i) {
+    w.step();
+    copy.step();
+  }
+  EXPECT_EQ(copy.save(), w.save());
+  for (const JointId id : w.joint_ids())
+    EXPECT_EQ(*copy.joint(id), *w.joint(id));
+  EXPECT_NE(w.joint(JointId{1})->linear_impulse, Vec3{});  // the joints carry load
+}
+
 // ---- Ball joints ----
 
 // The anchors' distance, world space: where the joint's anchor is on body a, and on body b.
