@@ -37,10 +37,11 @@
 // 2x2 block after the angular block. Translation along the axis is free (no limit or motor yet).
 //
 // A distance joint is one row along the anchors' direction. With min_length == max_length it is a
-// rigid rod (soft as above, either sign); otherwise each end of the range is a one-sided row: the
-// lower pushes (length >= min_length), the upper pulls (length <= max_length), a rope being the
-// upper alone (slack below max_length). An end not reached is speculative: it lets the bodies
-// close the gap within the sub-step, no further.
+// rigid rod (soft as above, either sign), or with spring_frequency > 0 a spring of that rest
+// length; otherwise each end of the range is a one-sided row: the lower pushes (length >=
+// min_length), the upper pulls (length <= max_length), a rope being the upper alone (slack below
+// max_length). An end not reached is speculative: it lets the bodies close the gap within the
+// sub-step, no further.
 #include "joint_solver.hpp"
 
 #include <detsim/fixed/math.hpp>
@@ -162,10 +163,18 @@ void JointSolver::prepare() {
       k.min_length = j.length;
       k.max_length = j.length;
     }
-    k.lower_impulse = max(j.axial_impulse, Fixed::zero());
-    k.upper_impulse = max(-j.axial_impulse, Fixed::zero());
-    k.rigid_impulse = j.axial_impulse;
-    if (k.min_length < k.max_length) k.rigid_impulse = Fixed::zero();
+    // axial_impulse is a rod's (or spring's) impulse, or a range's lower end's minus its upper
+    // end's (only one end can carry load).
+    const bool range = k.min_length < k.max_length;
+    k.rigid_impulse = range ? Fixed::zero() : j.axial_impulse;
+    k.lower_impulse = range ? max(j.axial_impulse, Fixed::zero()) : Fixed::zero();
+    k.upper_impulse = range ? max(-j.axial_impulse, Fixed::zero()) : Fixed::zero();
+    // A rod with spring_frequency > 0 is a spring of that rest length (a spring on a range, with
+    // its own rest length, is not supported yet).
+    k.spring = k.type == JointType::distance && k.min_length == k.max_length &&
+               j.def.spring_frequency > Fixed::zero();
+    if (k.spring)
+      k.spring_soft = make_soft(j.def.spring_frequency, j.def.spring_damping_ratio, bodies_.h);
     update_geometry(k);
     // Angular impulses are kept as a world vector. A fixed joint's rows are the world axes: the
     // vector is its impulse. A hinge's rows turn with body a: last step's impulse is projected
@@ -505,9 +514,14 @@ inline void JointSolver::solve_distance(JointConstraint& k, bool use_bias) {
   if (k.min_length == k.max_length) {
     const Fixed cdot = row_speed(bodies_.velocities, k.bodies, k.axial, row);
     const Fixed c = k.length - k.min_length;
-    const Fixed impulse = use_bias ? -mass * soft_.mass_scale * (cdot + soft_.bias_rate * c) -
-                                         soft_.impulse_scale * k.rigid_impulse
-                                   : -mass * cdot;
+    // A spring (spring_frequency > 0) is the same row with the spring's own softness, in solve
+    // and relax alike: its give is the physics, not an error for relax to remove (Box2D v3's
+    // distance spring).
+    const Softness& soft = k.spring ? k.spring_soft : soft_;
+    const Fixed impulse = use_bias || k.spring
+                              ? -mass * soft.mass_scale * (cdot + soft.bias_rate * c) -
+                                    soft.impulse_scale * k.rigid_impulse
+                              : -mass * cdot;
     k.rigid_impulse += impulse;
     apply_impulse(bodies_.velocities, k.bodies, k.axial, row, impulse);
     return;

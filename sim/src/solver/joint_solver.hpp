@@ -78,7 +78,9 @@ struct JointConstraint {
   Fixed max_length;
   Fixed lower_impulse;  ///< pushing apart (length >= min_length), >= 0
   Fixed upper_impulse;  ///< pulling together (length <= max_length), >= 0
-  Fixed rigid_impulse;  ///< a rigid rod's, either sign
+  Fixed rigid_impulse;  ///< a rigid rod's (or a spring's), either sign
+  bool spring;          ///< a rod with spring_frequency > 0: a spring of its length
+  Softness spring_soft;
 };
 
 /// The joints of the step, in ascending joint ID.
