@@ -730,6 +730,60 @@ TEST(SimSliderJoint, SlidesDownItsAxisWithoutFrictionAndHoldsEverythingElse) {
   EXPECT_GT(abs(b.orientation.w), 0.99998_fx);  // turned by less than 0.5 degree
 }
 
+// ---- Swing-twist joints ----
+
+TEST(SimSwingTwistJoint, ConeAndTwistLimitsHold) {
+  // A sphere hanging 2 m below a swing-twist joint whose axis points down at it: kicked sideways
+  // at 3 m/s (free, it would swing out to 0.69 rad), the cone of half-angle 0.2 rad stops it; spun
+  // about the vertical at 5 rad/s, the twist range +-0.3 rad stops the spin. Without limits
+  // (limit_enabled false) the joint is a ball joint and both go past.
+  for (const bool limited : {true, false}) {
+    World w = make_world();
+    const Vec3 pivot{0_fx, 10_fx, 0_fx};
+    const BodyId top = add(w, anchor_at(pivot));
+    BodyDef bob = ball_at({0_fx, 8_fx, 0_fx});
+    bob.linear_velocity = {3_fx, 0_fx, 0_fx};
+    bob.angular_velocity = {0_fx, 5_fx, 0_fx};
+    const BodyId body = add(w, bob);
+    JointDef d;
+    d.type = JointType::swing_twist;
+    d.body_a = top;
+    d.body_b = body;
+    d.anchor = pivot;
+    d.axis = {0_fx, -1_fx, 0_fx};
+    d.limit_enabled = limited;
+    d.swing_limit = 0.2_fx;
+    d.limit_lower = -0.3_fx;
+    d.limit_upper = 0.3_fx;
+    join(w, d);
+    double swing = 0.0;
+    double twist = 0.0;
+    for (std::int32_t i = 0; i < 120; ++i) {
+      w.step();
+      const BodyState b = state(w, body);
+      const Vec3 p = b.position - pivot;
+      swing = std::max(swing, std::acos(-p.y.to_double() / length(p).to_double()));
+      // The twist: the body's rotation about its own hanging axis (the body's y through the
+      // pivot), from its orientation's part along that axis.
+      const Vec3 down = rotate(b.orientation, Vec3{0_fx, -1_fx, 0_fx});
+      const double along = dot(b.orientation.vector(), down).to_double();
+      twist = std::max(twist, std::abs(2.0 * std::atan2(-along, b.orientation.w.to_double())));
+    }
+    if (limited) {
+      EXPECT_LT(swing, 0.21);
+      EXPECT_GT(swing, 0.19);
+      EXPECT_LT(twist, 0.31);
+      EXPECT_GT(twist, 0.29);
+      EXPECT_TRUE(w.validate().ok()) << w.validate().message();
+      std::cout << "[ swing-twist ] largest swing " << swing << " rad (cone 0.2), twist " << twist
+                << " rad (range 0.3)\n";
+    } else {
+      EXPECT_GT(swing, 0.5);
+      EXPECT_GT(twist, 1.0);
+    }
+  }
+}
+
 // ---- Fixed joints ----
 
 TEST(SimFixedJoint, CantileverHoldsItsPoseUnderGravity) {

@@ -93,8 +93,8 @@ void apply_impulses(std::vector<Velocity>& v, const BodyPair& k, const std::arra
 }
 
 bool solved_type(JointType t) {
-  return t == JointType::ball || t == JointType::hinge || t == JointType::slider ||
-         t == JointType::fixed || t == JointType::distance;
+  (void)t;  // every type
+  return true;
 }
 
 // A unit vector perpendicular to the unit vector n, chosen by n's components only (the contact
@@ -166,9 +166,10 @@ void JointSolver::prepare() {
     // axial_impulse is a rod's (or spring's) impulse, or a range's lower end's minus its upper
     // end's (only one end can carry load).
     const bool range = k.min_length < k.max_length;
-    k.rigid_impulse = range ? Fixed::zero() : j.axial_impulse;
-    k.lower_impulse = range ? max(j.axial_impulse, Fixed::zero()) : Fixed::zero();
-    k.upper_impulse = range ? max(-j.axial_impulse, Fixed::zero()) : Fixed::zero();
+    const bool distance = k.type == JointType::distance;
+    k.rigid_impulse = distance && !range ? j.axial_impulse : Fixed::zero();
+    k.lower_impulse = distance && range ? max(j.axial_impulse, Fixed::zero()) : Fixed::zero();
+    k.upper_impulse = distance && range ? max(-j.axial_impulse, Fixed::zero()) : Fixed::zero();
     // A rod with spring_frequency > 0 is a spring of that rest length (a spring on a range, with
     // its own rest length, is not supported yet).
     k.spring = k.type == JointType::distance && k.min_length == k.max_length &&
@@ -183,6 +184,11 @@ void JointSolver::prepare() {
     if (k.type == JointType::slider) {  // its linear rows turn with body a too
       k.slide_impulse_1 = dot(j.linear_impulse, k.across[0]);
       k.slide_impulse_2 = dot(j.linear_impulse, k.across[1]);
+    }
+    if (k.type == JointType::swing_twist && j.def.limit_enabled) {
+      k.lower_limit_impulse = max(j.limit_impulse, Fixed::zero());
+      k.upper_limit_impulse = max(-j.limit_impulse, Fixed::zero());
+      k.swing_impulse = j.axial_impulse;
     }
     if (k.type == JointType::hinge) {
       k.angular_impulse_1 = dot(j.angular_impulse, k.across[0]);
@@ -217,6 +223,27 @@ void JointSolver::update_geometry(JointConstraint& k) {
   k.anchor_a = rotate(a.orientation, j.local_anchor_a);
   k.anchor_b = rotate(b.orientation, j.local_anchor_b);
   const Vec3 separation = (b.position + k.anchor_b) - (a.position + k.anchor_a);
+  // The twist (hinge motor and limit, swing-twist's twist range) and the swing (swing-twist's
+  // cone) at the present poses.
+  const bool twists =
+      (k.type == JointType::hinge && (j.def.motor_enabled || j.def.limit_enabled)) ||
+      (k.type == JointType::swing_twist && j.def.limit_enabled);
+  if (twists) {
+    k.axis_a = rotate(a.orientation, j.local_axis_a);
+    k.axis_b = rotate(b.orientation, j.local_axis_b);
+    k.twist_row = angular_row(da, db, k.axis_a);
+    // The rotation from b's pose at creation relative to a to its present one, about axis_a:
+    // twice the angle of the error quaternion's part along the axis (the shorter way round).
+    const Quat e = b.orientation * conjugate(a.orientation * j.relative_orientation);
+    const Fixed along = dot(e.vector(), k.axis_a);
+    k.angle = e.w < Fixed::zero() ? atan2(-along, -e.w) * Fixed::from_int(2)
+                                  : atan2(along, e.w) * Fixed::from_int(2);
+  }
+  if (k.type == JointType::swing_twist && j.def.limit_enabled) {
+    const Vec3 parting = cross(k.axis_a, k.axis_b);
+    k.swing_angle = atan2(length(parting), dot(k.axis_a, k.axis_b));
+    k.swing_row = angular_row(da, db, normalize_or(parting, perpendicular(k.axis_a)));
+  }
   if (k.type == JointType::hinge) {
     k.axis_a = rotate(a.orientation, j.local_axis_a);
     k.axis_b = rotate(b.orientation, j.local_axis_b);
@@ -239,16 +266,6 @@ void JointSolver::update_geometry(JointConstraint& k) {
                   Vec3{entries[1][0], entries[1][1], Fixed::zero()},
                   Vec3{Fixed::zero(), Fixed::zero(), Fixed::one()}}};
     k.angular_mass = inverse(K);
-    const JointDef& def = j.def;
-    if (def.motor_enabled || def.limit_enabled) {
-      k.twist_row = angular_row(da, db, k.axis_a);
-      // The rotation from b's pose at creation relative to a to its present one, about axis_a:
-      // twice the angle of the error quaternion's part along the axis (the shorter way round).
-      const Quat e = b.orientation * conjugate(a.orientation * j.relative_orientation);
-      const Fixed along = dot(e.vector(), k.axis_a);
-      k.angle = e.w < Fixed::zero() ? atan2(-along, -e.w) * Fixed::from_int(2)
-                                    : atan2(along, e.w) * Fixed::from_int(2);
-    }
     const Vec3 misalignment = cross(k.axis_a, k.axis_b);
     k.angular_error_1 = dot(misalignment, k.across[0]);
     k.angular_error_2 = dot(misalignment, k.across[1]);
@@ -302,7 +319,8 @@ void JointSolver::update_geometry(JointConstraint& k) {
     const Vec3 v = e.vector() * Fixed::from_int(2);
     k.weld_error = e.w < Fixed::zero() ? -v : v;
   }
-  if (k.type == JointType::ball || k.type == JointType::hinge || k.type == JointType::fixed) {
+  if (k.type == JointType::ball || k.type == JointType::hinge || k.type == JointType::fixed ||
+      k.type == JointType::swing_twist) {
     k.separation = separation;
     for (std::size_t i = 0; i < 3; ++i)
       k.rows[i] = make_row(da, db, k.anchor_a, k.anchor_b, axis(i));
@@ -322,10 +340,10 @@ void JointSolver::update_geometry(JointConstraint& k) {
       K.rows[i] = {entries[0], entries[1], entries[2]};
     }
     k.point_mass = inverse(K);  // K is positive definite: one body is dynamic
-    if (k.type == JointType::hinge && (j.def.motor_enabled || j.def.limit_enabled)) {
-      // The twist row's coupling to the point rows, b_i = J_point_i M^-1 J_twist^T (the twist
-      // row has no linear part), and its effective mass with the point rows held.
-      const Row& t = k.twist_row;
+    // An angular row's coupling to the point rows, b_i = J_point_i M^-1 J_row^T (the row has no
+    // linear part), as K^-1 b, and the row's effective mass with the point rows held,
+    // 1 / (c - b . K^-1 b).
+    const auto hold_point = [&](const Row& t, Vec3& held, Fixed& mass) {
       Vec3 coupling;
       Fixed* entries[3] = {&coupling.x, &coupling.y, &coupling.z};
       for (std::size_t i = 0; i < 3; ++i)
@@ -333,11 +351,14 @@ void JointSolver::update_geometry(JointConstraint& k) {
                           .add(k.rows[i].angular_a, t.response_a)
                           .add(k.rows[i].angular_b, t.response_b)
                           .result();
-      k.twist_coupling = k.point_mass * coupling;
+      held = k.point_mass * coupling;
       const Fixed own =
           DotSum{}.add(t.angular_a, t.response_a).add(t.angular_b, t.response_b).result();
-      k.twist_mass = inverse_or_zero(own - dot(coupling, k.twist_coupling));
-    }
+      mass = inverse_or_zero(own - dot(coupling, held));
+    };
+    if (twists) hold_point(k.twist_row, k.twist_coupling, k.twist_mass);
+    if (k.type == JointType::swing_twist && j.def.limit_enabled)
+      hold_point(k.swing_row, k.swing_coupling, k.swing_mass);
     return;
   }
   // Distance: along the anchors' direction (any fixed one when they coincide).
@@ -353,7 +374,8 @@ void JointSolver::warm_start() {
     // carries no load: re-applying its old impulse (an impact's, most often) would throw the
     // bodies back a second time, as the contact kind's warm start says of points that separated.
     // A hinge whose limit stopped a 3 m/s swing rebounded at 5 m/s before this rule.
-    if (k.type == JointType::hinge && s_.joints[k.joint].def.limit_enabled) {
+    if ((k.type == JointType::hinge || k.type == JointType::swing_twist) &&
+        s_.joints[k.joint].def.limit_enabled) {
       const JointDef& def = s_.joints[k.joint].def;
       Fixed dropped;  // the twist impulse dropped, whose point compensation goes with it
       if (k.angle > def.limit_lower) {
@@ -365,6 +387,10 @@ void JointSolver::warm_start() {
         k.upper_limit_impulse = Fixed::zero();
       }
       k.impulse += k.twist_coupling * dropped;
+      if (k.type == JointType::swing_twist && k.swing_angle < def.swing_limit) {
+        k.impulse -= k.swing_coupling * k.swing_impulse;  // its impulse was -swing_impulse
+        k.swing_impulse = Fixed::zero();
+      }
     }
     if (k.type == JointType::distance && k.min_length < k.max_length) {
       if (k.length > k.min_length) k.lower_impulse = Fixed::zero();
@@ -386,7 +412,15 @@ void JointSolver::warm_start() {
                      k.slide_impulse_1, k.slide_directions[1], k.slide_rows[1], k.slide_impulse_2);
       continue;
     }
-    if (k.type == JointType::ball || k.type == JointType::hinge || k.type == JointType::fixed) {
+    if (k.type == JointType::swing_twist && s_.joints[k.joint].def.limit_enabled) {
+      const Fixed twist = k.lower_limit_impulse - k.upper_limit_impulse;
+      if (twist != Fixed::zero())
+        apply_impulse(bodies_.velocities, k.bodies, no_direction, k.twist_row, twist);
+      if (k.swing_impulse != Fixed::zero())
+        apply_impulse(bodies_.velocities, k.bodies, no_direction, k.swing_row, -k.swing_impulse);
+    }
+    if (k.type == JointType::ball || k.type == JointType::hinge || k.type == JointType::fixed ||
+        k.type == JointType::swing_twist) {
       apply_impulses(bodies_.velocities, k.bodies, k.axes, k.rows, k.impulse);
       continue;
     }
@@ -429,12 +463,37 @@ inline void JointSolver::solve_hinge_axes(JointConstraint& k, bool use_bias) {
 // start carries them too). Alone, an impulse about the axis on a body at the end of an arm
 // mostly spins the body about its own centre, which the point rows then undo: a limit on a 2 m
 // pendulum let it swing 2.5 times past its end.
-void JointSolver::apply_twist(JointConstraint& k, Fixed impulse) {
+void JointSolver::apply_held(JointConstraint& k, const Row& row, Vec3 coupling, Fixed impulse) {
   if (impulse == Fixed::zero()) return;
-  const Vec3 point = -(k.twist_coupling * impulse);
+  const Vec3 point = -(coupling * impulse);
   k.impulse += point;
   apply_impulses(bodies_.velocities, k.bodies, k.axes, k.rows, point);
-  apply_impulse(bodies_.velocities, k.bodies, no_direction, k.twist_row, impulse);
+  apply_impulse(bodies_.velocities, k.bodies, no_direction, row, impulse);
+}
+
+void JointSolver::apply_twist(JointConstraint& k, Fixed impulse) {
+  apply_held(k, k.twist_row, k.twist_coupling, impulse);
+}
+
+// Swing-twist's cone: the angle between the axes at most swing_limit, one-sided like the hinge
+// limit's ends, about the direction the axes part in.
+inline void JointSolver::solve_swing_limit(JointConstraint& k, bool use_bias) {
+  const JointDef& def = s_.joints[k.joint].def;
+  const Fixed c = def.swing_limit - k.swing_angle;
+  const Fixed cdot = -row_speed(bodies_.velocities, k.bodies, no_direction, k.swing_row);
+  Fixed impulse;
+  if (c > Fixed::zero()) {
+    impulse = -k.swing_mass * (cdot + c * bodies_.inv_h);
+  } else if (use_bias) {
+    impulse = -k.swing_mass * soft_.mass_scale * (cdot + soft_.bias_rate * c) -
+              soft_.impulse_scale * k.swing_impulse;
+  } else {
+    impulse = -k.swing_mass * cdot;
+  }
+  const Fixed next = max(k.swing_impulse + impulse, Fixed::zero());
+  impulse = next - k.swing_impulse;
+  k.swing_impulse = next;
+  apply_held(k, k.swing_row, k.swing_coupling, -impulse);
 }
 
 // The hinge motor: drives the relative speed about the axis to motor_speed with at most
@@ -563,6 +622,12 @@ void JointSolver::solve_joints(bool use_bias) {
     } else if (k.type == JointType::fixed) {
       solve_weld(k, use_bias);
       solve_ball(k, use_bias);
+    } else if (k.type == JointType::swing_twist) {
+      solve_ball(k, use_bias);
+      if (s_.joints[k.joint].def.limit_enabled) {
+        solve_hinge_limit(k, use_bias);
+        solve_swing_limit(k, use_bias);
+      }
     } else if (k.type == JointType::ball) {
       solve_ball(k, use_bias);
     } else {
@@ -621,11 +686,13 @@ void JointSolver::store_impulses() {
       j.angular_impulse = k.weld_impulse;
     if (k.type == JointType::slider)
       j.linear_impulse = k.across[0] * k.slide_impulse_1 + k.across[1] * k.slide_impulse_2;
-    if (k.type == JointType::hinge) {
+    if (k.type == JointType::hinge || k.type == JointType::swing_twist) {
       j.motor_impulse = k.motor_impulse;
       j.limit_impulse = k.lower_limit_impulse - k.upper_limit_impulse;
     }
-    j.axial_impulse = k.rigid_impulse + k.lower_impulse - k.upper_impulse;
+    j.axial_impulse = k.type == JointType::swing_twist
+                          ? k.swing_impulse
+                          : k.rigid_impulse + k.lower_impulse - k.upper_impulse;
   }
 }
 

@@ -1,5 +1,5 @@
 // Joints as a constraint kind (joint_solver.cpp), run after contacts in every stage (solve.cpp).
-// Work in progress (docs/JOINTS-WIP.md): ball, hinge, slider, fixed and distance joints are solved
+// Work in progress (docs/JOINTS-WIP.md): all six joint types are solved
 // (no limits, motors, springs or breaking yet); the other types are skipped. Internal to
 // detsim::sim.
 #pragma once
@@ -56,6 +56,13 @@ struct JointConstraint {
   Fixed motor_impulse;
   Fixed lower_limit_impulse;  ///< >= 0
   Fixed upper_limit_impulse;  ///< >= 0
+  // Swing-twist: the cone limit, one row about axis_a x axis_b (the direction the axes part in),
+  // with the point rows held like the twist row.
+  Row swing_row;
+  Vec3 swing_coupling;
+  Fixed swing_mass;
+  Fixed swing_angle;    ///< between axis_a and axis_b, radians in [0, pi]
+  Fixed swing_impulse;  ///< >= 0
   // Fixed: three angular rows about world x, y, z, solved as one 3x3 block.
   std::array<Row, 3> weld_rows;
   Mat3 weld_mass;     ///< K^-1 of the three angular rows
@@ -106,6 +113,8 @@ class JointSolver final : public ConstraintKind {
   void solve_hinge_motor(JointConstraint& k);
   void solve_hinge_limit(JointConstraint& k, bool use_bias);
   void apply_twist(JointConstraint& k, Fixed impulse);
+  void apply_held(JointConstraint& k, const Row& row, Vec3 coupling, Fixed impulse);
+  void solve_swing_limit(JointConstraint& k, bool use_bias);
   void solve_weld(JointConstraint& k, bool use_bias);
   void solve_slide(JointConstraint& k, bool use_bias);
   void solve_distance(JointConstraint& k, bool use_bias);
