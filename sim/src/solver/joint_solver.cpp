@@ -1,7 +1,6 @@
 // Joints, the second constraint kind (after contacts, solve.cpp): soft point constraints of the
 // sub-stepped solver, as Box2D v3 solves its joints, in 3D. Work in progress
-// (docs/JOINTS-WIP.md): ball, hinge, slider, fixed and distance joints; swing_twist is not solved
-// yet.
+// (docs/JOINTS-WIP.md): every type is solved; joints are not yet in the saved state.
 //
 // Unlike a contact, whose anchors stay fixed for the step, a joint's anchors turn with its bodies:
 // after every sub-step's position update (positions_moved) the anchors are rotated from each
@@ -24,9 +23,14 @@
 // then point), soft in the same way. Their error is the small angle between the axis as each
 // body carries it, (axis_a x axis_b) across each direction. Rotation about the axis is free.
 //
-// A hinge's motor and limit are rows about its axis, solved before the hinge's other rows (Jolt's
-// and Box2D's order: motor, limit, then the rest), the motor without bias and clamped to its
-// torque, the limit one-sided at each end.
+// A hinge's motor and limit are rows about its axis ("twist"), applied with the point rows held
+// (apply_held): the motor first, without bias and clamped to its torque (Box2D's order), the
+// limit last, one-sided at each end.
+//
+// A swing-twist joint is a ball joint plus, with limit_enabled, the hinge's twist limit about its
+// axis and a cone limit (the angle between the axis as each body carries it, at most
+// swing_limit) about the direction the axes part in, both after the point block and with the
+// point rows held.
 //
 // A fixed joint is a ball joint plus three angular rows about world x, y and z holding body b's
 // orientation relative to body a at creation, solved as a 3x3 block before the point block. The
@@ -92,11 +96,6 @@ void apply_impulses(std::vector<Velocity>& v, const BodyPair& k, const std::arra
         [&](std::size_t i) { return r[i].response_b; });
 }
 
-bool solved_type(JointType t) {
-  (void)t;  // every type
-  return true;
-}
-
 // A unit vector perpendicular to the unit vector n, chosen by n's components only (the contact
 // kind's, contact_solver.cpp).
 Vec3 perpendicular(Vec3 n) {
@@ -140,7 +139,7 @@ void JointSolver::prepare() {
   constraints_.reserve(s_.joints.size());
   for (std::size_t ji = 0; ji < s_.joints.size(); ++ji) {
     const JointState& j = s_.joints[ji];
-    if (j.broken || !solved_type(j.def.type)) continue;
+    if (j.broken) continue;
     const std::size_t ia = static_cast<std::size_t>(s_.find(j.def.body_a.value));
     const std::size_t ib = static_cast<std::size_t>(s_.find(j.def.body_b.value));
     const BodyState& a = s_.bodies[ia];

@@ -1,7 +1,6 @@
 // Joints as a constraint kind (joint_solver.cpp), run after contacts in every stage (solve.cpp).
-// Work in progress (docs/JOINTS-WIP.md): all six joint types are solved
-// (no limits, motors, springs or breaking yet); the other types are skipped. Internal to
-// detsim::sim.
+// Work in progress (docs/JOINTS-WIP.md): all six joint types are solved (the slider without its
+// limit and motor, swing-twist without a motor). Internal to detsim::sim.
 #pragma once
 
 #include <array>
