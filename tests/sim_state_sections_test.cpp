@@ -47,7 +47,8 @@ void put_var(Bytes& out, std::uint64_t v) {
 }
 
 // The container as docs/STATE.md specifies it, written here independently of state_io.cpp.
-Bytes container(const std::vector<Section>& sections, std::uint32_t version = 3) {
+Bytes container(const std::vector<Section>& sections,
+                std::uint32_t version = state_encoding_version) {
   Bytes out{'D', 'S', 'I', 'M'};
   for (int i = 0; i < 4; ++i)
     out.push_back(static_cast<std::uint8_t>(version >> (8 * i)));
@@ -75,17 +76,17 @@ void expect_refused(const Bytes& bad, std::initializer_list<const char*> parts) 
   EXPECT_EQ(w.save(), before);
 }
 
-TEST(StateSections, AWorldsStateIsItsFourSectionsAndTheirHashes) {
+TEST(StateSections, AWorldsStateIsItsFiveSectionsAndTheirHashes) {
   const World w = sample_world();
   const Bytes state = w.save();
   auto found = read_state_sections(state);
   ASSERT_TRUE(found.ok()) << found.message();
   const StateHashes h = w.hashes();
-  ASSERT_EQ(found->size(), 4U);
-  ASSERT_EQ(h.sections.size(), 4U);
-  const char* names[] = {"globals", "rng", "bodies", "contacts"};
-  std::size_t next = 9;  // magic, version, the count 4 in one byte
-  for (std::size_t i = 0; i < 4; ++i) {
+  ASSERT_EQ(found->size(), 5U);
+  ASSERT_EQ(h.sections.size(), 5U);
+  const char* names[] = {"globals", "rng", "bodies", "contacts", "joints"};
+  std::size_t next = 9;  // magic, version, the count 5 in one byte
+  for (std::size_t i = 0; i < 5; ++i) {
     const StateSection& s = (*found)[i];
     EXPECT_EQ(s.name, names[i]);
     EXPECT_EQ(s.version, 1U);
@@ -116,7 +117,7 @@ TEST(StateSections, TheListOfSectionsMustBeAWorlds) {
   expect_refused(container(swapped), {"section \"rng\"", "section \"globals\" was expected"});
 
   std::vector<Section> missing(good.begin(), good.end() - 1);
-  expect_refused(container(missing), {"section \"contacts\" is missing"});
+  expect_refused(container(missing), {"section \"joints\" is missing"});
 
   std::vector<Section> newer = good;
   newer[2].version = 2;
@@ -159,7 +160,7 @@ TEST(StateSections, TheContainerIsChecked) {
   Bytes huge(state.begin(), state.begin() + 8);
   put_var(huge, 0xFFFFFFFFFFULL);
   expect_refused(huge, {"section count", "exceeds"});
-  expect_refused(container(good, 2), {"state encoding version 2, this build reads 3"});
+  expect_refused(container(good, 3), {"state encoding version 3, this build reads 4"});
 }
 
 }  // namespace

@@ -11,12 +11,28 @@
 #include <detsim/fixed/quat.hpp>
 
 #include "body_fields.hpp"
+#include "joint_fields.hpp"
 #include "shapes.hpp"
 #include "state_io.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
 namespace {
+
+/// The joint's fields from its table (joint_fields.hpp), with the delta each takes.
+std::string joint_fields_help() {
+  using sim_detail::JointFieldKind;
+  std::string out;
+  for (const sim_detail::JointField& f : sim_detail::joint_fields()) {
+    std::string form = f.name;
+    if (f.kind == JointFieldKind::vec3) form += ".x|y|z";
+    if (f.kind == JointFieldKind::quat) form += ".w|x|y|z";
+    if (f.kind == JointFieldKind::flag) form += " (1 toggles)";
+    if (f.kind == JointFieldKind::u64) form += " (an integer)";
+    out += (out.empty() ? "" : ", ") + form;
+  }
+  return out;
+}
 
 /// The field forms, for errors and --help: the body's motion fields from the field table, then
 /// the forms that are not body fields. Built once.
@@ -53,7 +69,8 @@ const std::string& fields_help() {
            " (DELTA an integer, added); present (DELTA -1 removes BODY, +1 adds a static copy of "
            "its shape 1000 m above); rng.state[0..3] (BODY 0, DELTA an integer, added mod 2^64); "
            "contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2 (DELTA a "
-           "decimal)";
+           "decimal); joint[J].FIELD (BODY 0; FIELD a field of the joint as diff names it: " +
+           joint_fields_help() + ")";
   }();
   return help;
 }
@@ -63,11 +80,12 @@ enum class DeltaKind { fixed, toggle, integer, presence };
 /// What a field name refers to, once parsed.
 struct Target {
   DeltaKind kind = DeltaKind::fixed;
-  enum class Part { body, rng, contact } part = Part::body;
+  enum class Part { body, rng, contact, joint } part = Part::body;
   std::string base;         ///< "position", "sleep_time", "normal_impulse", ...
   int component = -1;       ///< x y z = 0 1 2, w = 3; the RNG word; -1: none
   std::uint32_t other = 0;  ///< contact: the other body
   std::size_t point = 0;    ///< contact: the point
+  std::uint32_t joint = 0;  ///< joint: its ID
 };
 
 /// A decimal without sign or leading zeros ("0" itself is fine).
@@ -130,6 +148,35 @@ Expected<Target> parse_field(std::string_view field) {
     t.base = std::string(name);
     return t;
   }
+  if (field.starts_with("joint[")) {
+    std::string_view rest;
+    auto joint = indexed(field, "joint", rest);
+    if (!joint || *joint == 0 || *joint > 0xFFFFFFFFU || !rest.starts_with(".")) return unknown();
+    rest.remove_prefix(1);
+    std::string_view base = rest;
+    int component = -1;
+    const std::size_t dot = rest.rfind('.');
+    if (dot != std::string_view::npos && dot + 2 == rest.size()) {
+      const char c = rest.back();
+      base = rest.substr(0, dot);
+      component = c == 'w' ? 3 : c >= 'x' && c <= 'z' ? c - 'x' : -2;
+    }
+    const sim_detail::JointField* f = sim_detail::find_joint_field(base);
+    if (f == nullptr) return unknown();
+    using sim_detail::JointFieldKind;
+    const bool whole = f->kind != JointFieldKind::vec3 && f->kind != JointFieldKind::quat;
+    if (whole ? component != -1
+              : component < 0 || (f->kind == JointFieldKind::vec3 && component == 3))
+      return unknown();
+    t.part = Target::Part::joint;
+    t.joint = static_cast<std::uint32_t>(*joint);
+    t.base = f->name;
+    t.component = component;
+    t.kind = f->kind == JointFieldKind::flag  ? DeltaKind::toggle
+             : f->kind == JointFieldKind::u64 ? DeltaKind::integer
+                                              : DeltaKind::fixed;
+    return t;
+  }
   if (field == "present") {
     t.base = "present";
     t.kind = DeltaKind::presence;
@@ -166,7 +213,8 @@ Status check_delta(const Target& t, std::string_view delta) {
       return Status::success();
     }
     case DeltaKind::toggle:
-      if (delta != "1") return Status::error("DELTA for awake must be 1 (toggle the flag)");
+      if (delta != "1")
+        return Status::error("DELTA for " + t.base + " must be 1 (toggle the flag)");
       return Status::success();
     case DeltaKind::integer:
       if (!parse_i64(delta))
@@ -212,6 +260,33 @@ Status change_body(BodyState& b, const Target& t, std::string_view delta) {
   }
   if (auto e = sim_detail::check_body_record(b); !e.empty())
     return Status::error("body " + std::to_string(b.id.value) +
+                         ": the change would leave an invalid state: " + e);
+  return Status::success();
+}
+
+// Changes a copy of the joint's field, then checks it as restore() would.
+Status change_joint(const sim_detail::WorldState& s, JointState& j, const Target& t,
+                    std::string_view delta) {
+  const sim_detail::JointField& f = *sim_detail::find_joint_field(t.base);
+  switch (f.kind) {
+    case sim_detail::JointFieldKind::fixed:
+      f.fixed(j) += Fixed::parse(delta).value;
+      break;
+    case sim_detail::JointFieldKind::vec3:
+      field_ref(f.vec3(j), t.component) += Fixed::parse(delta).value;
+      break;
+    case sim_detail::JointFieldKind::quat:
+      field_ref(f.quat(j), t.component) += Fixed::parse(delta).value;
+      break;
+    case sim_detail::JointFieldKind::u64:
+      f.u64(j) += static_cast<std::uint64_t>(*parse_i64(delta));  // modulo 2^64
+      break;
+    case sim_detail::JointFieldKind::flag:
+      f.flag(j) = !f.flag(j);
+      break;
+  }
+  if (auto e = sim_detail::check_joint_record(s, j); !e.empty())
+    return Status::error("joint " + std::to_string(j.id.value) +
                          ": the change would leave an invalid state: " + e);
   return Status::success();
 }
@@ -281,7 +356,9 @@ Expected<Injection> parse_injection(std::string_view spec) {
   if (!target) return Status::error(where + target.message());
   if (target->part == Target::Part::rng && *body != 0)
     return Status::error(where + "BODY must be 0 for an RNG field");
-  if (target->part != Target::Part::rng && *body == 0)
+  if (target->part == Target::Part::joint && *body != 0)
+    return Status::error(where + "BODY must be 0 for a joint field (the joint is named in it)");
+  if (target->part != Target::Part::rng && target->part != Target::Part::joint && *body == 0)
     return Status::error(where + "BODY must be a body ID (IDs start at 1)");
   if (target->part == Target::Part::contact && target->other == *body)
     return Status::error(where + "a contact is between BODY and another body, not itself");
@@ -308,6 +385,16 @@ Status apply_injection(World& world, const Injection& injection) {
         static_cast<std::uint64_t>(*parse_i64(injection.delta));
     if (!s.rng.set_state(state))
       return Status::error(where + "the change would leave the all-zero RNG state");
+    return Status::success();
+  }
+
+  if (t.part == Target::Part::joint) {
+    const std::ptrdiff_t j = s.find_joint(t.joint);
+    if (j < 0) return Status::error(where + "no joint with ID " + std::to_string(t.joint));
+    JointState changed = s.joints[static_cast<std::size_t>(j)];
+    if (Status st = change_joint(s, changed, t, injection.delta); !st)
+      return Status::error(where + st.message());
+    s.joints[static_cast<std::size_t>(j)] = changed;
     return Status::success();
   }
 

@@ -1,7 +1,8 @@
 // Field-level state comparison (state_diff.hpp). Both states are restored into scratch worlds
 // (so both are fully validated); each section whose hash differs is compared by its differ
 // (kDiffers): bodies field by field through the field table (body_fields.hpp), contacts pair by
-// pair (World::contacts()), point by point. A section without a differ is named by its hashes.
+// pair (World::contacts()), point by point, joints field by field through their table
+// (joint_fields.hpp). A section without a differ is named by its hashes.
 #include <detsim/sim/state_diff.hpp>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <detsim/fixed/decimal.hpp>
 
 #include "body_fields.hpp"
+#include "joint_fields.hpp"
 
 namespace detsim {
 namespace {
@@ -28,6 +30,23 @@ std::string show(std::uint64_t v) {
 }
 std::string show(bool v) {
   return v ? "true" : "false";
+}
+std::string show(JointType t) {
+  switch (t) {
+    case JointType::ball:
+      return "ball";
+    case JointType::hinge:
+      return "hinge";
+    case JointType::slider:
+      return "slider";
+    case JointType::fixed:
+      return "fixed";
+    case JointType::distance:
+      return "distance";
+    case JointType::swing_twist:
+      return "swing_twist";
+  }
+  return "unknown";
 }
 std::string show(BodyType t) {
   switch (t) {
@@ -58,16 +77,18 @@ class Collector {
              const char* subsystem = "bodies") {
     if (!(a == b)) add(subsystem, body, name, show(a), show(b));
   }
-  void vec(std::uint32_t body, const std::string& name, Vec3 a, Vec3 b) {
-    field(body, name + ".x", a.x, b.x);
-    field(body, name + ".y", a.y, b.y);
-    field(body, name + ".z", a.z, b.z);
+  void vec(std::uint32_t body, const std::string& name, Vec3 a, Vec3 b,
+           const char* subsystem = "bodies") {
+    field(body, name + ".x", a.x, b.x, subsystem);
+    field(body, name + ".y", a.y, b.y, subsystem);
+    field(body, name + ".z", a.z, b.z, subsystem);
   }
-  void quat(std::uint32_t body, const std::string& name, Quat a, Quat b) {
-    field(body, name + ".w", a.w, b.w);
-    field(body, name + ".x", a.x, b.x);
-    field(body, name + ".y", a.y, b.y);
-    field(body, name + ".z", a.z, b.z);
+  void quat(std::uint32_t body, const std::string& name, Quat a, Quat b,
+            const char* subsystem = "bodies") {
+    field(body, name + ".w", a.w, b.w, subsystem);
+    field(body, name + ".x", a.x, b.x, subsystem);
+    field(body, name + ".y", a.y, b.y, subsystem);
+    field(body, name + ".z", a.z, b.z, subsystem);
   }
 
  private:
@@ -150,6 +171,42 @@ void diff_contacts(Collector& c, const std::vector<ContactState>& ca,
   }
 }
 
+std::string joint_name(JointId id) {
+  return "joint[" + std::to_string(id.value) + "]";
+}
+
+// A joint's identity (type, bodies), then every field of the table (joint_fields.hpp) in its
+// order. Joints belong to no one body: their lines have body 0 and name the joint in the field.
+void diff_joint(Collector& c, JointState a, JointState b) {
+  const std::string name = joint_name(a.id) + ".";
+  const char* section = "joints";
+  c.field(0, name + "type", a.def.type, b.def.type, section);
+  c.field(0, name + "body_a", std::uint64_t{a.def.body_a.value}, std::uint64_t{b.def.body_a.value},
+          section);
+  c.field(0, name + "body_b", std::uint64_t{a.def.body_b.value}, std::uint64_t{b.def.body_b.value},
+          section);
+  for (const sim_detail::JointField& f : sim_detail::joint_fields()) {
+    const std::string field = name + f.name;
+    switch (f.kind) {
+      case sim_detail::JointFieldKind::fixed:
+        c.field(0, field, f.fixed(a), f.fixed(b), section);
+        break;
+      case sim_detail::JointFieldKind::vec3:
+        c.vec(0, field, f.vec3(a), f.vec3(b), section);
+        break;
+      case sim_detail::JointFieldKind::quat:
+        c.quat(0, field, f.quat(a), f.quat(b), section);
+        break;
+      case sim_detail::JointFieldKind::u64:
+        c.field(0, field, f.u64(a), f.u64(b), section);
+        break;
+      case sim_detail::JointFieldKind::flag:
+        c.field(0, field, f.flag(a), f.flag(b), section);
+        break;
+    }
+  }
+}
+
 // ---- Sections: each a differ that lists its fields; any other section is named by its hash ----
 
 struct Sides {
@@ -196,6 +253,27 @@ void diff_contact_cache(Collector& c, const Sides& w) {
   diff_contacts(c, w.a.contacts(), w.b.contacts());
 }
 
+// A merge of both ascending joint ID lists; a joint on one side only is "present".
+void diff_joints(Collector& c, const Sides& w) {
+  const std::vector<JointId> ia = w.a.joint_ids();
+  const std::vector<JointId> ib = w.b.joint_ids();
+  std::size_t i = 0;
+  std::size_t j = 0;
+  while (i < ia.size() || j < ib.size()) {
+    if (j == ib.size() || (i < ia.size() && ia[i] < ib[j])) {
+      c.add("joints", 0, joint_name(ia[i]) + ".present", "present", "absent");
+      ++i;
+    } else if (i == ia.size() || ib[j] < ia[i]) {
+      c.add("joints", 0, joint_name(ib[j]) + ".present", "absent", "present");
+      ++j;
+    } else {
+      diff_joint(c, w.a.joint(ia[i]).value(), w.b.joint(ib[j]).value());
+      ++i;
+      ++j;
+    }
+  }
+}
+
 struct SectionDiffer {
   std::string_view name;
   void (*diff)(Collector& c, const Sides& w);
@@ -203,10 +281,8 @@ struct SectionDiffer {
 
 /// A new section of the World's state adds its differ here.
 constexpr SectionDiffer kDiffers[] = {
-    {"globals", diff_globals},
-    {"rng", diff_rng},
-    {"bodies", diff_bodies},
-    {"contacts", diff_contact_cache},
+    {"globals", diff_globals},        {"rng", diff_rng},       {"bodies", diff_bodies},
+    {"contacts", diff_contact_cache}, {"joints", diff_joints},
 };
 
 /// Every section name of either side: A's in order, then those only B has.

@@ -1,5 +1,6 @@
 // The canonical state encoding (docs/STATE.md): the container of sections, the World's sections
-// (globals, rng, bodies in state_bodies.cpp, contacts), save, restore and the hashes.
+// (globals, rng, bodies in state_bodies.cpp, contacts, joints in state_joints.cpp), save, restore
+// and the hashes.
 //
 // A World's state is one list of sections, each with its name, version and length; the World's
 // sections are described once, in kSections below, and save, restore and the hashes walk that
@@ -239,10 +240,9 @@ struct WorldSection {
 /// The World's sections, in the order a state lists them: a new kind of state (joints, particle
 /// groups, controllers) is a row here, after the bodies it refers to.
 constexpr WorldSection kSections[] = {
-    {"globals", 1, write_globals, read_globals},
-    {"rng", 1, write_rng_section, read_rng},
-    {"bodies", 1, write_bodies, read_bodies},
-    {"contacts", 1, write_contacts, read_contacts},
+    {"globals", 1, write_globals, read_globals}, {"rng", 1, write_rng_section, read_rng},
+    {"bodies", 1, write_bodies, read_bodies},    {"contacts", 1, write_contacts, read_contacts},
+    {"joints", 1, write_joints, read_joints},
 };
 constexpr std::size_t kSectionCount = std::size(kSections);
 
@@ -256,7 +256,7 @@ struct Encoded {
 };
 
 void encode(const WorldState& s, Encoded& e) {
-  e.w.reserve(256 + s.bodies.size() * 96 + s.contacts.size() * 72);
+  e.w.reserve(256 + s.bodies.size() * 96 + s.contacts.size() * 72 + s.joints.size() * 96);
   e.w.u32(kMagic);
   e.w.u32(kVersion);
   e.w.var(kSectionCount);

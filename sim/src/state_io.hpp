@@ -1,5 +1,6 @@
 // The sections of the canonical state (docs/STATE.md), internal to detsim::sim: what state_io.cpp
-// (the container, globals, rng, contacts) and state_bodies.cpp (the bodies) share.
+// (the container, globals, rng, contacts), state_bodies.cpp (the bodies) and state_joints.cpp
+// (the joints) share.
 #pragma once
 
 #include <cstdint>
@@ -18,6 +19,13 @@ void write_bodies(const WorldState& s, ByteWriter& w);
 /// on failure returns false with `error` set ("byte N: ...") or the reader failed.
 bool read_bodies(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState& s,
                  std::string& error);
+/// The "joints" payload (state_joints.cpp), and its reader (bodies already read).
+void write_joints(const WorldState& s, ByteWriter& w);
+bool read_joints(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState& s,
+                 std::string& error);
+/// The checks restore() makes of a joint against the bodies of `s` ("" when valid): what --inject
+/// must keep.
+[[nodiscard]] std::string check_joint_record(const WorldState& s, const JointState& j);
 /// The checks restore() makes of a body's motion fields ("" when valid): what --inject must keep.
 [[nodiscard]] std::string check_body_record(const BodyState& b);
 

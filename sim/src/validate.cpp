@@ -119,6 +119,14 @@ std::string check_mass_properties(const BodyDef& def) {
 
 }  // namespace
 
+std::string check_unit_vector(const char* what, Vec3 v) {
+  const Fixed l2 = length_squared(v);
+  if (abs(l2 - Fixed::one()) > kUnitTolerance)
+    return std::string(what) + " must be a unit vector (|" + what +
+           "|^2 within 2^-20 of 1), got |" + what + "|^2 = " + str(l2);
+  return {};
+}
+
 std::string check_orientation(Quat q) {
   const Fixed l2 = length_squared(q);
   if (abs(l2 - Fixed::one()) > kUnitTolerance)
@@ -188,21 +196,24 @@ std::string check_joint_body(const WorldState& s, const char* field, BodyId id) 
 }  // namespace
 
 std::string check_joint_def(const WorldState& s, const JointDef& def) {
+  if (auto e = check_joint_fields(s, def); !e.empty()) return e;
+  const BodyState& a = s.bodies[static_cast<std::size_t>(s.find(def.body_a.value))];
+  const BodyState& b = s.bodies[static_cast<std::size_t>(s.find(def.body_b.value))];
+  if (a.type == BodyType::static_body && b.type == BodyType::static_body)
+    return "body_a (" + std::to_string(def.body_a.value) + ") and body_b (" +
+           std::to_string(def.body_b.value) + ") are both static: at most one may be";
+  return {};
+}
+
+std::string check_joint_fields(const WorldState& s, const JointDef& def) {
   if (static_cast<unsigned>(def.type) > static_cast<unsigned>(JointType::swing_twist))
     return "unknown joint type " + std::to_string(static_cast<unsigned>(def.type));
   if (auto e = check_joint_body(s, "body_a", def.body_a); !e.empty()) return e;
   if (auto e = check_joint_body(s, "body_b", def.body_b); !e.empty()) return e;
   if (def.body_a == def.body_b)
     return "body_a and body_b must differ, both are body " + std::to_string(def.body_a.value);
-  const BodyState& a = s.bodies[static_cast<std::size_t>(s.find(def.body_a.value))];
-  const BodyState& b = s.bodies[static_cast<std::size_t>(s.find(def.body_b.value))];
-  if (a.type == BodyType::static_body && b.type == BodyType::static_body)
-    return "body_a (" + std::to_string(def.body_a.value) + ") and body_b (" +
-           std::to_string(def.body_b.value) + ") are both static: at most one may be";
   if (auto e = check_components("anchor", def.anchor, max_position, "m"); !e.empty()) return e;
-  const Fixed l2 = length_squared(def.axis);
-  if (abs(l2 - Fixed::one()) > kUnitTolerance)
-    return "axis must be a unit vector (|axis|^2 within 2^-20 of 1), got |axis|^2 = " + str(l2);
+  if (auto e = check_unit_vector("axis", def.axis); !e.empty()) return e;
   if (def.limit_lower > def.limit_upper)
     return "limit_lower must be <= limit_upper, got limit_lower " + str(def.limit_lower) +
            " > limit_upper " + str(def.limit_upper);

@@ -1,10 +1,10 @@
 // The World's state, internal to detsim::sim.
 //
 // Saved state (everything that affects the future, docs/DETERMINISM.md rule 5): the definition,
-// the frame counter, the ID counter, the RNG, the bodies (sorted by ID) and the contact cache
-// (sorted by ID pair) with its warm-start impulses. Derived data (poses, world-space inverse
-// inertia, bounding boxes, solver scratch) is rebuilt from it at the start of every step, so a
-// restored world steps exactly like the one that was saved.
+// the frame counter, the ID counters, the RNG, the bodies (sorted by ID), the contact cache
+// (sorted by ID pair) with its warm-start impulses and the joints (sorted by ID) with theirs.
+// Derived data (poses, world-space inverse inertia, bounding boxes, solver scratch) is rebuilt from
+// it at the start of every step, so a restored world steps exactly like the one that was saved.
 #pragma once
 
 #include <array>
@@ -79,11 +79,9 @@ struct WorldState {
   std::uint64_t frame = 0;
   std::uint32_t next_id = 1;
   Rng rng;
-  std::vector<BodyState> bodies;  ///< ascending ID
-  std::vector<Contact> contacts;  ///< ascending (a, b)
-  /// Ascending ID. Work in progress (docs/JOINTS-WIP.md): not yet a state section, so save,
-  /// restore and the hashes do not see joints or next_joint_id.
-  std::vector<JointState> joints;
+  std::vector<BodyState> bodies;   ///< ascending ID
+  std::vector<Contact> contacts;   ///< ascending (a, b)
+  std::vector<JointState> joints;  ///< ascending ID
   std::uint32_t next_joint_id = 1;
   std::vector<Derived> derived;  ///< rebuilt each step
   /// The broadphase's sweep order at the last step (body indices): where the next step's sort
@@ -103,9 +101,14 @@ struct WorldState {
 [[nodiscard]] std::string check_world_def(const WorldDef& def);
 [[nodiscard]] std::string check_shape(const Shape& shape, BodyType type);
 [[nodiscard]] std::string check_orientation(Quat q);
+/// "<what> must be a unit vector ..." unless | |v|^2 - 1 | <= 2^-20 (the orientations' tolerance).
+[[nodiscard]] std::string check_unit_vector(const char* what, Vec3 v);
 [[nodiscard]] std::string check_body_def(const BodyDef& def);
 /// A joint definition against the world's bodies (validate.cpp): "" when valid.
 [[nodiscard]] std::string check_joint_def(const WorldState& s, const JointDef& def);
+/// check_joint_def without "at most one body static": what a saved joint must satisfy (set_type
+/// may make both of a joint's bodies static after its creation; the solver skips such a joint).
+[[nodiscard]] std::string check_joint_fields(const WorldState& s, const JointDef& def);
 /// The limits of limits.hpp for calls: "" when within them, else the refusal's message.
 /// Each component of v within +-limit ("<what> x must be within +-limit unit, got v").
 [[nodiscard]] std::string check_components(const char* what, Vec3 v, Fixed limit, const char* unit);

@@ -1,19 +1,24 @@
-// An independent codec of the v3 world-state layout (docs/STATE.md), for the world-state tests
+// An independent codec of the v4 world-state layout (docs/STATE.md), for the world-state tests
 // (support/state_helpers.hpp includes it).
 //
 // Written from docs/STATE.md, not from state_io.cpp, so that the two can disagree. In brief:
-//   "DSIM" u32 version=3 | var section count (4) | four sections, each: var name length, name,
+//   "DSIM" u32 version=4 | var section count (5) | five sections, each: var name length, name,
 //   var section version (1), u32 payload length, payload. The payloads, in this order:
 //   globals: u64 frame | u32 next ID | definition (fixed width);  rng: 4 x u64;
 //   bodies: u32 property-set count, sets in first-use order | u32 body count, bodies ascending by
-//   ID;  contacts: u32 contact count, contacts ascending by (a, b).
+//   ID;  contacts: u32 contact count, contacts ascending by (a, b);  joints: u32 next joint ID,
+//   u32 joint count, joints ascending by ID.
 // `var` is canonical LEB128 (at most 5 bytes for a 32-bit field, 10 for a 64-bit one); `vfixed` a
 // var of the zigzag raw value. A set: type u8, shape (type u8, then its vfixed sizes), mass,
 // inertia, friction, restitution, linear and angular damping (vfixed), layer u32, mask u32, flags
 // u8 (sensor, CCD). A body: ID step var, set index var, flags u8 (awake, user data, force, torque
 // follow), position, orientation, velocities, sleep time (vfixed), then the flagged values. A
 // contact: a step var, b - a var, point byte (count in bits 0-2, reported in bit 3), then per
-// point: feature on a, feature on b (var: index * 4 + kind), three impulses (vfixed).
+// point: feature on a, feature on b (var: index * 4 + kind), three impulses (vfixed). A joint: ID
+// step var, type u8 (0-5), body a var, body b var, flags u8 (limit enabled, motor enabled, collide
+// connected, broken, user data follows), anchor, axis (vec3), eleven definition numbers (vfixed),
+// local anchors a and b, local axes a and b (vec3), relative orientation (quat), length (vfixed),
+// linear and angular impulse (vec3), axial, motor and limit impulse (vfixed), then the user data.
 //
 // decode() is strict about what the layout itself says (canonical vars, enum values, flag bits,
 // zero values flagged present, set order and use, ID and pair order, point bytes, features) and
@@ -42,9 +47,10 @@ namespace detsim::state_test {
 using Bytes = std::vector<std::uint8_t>;
 
 inline constexpr std::uint32_t kStateMagic = 0x4D495344U;
-inline constexpr std::uint32_t kStateVersion = 3;
+inline constexpr std::uint32_t kStateVersion = 4;
 /// A World's sections, in their order, each at version 1.
-inline constexpr const char* kSectionNames[] = {"globals", "rng", "bodies", "contacts"};
+inline constexpr const char* kSectionNames[] = {"globals", "rng", "bodies", "contacts", "joints"};
+inline constexpr std::size_t kSectionCount = 5;
 inline constexpr std::uint32_t kSectionVersion = 1;
 
 // Body flags.
@@ -58,6 +64,12 @@ inline constexpr std::uint8_t kCcd = 2;
 // A contact's point byte.
 inline constexpr std::uint8_t kPointCountBits = 7;
 inline constexpr std::uint8_t kReported = 8;
+// Joint flags.
+inline constexpr std::uint8_t kLimitEnabled = 1;
+inline constexpr std::uint8_t kMotorEnabled = 2;
+inline constexpr std::uint8_t kCollideConnected = 4;
+inline constexpr std::uint8_t kBroken = 8;
+inline constexpr std::uint8_t kJointHasUserData = 16;
 
 // The bytes of the world definition (fixed width) and the offsets of two of its fields.
 inline constexpr std::size_t kDefinitionBytes = 137;
@@ -219,6 +231,43 @@ struct DecodedContact {
   [[nodiscard]] bool reported() const { return (points_byte & kReported) != 0; }
 };
 
+struct DecodedJoint {
+  std::uint64_t id_step = 0;  // the ID minus the previous joint's
+  std::uint8_t type = 0;      // JointType's value (any byte)
+  std::uint64_t body_a = 0;
+  std::uint64_t body_b = 0;
+  std::uint8_t flags = 0;  // kLimitEnabled, kMotorEnabled, kCollideConnected, kBroken, user data
+  Vec3 anchor{};
+  Vec3 axis{};
+  // limit lower, limit upper, swing limit, motor speed, motor max force, min length, max length,
+  // spring frequency, spring damping ratio, break force, break torque.
+  std::array<Fixed, 11> numbers{};
+  Vec3 local_anchor_a{};
+  Vec3 local_anchor_b{};
+  Vec3 local_axis_a{};
+  Vec3 local_axis_b{};
+  Quat relative_orientation{};
+  Fixed length{};
+  Vec3 linear_impulse{};
+  Vec3 angular_impulse{};
+  Fixed axial_impulse{};
+  Fixed motor_impulse{};
+  Fixed limit_impulse{};
+  std::uint64_t user_data = 0;  // written only when `flags` says so
+  // Filled by decode(), ignored by encode():
+  std::uint32_t id = 0;
+  std::size_t at = 0;  // the record, = its ID step
+  std::size_t type_at = 0;
+  std::size_t body_a_at = 0;
+  std::size_t flags_at = 0;
+  std::size_t axis_at = 0;
+  std::size_t numbers_at = 0;
+  std::size_t local_axis_a_at = 0;
+  std::size_t relative_orientation_at = 0;
+  std::size_t length_at = 0;
+  std::size_t end = 0;
+};
+
 struct Decoded {
   bool ok = false;
   std::string error;  // "byte N: what", the first error
@@ -231,11 +280,13 @@ struct Decoded {
   std::vector<DecodedSet> sets;
   std::vector<DecodedBody> bodies;
   std::vector<DecodedContact> contacts;
+  std::uint32_t next_joint_id = 1;
+  std::vector<DecodedJoint> joints;
   // Offsets, filled by decode(): of each section's record (its name length), its u32 payload
   // length and its payload, in kSectionNames' order; then of the payloads' fields.
-  std::array<std::size_t, 4> section_at{};
-  std::array<std::size_t, 4> section_length_at{};
-  std::array<std::size_t, 4> payload_at{};
+  std::array<std::size_t, kSectionCount> section_at{};
+  std::array<std::size_t, kSectionCount> section_length_at{};
+  std::array<std::size_t, kSectionCount> payload_at{};
   std::size_t globals_at = 0;  // the frame
   std::size_t next_id_at = 0;
   std::size_t def_at = 0;
@@ -243,6 +294,8 @@ struct Decoded {
   std::size_t property_count_at = 0;
   std::size_t body_count_at = 0;
   std::size_t contact_count_at = 0;
+  std::size_t next_joint_id_at = 0;
+  std::size_t joint_count_at = 0;
   std::size_t end = 0;
 };
 
@@ -500,7 +553,54 @@ inline void read_contact(StateReader& r, Decoded& d, std::uint64_t& previous_a,
   d.contacts.push_back(c);
 }
 
-/// Decodes a whole v2 state; `ok` is false and `error` names the first problem otherwise (what was
+inline void read_joint(StateReader& r, Decoded& d, std::uint64_t& previous_id) {
+  DecodedJoint j;
+  j.at = r.at();
+  j.id_step = r.var("joint ID step", 32);
+  if (r.ok() && j.id_step == 0) r.fail(j.at, "joint ID step: zero");
+  const std::uint64_t id = previous_id + j.id_step;
+  if (r.ok() && id >= d.next_joint_id) r.fail(j.at, "joint ID: not below the next joint ID");
+  previous_id = id;
+  j.id = static_cast<std::uint32_t>(id);
+  j.type_at = r.at();
+  j.type = r.u8("joint type");
+  if (r.ok() && j.type > 5) r.fail(j.type_at, "joint type: not 0 to 5");
+  j.body_a_at = r.at();
+  j.body_a = r.var("joint body a", 32);
+  j.body_b = r.var("joint body b", 32);
+  j.flags_at = r.at();
+  j.flags = r.u8("joint flags");
+  if (r.ok() && j.flags >= 32) r.fail(j.flags_at, "joint flags: an unknown bit");
+  j.anchor = r.vvec3("joint anchor");
+  j.axis_at = r.at();
+  j.axis = r.vvec3("joint axis");
+  j.numbers_at = r.at();
+  for (Fixed& f : j.numbers)
+    f = r.vfixed("joint definition number");
+  j.local_anchor_a = r.vvec3("local anchor a");
+  j.local_anchor_b = r.vvec3("local anchor b");
+  j.local_axis_a_at = r.at();
+  j.local_axis_a = r.vvec3("local axis a");
+  j.local_axis_b = r.vvec3("local axis b");
+  j.relative_orientation_at = r.at();
+  j.relative_orientation = r.vquat("relative orientation");
+  j.length_at = r.at();
+  j.length = r.vfixed("length");
+  j.linear_impulse = r.vvec3("linear impulse");
+  j.angular_impulse = r.vvec3("angular impulse");
+  j.axial_impulse = r.vfixed("axial impulse");
+  j.motor_impulse = r.vfixed("motor impulse");
+  j.limit_impulse = r.vfixed("limit impulse");
+  if ((j.flags & kJointHasUserData) != 0) {
+    const std::size_t at = r.at();
+    j.user_data = r.var("joint user data", 64);
+    if (r.ok() && j.user_data == 0) r.fail(at, "joint user data: flagged present but zero");
+  }
+  j.end = r.at();
+  d.joints.push_back(j);
+}
+
+/// Decodes a whole v4 state; `ok` is false and `error` names the first problem otherwise (what was
 /// decoded up to there is kept).
 inline Decoded decode(std::span<const std::uint8_t> bytes) {
   Decoded d;
@@ -511,8 +611,8 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
   if (r.ok() && d.version != kStateVersion) r.fail(4, "version");
   const std::size_t count_at = r.at();
   const std::uint64_t sections = r.var("section count", 64);
-  if (r.ok() && sections != 4) r.fail(count_at, "section count: not 4");
-  for (std::size_t i = 0; i < 4 && r.ok(); ++i) {
+  if (r.ok() && sections != kSectionCount) r.fail(count_at, "section count: not 5");
+  for (std::size_t i = 0; i < kSectionCount && r.ok(); ++i) {
     // The section's record: its name, its version, its payload's length; the payload must end
     // exactly where the length says.
     d.section_at[i] = r.at();
@@ -560,6 +660,17 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
         for (std::uint32_t k = 0; k < body_count && r.ok(); ++k)
           read_body(r, d, previous_id, used);
         if (r.ok() && used != d.sets.size()) r.fail(d.property_count_at, "property set: unused");
+        break;
+      }
+      case 4: {
+        d.next_joint_id_at = r.at();
+        d.next_joint_id = r.u32("next joint ID");
+        if (r.ok() && d.next_joint_id == 0) r.fail(d.next_joint_id_at, "next joint ID: zero");
+        d.joint_count_at = r.at();
+        const std::uint32_t joint_count = r.u32("joint count");
+        std::uint64_t previous_id = 0;
+        for (std::uint32_t k = 0; k < joint_count && r.ok(); ++k)
+          read_joint(r, d, previous_id);
         break;
       }
       default: {
@@ -672,10 +783,34 @@ inline void write_contact(StateWriter& w, const DecodedContact& c) {
   }
 }
 
-/// The v3 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
+inline void write_joint(StateWriter& w, const DecodedJoint& j) {
+  w.var(j.id_step);
+  w.u8(j.type);
+  w.var(j.body_a);
+  w.var(j.body_b);
+  w.u8(j.flags);
+  w.vvec3(j.anchor);
+  w.vvec3(j.axis);
+  for (const Fixed f : j.numbers)
+    w.vfixed(f);
+  w.vvec3(j.local_anchor_a);
+  w.vvec3(j.local_anchor_b);
+  w.vvec3(j.local_axis_a);
+  w.vvec3(j.local_axis_b);
+  w.vquat(j.relative_orientation);
+  w.vfixed(j.length);
+  w.vvec3(j.linear_impulse);
+  w.vvec3(j.angular_impulse);
+  w.vfixed(j.axial_impulse);
+  w.vfixed(j.motor_impulse);
+  w.vfixed(j.limit_impulse);
+  if ((j.flags & kJointHasUserData) != 0) w.var(j.user_data);
+}
+
+/// The v4 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
 /// sizes of the vectors, the section lengths those of the payloads written).
 inline Bytes encode(const Decoded& d) {
-  StateWriter payloads[4];
+  StateWriter payloads[kSectionCount];
   StateWriter& globals = payloads[0];
   globals.u64(d.frame);
   globals.u32(d.next_id);
@@ -706,12 +841,16 @@ inline Bytes encode(const Decoded& d) {
   payloads[3].u32(static_cast<std::uint32_t>(d.contacts.size()));
   for (const DecodedContact& c : d.contacts)
     write_contact(payloads[3], c);
+  payloads[4].u32(d.next_joint_id);
+  payloads[4].u32(static_cast<std::uint32_t>(d.joints.size()));
+  for (const DecodedJoint& j : d.joints)
+    write_joint(payloads[4], j);
 
   StateWriter w;
   w.u32(d.magic);
   w.u32(d.version);
-  w.var(4);
-  for (std::size_t i = 0; i < 4; ++i) {
+  w.var(kSectionCount);
+  for (std::size_t i = 0; i < kSectionCount; ++i) {
     const std::string name = kSectionNames[i];
     w.var(name.size());
     for (const char c : name)
@@ -730,7 +869,7 @@ inline Bytes encode(const Decoded& d) {
 /// `delta` bytes for the section that holds byte `at`.
 inline void adjust_section_length(Bytes& bytes, const Decoded& before, std::size_t at,
                                   std::ptrdiff_t delta) {
-  for (std::size_t i = 4; i-- > 0;) {
+  for (std::size_t i = kSectionCount; i-- > 0;) {
     if (at < before.payload_at[i]) continue;
     const std::size_t length_at = before.section_length_at[i];
     std::uint32_t length = 0;

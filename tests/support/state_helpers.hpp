@@ -1,5 +1,5 @@
 // Shared helpers of the world-state tests (sim_state_test.cpp, sim_state_restore_test.cpp,
-// sim_state_v2_codec_test.cpp): scenes built through the public API, the independent codec of the
+// sim_state_codec_test.cpp): scenes built through the public API, the independent codec of the
 // v2 state layout (state_codec.hpp) and what the world's accessors say its encoding must be, and
 // the check that a refused restore changes nothing.
 //
@@ -280,10 +280,42 @@ inline DecodedBody record_of(const BodyState& b) {
   return r;
 }
 
-/// What save() must write for `w`, built from body(), contacts() and the other accessors: sets
-/// deduplicated in first-use order, flags from the values. The ID counter is not public: the
-/// caller passes it.
-inline Decoded expected_encoding(const World& w, std::uint32_t next_id) {
+/// A joint's record as docs/STATE.md lays it out (the ID step is the caller's).
+inline DecodedJoint joint_record(const JointState& j) {
+  DecodedJoint r;
+  r.type = static_cast<std::uint8_t>(j.def.type);
+  r.body_a = j.def.body_a.value;
+  r.body_b = j.def.body_b.value;
+  r.flags = static_cast<std::uint8_t>(
+      (j.def.limit_enabled ? kLimitEnabled : 0) | (j.def.motor_enabled ? kMotorEnabled : 0) |
+      (j.def.collide_connected ? kCollideConnected : 0) | (j.broken ? kBroken : 0) |
+      (j.def.user_data != 0 ? kJointHasUserData : 0));
+  r.anchor = j.def.anchor;
+  r.axis = j.def.axis;
+  r.numbers = {j.def.limit_lower, j.def.limit_upper,      j.def.swing_limit,
+               j.def.motor_speed, j.def.motor_max_force,  j.def.min_length,
+               j.def.max_length,  j.def.spring_frequency, j.def.spring_damping_ratio,
+               j.def.break_force, j.def.break_torque};
+  r.local_anchor_a = j.local_anchor_a;
+  r.local_anchor_b = j.local_anchor_b;
+  r.local_axis_a = j.local_axis_a;
+  r.local_axis_b = j.local_axis_b;
+  r.relative_orientation = j.relative_orientation;
+  r.length = j.length;
+  r.linear_impulse = j.linear_impulse;
+  r.angular_impulse = j.angular_impulse;
+  r.axial_impulse = j.axial_impulse;
+  r.motor_impulse = j.motor_impulse;
+  r.limit_impulse = j.limit_impulse;
+  r.user_data = j.def.user_data;
+  return r;
+}
+
+/// What save() must write for `w`, built from body(), contacts(), joint() and the other
+/// accessors: sets deduplicated in first-use order, flags from the values. The ID counters are not
+/// public: the caller passes them.
+inline Decoded expected_encoding(const World& w, std::uint32_t next_id,
+                                 std::uint32_t next_joint_id = 1) {
   Decoded d;
   d.frame = w.frame();
   d.next_id = next_id;
@@ -322,6 +354,14 @@ inline Decoded expected_encoding(const World& w, std::uint32_t next_id) {
     }
     d.contacts.push_back(out);
     previous_a = c.a.value;
+  }
+  d.next_joint_id = next_joint_id;
+  std::uint32_t previous_joint = 0;
+  for (const JointId id : w.joint_ids()) {
+    DecodedJoint r = joint_record(w.joint(id).value());
+    r.id_step = id.value - previous_joint;
+    previous_joint = id.value;
+    d.joints.push_back(r);
   }
   return d;
 }

@@ -18,8 +18,11 @@
 //   rng.state[0..3]       BODY 0; DELTA: an integer, added modulo 2^64
 //   contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2
 //                         the cached impulse of point I of the pair (BODY, OTHER); DELTA: a decimal
+//   joint[J].FIELD        BODY 0; FIELD a field of joint J as diff names it (anchor.x,
+//                         linear_impulse.y, motor_speed, broken, ...): DELTA as for its kind
 // Results that restore() would refuse (an orientation no longer a unit quaternion, a negative
-// sleep time, a static body awake, an all-zero RNG state) are refused, and the world is unchanged.
+// sleep time, a static body awake, an all-zero RNG state, a joint's axis no longer a unit vector)
+// are refused, and the world is unchanged.
 #pragma once
 
 #include <cstdint>
@@ -36,6 +39,7 @@ namespace detsim {
 struct Injection {
   std::uint64_t frame = 0;  ///< the state frame changed (1 or later: frame 0 is never stepped into)
   std::uint32_t body = 0;   ///< the body; for contact fields either body of the pair; 0 for rng
+                            ///< and joint fields
   std::string field;        ///< as written, e.g. "position.y"
   std::string delta;        ///< as written, e.g. "0.001"
 

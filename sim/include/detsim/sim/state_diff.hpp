@@ -16,14 +16,16 @@ namespace detsim {
 
 /// One difference between state A and state B.
 struct FieldDiff {
-  /// The state section the field is in (a World's: "globals", "rng", "bodies", "contacts").
+  /// The state section the field is in (a World's: "globals", "rng", "bodies", "contacts",
+  /// "joints").
   std::string subsystem;
   /// The body the field belongs to, in any section ("bodies": the body; "contacts": the pair's
-  /// lower ID); 0 for a field of no body. A section's own "hash" line has 0.
+  /// lower ID); 0 for a field of no body (a joint's). A section's own "hash" line has 0.
   std::uint32_t body = 0;
   /// e.g. "position.y", "orientation.w", "angular_velocity.x", "sleep_time", "frame", "state[2]";
   /// "present" when the body exists on one side only; for a contact of `body` with body 23:
-  /// "contact[23].point[0].normal_impulse", "contact[23].touching", "contact[23].present".
+  /// "contact[23].point[0].normal_impulse", "contact[23].touching", "contact[23].present"; for
+  /// joint 7: "joint[7].linear_impulse.x", "joint[7].broken", "joint[7].present".
   std::string field;
   std::string a;  ///< the value in A: decimal, then the raw bits ("0.5 (0x0000000080000000)")
   std::string b;  ///< the value in B, alike; "absent" for a body missing on that side
@@ -34,7 +36,8 @@ struct StateDiff {
   StateHashes b;
   std::uint64_t frame_a = 0;
   std::uint64_t frame_b = 0;
-  /// In order: globals, rng, bodies by ascending ID (fields in declaration order), contacts.
+  /// In order: globals, rng, bodies by ascending ID (fields in declaration order), contacts,
+  /// joints by ascending ID.
   std::vector<FieldDiff> fields;
   /// Differences found beyond max_fields (not listed).
   std::size_t omitted = 0;
