@@ -21,9 +21,10 @@ bool contains(const std::string& text, const std::string& part) {
 
 TEST(ScenarioRegistry, ListsEveryScenarioOnceSortedByName) {
   const auto list = scenario_list();
-  const std::vector<std::string> expected{"arena",      "bounce",       "bullet_wall", "dominoes",
-                                          "pile_boxes", "pile_spheres", "pyramid",     "slope",
-                                          "spray",      "stack"};
+  const std::vector<std::string> expected{"arena",      "bounce",       "bridge",  "bullet_wall",
+                                          "chain",      "dominoes",     "motors",  "pendulum",
+                                          "pile_boxes", "pile_spheres", "pyramid", "ragdolls",
+                                          "slope",      "spray",        "stack",   "wrecking_ball"};
   ASSERT_EQ(list.size(), expected.size());
   for (std::size_t i = 0; i < list.size(); ++i) {
     EXPECT_EQ(std::string(list[i].name), expected[i]);
@@ -58,6 +59,9 @@ TEST(ScenarioRegistry, BadNamesAndParametersAreErrorsThatSayWhatIsAllowed) {
   bad = Scenario::create("pyramid", {.count = 101});
   ASSERT_FALSE(bad.ok());
   EXPECT_TRUE(contains(bad.message(), "1 to 100 rows")) << bad.message();
+  bad = Scenario::create("chain", {.count = 1001});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_TRUE(contains(bad.message(), "1 to 1000 links")) << bad.message();
   bad = Scenario::create("bounce", {.count = 3});
   ASSERT_FALSE(bad.ok());
   EXPECT_TRUE(contains(bad.message(), "takes no body count")) << bad.message();
@@ -88,6 +92,14 @@ TEST(ScenarioRegistry, DefaultsAreFilledIn) {
   auto small = Scenario::create("pyramid", {.count = 8});
   ASSERT_TRUE(small.ok());
   EXPECT_EQ(small->world().body_count(), 37U);
+  // The joint scenes: a ragdoll is 11 bodies and 10 joints; the chain hangs N links.
+  auto ragdolls = Scenario::create("ragdolls", {.count = 3});
+  ASSERT_TRUE(ragdolls.ok()) << ragdolls.message();
+  EXPECT_EQ(ragdolls->world().joint_ids().size(), 30U);
+  auto chain = Scenario::create("chain", {.count = 12});
+  ASSERT_TRUE(chain.ok()) << chain.message();
+  EXPECT_EQ(chain->world().body_count(), 13U);  // the static block and 12 links
+  EXPECT_EQ(chain->world().joint_ids().size(), 12U);
   auto seeded = Scenario::create("spray", {.seed = 77});
   ASSERT_TRUE(seeded.ok());
   EXPECT_EQ(seeded->world().def().seed, 77U);

@@ -2,6 +2,7 @@
 // scenario_play.cpp (the scenes with game logic). Internal to detsim::scenes.
 #pragma once
 
+#include <cstdint>
 #include <span>
 
 #include <detsim/scenes/scenario.hpp>
@@ -24,10 +25,18 @@ void build_bounce(World& w, const ScenarioParams& p);
 void build_slope(World& w, const ScenarioParams& p);
 void build_spray(World& w, const ScenarioParams& p);
 void build_arena(World& w, const ScenarioParams& p);
+// The scenes with joints (scenario_joints.cpp).
+void build_pendulum(World& w, const ScenarioParams& p);
+void build_chain(World& w, const ScenarioParams& p);
+void build_ragdolls(World& w, const ScenarioParams& p);
+void build_bridge(World& w, const ScenarioParams& p);
+void build_wrecking_ball(World& w, const ScenarioParams& p);
+void build_motors(World& w, const ScenarioParams& p);
 
 // Per-frame logic, run before each step. Reads only the World and the inputs.
 void control_spray(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_arena(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
+void control_bridge(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 
 // Tags in BodyDef::user_data by which game logic finds its bodies again (the World is the whole
 // scenario state, so nothing else may remember them). A player's tag is player_tag + index.
@@ -35,5 +44,88 @@ inline constexpr std::uint64_t player_tag = 0x504C'4159'0000'0000ULL;  // "PLAY"
 inline constexpr std::uint64_t platform_tag = 0x504C'4154'0000'0000ULL;
 inline constexpr std::uint64_t spawned_tag = 0x5350'4157'0000'0000ULL;
 inline constexpr std::uint64_t crate_tag = 0x4352'4154'0000'0000ULL;
+inline constexpr std::uint64_t ragdoll_tag = 0x5241'4744'0000'0000ULL;  // + ragdoll index
+inline constexpr std::uint64_t load_tag = 0x4C4F'4144'0000'0000ULL;     // the bridge's box
+inline constexpr std::uint64_t brick_tag = 0x4252'4943'0000'0000ULL;
+inline constexpr std::uint64_t ball_tag = 0x4241'4C4C'0000'0000ULL;     // the wrecking ball
+inline constexpr std::uint64_t chassis_tag = 0x4341'5220'0000'0000ULL;  // + car index
+
+// The joint scenes' dimensions (m, kg, s), shared with tests/sim_scenario_physics_test.cpp, which
+// derives from them what each scene must do.
+using namespace detsim::literals;
+
+namespace pendulum {
+inline constexpr Fixed pivot_y = 5_fx;
+inline constexpr Fixed length = 2_fx;  ///< pivot to the bob's centre
+inline constexpr Fixed bob_radius = 0.1_fx;
+inline constexpr Fixed bob_mass = 1_fx;
+inline constexpr Fixed start_angle = Fixed::pi() / 18_fx;  ///< 10 degrees
+}  // namespace pendulum
+
+namespace chain {
+inline constexpr Vec3 top{0_fx, 40_fx, 0_fx};  ///< the first joint, below a static block
+inline constexpr Fixed link = 0.4_fx;          ///< joint to joint
+inline constexpr Fixed radius = 0.05_fx;
+inline constexpr Fixed link_mass = 1_fx;
+inline constexpr Fixed damping = 0.5_fx;  ///< linear, 1/s: the swing dies out in tens of seconds
+}  // namespace chain
+
+namespace ragdolls {
+inline constexpr std::int32_t steps = 8;  ///< the landing's height is steps * rise
+inline constexpr Fixed rise = 0.3_fx;
+inline constexpr Fixed run = 0.3_fx;
+inline constexpr Fixed spacing = 1.2_fx;  ///< between ragdolls along z
+/// Every part's, 1/s: a ragdoll's usual setting; it also stops a head spinning freely on its
+/// ball joint on the ground for ever.
+inline constexpr Fixed angular_damping = 0.5_fx;
+}  // namespace ragdolls
+
+namespace bridge {
+inline constexpr Vec3 left{0_fx, 4_fx, 0_fx};  ///< the left end hinge, on the planks' mid-line
+inline constexpr Fixed plank = 0.5_fx;         ///< hinge to hinge
+inline constexpr Fixed thickness = 0.1_fx;
+inline constexpr Fixed plank_mass = 5_fx;
+/// The planks are laid in a shallow V (down, then up at this angle), so that the chain of planks
+/// is longer than the gap it spans by a factor 1 / cos(slack_angle).
+inline constexpr Fixed slack_angle = 0.2_fx;
+inline constexpr Fixed box_mass = 50_fx;    ///< ten planks
+inline constexpr Fixed box_speed = 2_fx;    ///< m/s, the cruise control's target
+inline constexpr Fixed cruise_rate = 4_fx;  ///< 1/s: the push per m/s short of box_speed
+inline constexpr Fixed push_limit = 1_fx;   ///< the push's most, in units of the box's weight
+/// Hinge k (0 .. planks) of a bridge of `planks` planks, world space.
+Vec3 hinge_point(std::uint32_t planks, std::uint32_t k);
+}  // namespace bridge
+
+namespace wrecking_ball {
+inline constexpr std::int32_t rows = 6;
+inline constexpr std::int32_t columns = 6;
+inline constexpr Vec3 brick_half{0.25_fx, 0.25_fx, 0.5_fx};
+inline constexpr Fixed brick_mass = 20_fx;
+inline constexpr Fixed wall_x = 0.95_fx;  ///< the wall's mid-plane; its face to the ball at 0.7
+/// Three times the largest load a joint carries at rest (five bricks hang on the lowest
+/// vertical joint of a column: 5 * 20 * 9.81 = 981 N).
+inline constexpr Fixed break_force = 3000_fx;
+inline constexpr Vec3 pivot{0_fx, 6.2_fx, 0_fx};
+inline constexpr std::int32_t links = 5;
+inline constexpr Fixed link = 0.8_fx;
+inline constexpr Fixed link_mass = 5_fx;
+inline constexpr Fixed ball_radius = 0.6_fx;
+inline constexpr Fixed ball_mass = 500_fx;
+inline constexpr Fixed release_angle = Fixed::pi() / 3_fx;  ///< 60 degrees
+}  // namespace wrecking_ball
+
+namespace motors {
+inline constexpr Fixed wheel_radius = 0.3_fx;
+inline constexpr Fixed capsule_half_height = 0.1_fx;  ///< the capsule wheels' half width
+inline constexpr Fixed wheel_mass = 10_fx;
+inline constexpr Fixed wheel_speed = 10_fx;    ///< rad/s: the car should run at 3 m/s
+inline constexpr Fixed motor_torque = 100_fx;  ///< N m per wheel
+inline constexpr Vec3 chassis_half{1_fx, 0.2_fx, 0.5_fx};
+inline constexpr Fixed chassis_mass = 100_fx;
+inline constexpr Fixed ride_height = 0.3_fx;  ///< the chassis' centre above the axles
+inline constexpr Fixed axle_x = 0.8_fx;
+inline constexpr Fixed track_z = 0.9_fx;
+inline constexpr Fixed car_spacing = 5_fx;
+}  // namespace motors
 
 }  // namespace detsim::scenes_detail

@@ -211,7 +211,8 @@ void add_scenario_options(CLI::App* cmd, detsim::cli::ScenarioArgs& a) {
       ->type_name("P");
   cmd->add_option("--count", a.count,
                   "Size of the scene: bodies for the piles (default 1000), rows for the pyramid "
-                  "(default 20)")
+                  "(default 20), links (chain), planks (bridge), ragdolls; `detsim scenarios` "
+                  "lists each range")
       ->type_name("N");
 }
 

@@ -42,14 +42,15 @@ struct ScenarioInfo {
   std::uint32_t default_count = 0;  ///< 0: no `count` parameter; else its default
   std::uint32_t max_count = 0;
   bool uses_seed = false;  ///< whether the seed changes anything but the RNG's unused state
-  std::string_view count_unit = "bodies";  ///< what `count` counts: "bodies", or "rows"
+  std::string_view count_unit = "bodies";  ///< what `count` counts: "bodies", "rows", "links", ...
 };
 
 /// Parameters of a scenario; zero means "the scenario's default".
 struct ScenarioParams {
   std::uint64_t seed = 1;
   std::uint32_t players = 0;
-  std::uint32_t count = 0;  ///< the scene's size, where it has one: bodies (piles), rows (pyramid)
+  std::uint32_t count = 0;  ///< the scene's size, where it has one: bodies (piles), rows (pyramid),
+                            ///< links (chain), planks (bridge), ragdolls
 
   friend constexpr bool operator==(const ScenarioParams&, const ScenarioParams&) noexcept = default;
 };
