@@ -79,6 +79,39 @@ TEST(CliBisect, ReplayPathNamesTheInjectedFrameBodyAndField) {
   EXPECT_TRUE(has(r.out, "--at 1234")) << r.out;
 }
 
+/// A joint's field (a warm-start impulse of the chain scenario's fifth joint) through the
+/// commands: bisection names the joint and the field like a body's, in the "joints" subsystem.
+TEST(CliBisect, AJointsFieldIsNamedLikeABodysField) {
+  TempFile faulty("faulty.dsr");
+  TempFile healthy_report("healthy.dsd");
+  TempFile faulty_report("faulty.dsd");
+  const std::string inject = "150:0:joint[5].linear_impulse.x:0.01";
+  auto r = detsim_cli("run --scenario chain --frames 300 --record " + faulty.path() + " --inject " +
+                      inject);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = detsim_cli("verify " + faulty.path() + " --report " + healthy_report.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "first_mismatch"), "150") << r.out;
+  r = detsim_cli("verify " + faulty.path() + " --inject " + inject + " --report " +
+                 faulty_report.path() + " --at 150");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = detsim_cli("bisect " + healthy_report.path() + " " + faulty_report.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "first_divergent_frame"), "150") << r.out;
+  EXPECT_TRUE(has(r.out, R"("subsystems":["joints"])")) << r.out;
+  EXPECT_TRUE(
+      has(r.out, R"("diffs":[{"subsystem":"joints","body":0,"field":"joint[5].linear_impulse.x",)"))
+      << r.out;
+  EXPECT_TRUE(has(r.out, R"(}],"diffs_omitted":0)")) << "exactly one difference: " << r.out;
+  r = detsim_cli("bisect " + healthy_report.path() + " " + faulty_report.path());
+  EXPECT_TRUE(has(r.out, "joint[5].linear_impulse.x")) << r.out;
+
+  // A joint that does not exist is refused before the run starts.
+  r = detsim_cli("run --scenario chain --frames 100 --inject 50:0:joint[999].motor_speed:1");
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "no joint with ID 999")) << r.err;
+}
+
 /// Every field class through the commands themselves, at a seeded random frame of a 10,000-frame
 /// 8-player arena match (1,000 in the sanitizer build): the injection is chosen from the state at
 /// that frame (simulated here), then the faulty machine records with --inject, the healthy one
