@@ -2,6 +2,7 @@
 // solver's joint kind is solver/joint_solver.cpp.
 #include <algorithm>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -58,8 +59,11 @@ bool is_joined_pair(const std::vector<std::uint64_t>& pairs, std::size_t i,
 
 void destroy_joints_of(WorldState& s, BodyId id) {
   for (const JointState& j : s.joints) {
-    if (j.def.body_a == id) wake_body(s, j.def.body_b);
-    if (j.def.body_b == id) wake_body(s, j.def.body_a);
+    if (j.def.body_a != id && j.def.body_b != id) continue;
+    wake_body(s, j.def.body_a == id ? j.def.body_b : j.def.body_a);
+    // Reported with the load it carried, while both bodies still exist.
+    s.joint_events.push_back({JointEvent::Kind::destroyed, j.id, j.def.body_a, j.def.body_b,
+                              j.def.user_data, joint_reaction_of(s, j)});
   }
   std::erase_if(s.joints,
                 [id](const JointState& j) { return j.def.body_a == id || j.def.body_b == id; });
@@ -124,6 +128,35 @@ Expected<JointState> World::joint(JointId id) const {
   const std::ptrdiff_t i = s_->find_joint(id.value);
   if (i < 0) return unknown_joint(id);
   return s_->joints[static_cast<std::size_t>(i)];
+}
+
+Status World::set_joint_motor(JointId id, Fixed speed, Fixed max_force) {
+  const std::ptrdiff_t i = s_->find_joint(id.value);
+  if (i < 0) return unknown_joint(id);
+  JointState& j = s_->joints[static_cast<std::size_t>(i)];
+  if (j.def.type != JointType::hinge && j.def.type != JointType::slider)
+    return Status::error("joint " + std::to_string(id.value) +
+                         " has no motor: only hinge and slider joints have one");
+  if (auto e = sim_detail::check_joint_motor(speed, max_force); !e.empty())
+    return Status::error("joint " + std::to_string(id.value) + ": " + e);
+  j.def.motor_speed = speed;
+  j.def.motor_max_force = max_force;
+  // A motor of no force does nothing: max_force 0 is how a game switches it off. (Its
+  // accumulated impulse is clamped to the new force by the next step's warm start.)
+  j.def.motor_enabled = max_force > Fixed::zero();
+  sim_detail::wake_body(*s_, j.def.body_a);
+  sim_detail::wake_body(*s_, j.def.body_b);
+  return Status::success();
+}
+
+Expected<JointReaction> World::joint_reaction(JointId id) const {
+  const std::ptrdiff_t i = s_->find_joint(id.value);
+  if (i < 0) return unknown_joint(id);
+  return sim_detail::joint_reaction_of(*s_, s_->joints[static_cast<std::size_t>(i)]);
+}
+
+std::span<const JointEvent> World::joint_events() const noexcept {
+  return s_->joint_events;
 }
 
 std::vector<JointId> World::joint_ids() const {

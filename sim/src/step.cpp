@@ -9,6 +9,7 @@ namespace detsim {
 void World::step() {
   sim_detail::WorldState& s = *s_;
   s.events.clear();
+  s.joint_events.clear();
   sim_detail::prepare_bodies(s);        // 1. derived data: poses, inverse mass and inertia, AABBs
   sim_detail::update_contacts(s);       // 2. broadphase: overlapping pairs, ascending by ID pair
   sim_detail::collide_contacts(s);      // 3. narrowphase: manifolds, warm-start impulses matched

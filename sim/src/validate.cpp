@@ -195,6 +195,15 @@ std::string check_joint_body(const WorldState& s, const char* field, BodyId id) 
 
 }  // namespace
 
+std::string check_joint_motor(Fixed speed, Fixed max_force) {
+  if (beyond(speed, max_velocity))
+    return "motor_speed must be within +-" + str(max_velocity) + ", got " + str(speed);
+  if (auto e = non_negative("motor_max_force", max_force); !e.empty()) return e;
+  if (max_force > max_quantity)
+    return "motor_max_force must be <= " + str(max_quantity) + ", got " + str(max_force);
+  return {};
+}
+
 std::string check_joint_def(const WorldState& s, const JointDef& def) {
   if (auto e = check_joint_fields(s, def); !e.empty()) return e;
   const BodyState& a = s.bodies[static_cast<std::size_t>(s.find(def.body_a.value))];
@@ -220,7 +229,7 @@ std::string check_joint_fields(const WorldState& s, const JointDef& def) {
   if (auto e = non_negative("swing_limit", def.swing_limit); !e.empty()) return e;
   if (def.swing_limit > Fixed::pi())
     return "swing_limit must be <= pi, got " + str(def.swing_limit);
-  if (auto e = non_negative("motor_max_force", def.motor_max_force); !e.empty()) return e;
+  if (auto e = check_joint_motor(def.motor_speed, def.motor_max_force); !e.empty()) return e;
   if (auto e = non_negative("min_length", def.min_length); !e.empty()) return e;
   if (auto e = non_negative("max_length", def.max_length); !e.empty()) return e;
   if (def.min_length > def.max_length)

@@ -90,6 +90,8 @@ struct WorldState {
   std::vector<std::uint32_t> sweep_order;
   /// Output of the last step (and of destroy_body since); not saved, cleared by restore.
   std::vector<ContactEvent> events;
+  /// The same for joints: breaks in the last step, then joints destroy_body removed since.
+  std::vector<JointEvent> joint_events;
 
   /// Index of body `id` in `bodies`, or -1.
   [[nodiscard]] std::ptrdiff_t find(std::uint32_t id) const noexcept;
@@ -109,6 +111,8 @@ struct WorldState {
 /// check_joint_def without "at most one body static": what a saved joint must satisfy (set_type
 /// may make both of a joint's bodies static after its creation; the solver skips such a joint).
 [[nodiscard]] std::string check_joint_fields(const WorldState& s, const JointDef& def);
+/// A motor's speed and max_force (create_joint and set_joint_motor): "" when valid.
+[[nodiscard]] std::string check_joint_motor(Fixed speed, Fixed max_force);
 /// The limits of limits.hpp for calls: "" when within them, else the refusal's message.
 /// Each component of v within +-limit ("<what> x must be within +-limit unit, got v").
 [[nodiscard]] std::string check_components(const char* what, Vec3 v, Fixed limit, const char* unit);
@@ -148,8 +152,13 @@ void prepare_body(WorldState& s, std::size_t i);
 [[nodiscard]] bool is_joined_pair(const std::vector<std::uint64_t>& pairs, std::size_t i,
                                   std::size_t j) noexcept;
 
-/// Removes the joints of body `id`, waking the other body of each (joints.cpp).
+/// Removes the joints of body `id`, waking the other body of each and reporting each (a
+/// JointEvent::Kind::destroyed, ascending by joint ID) (joints.cpp).
 void destroy_joints_of(WorldState& s, BodyId id);
+
+/// The force and torque joint `j` applied to its body b in the last step it was solved, from its
+/// accumulated impulses and its bodies' present poses (joint_solver.cpp; zero when broken).
+[[nodiscard]] JointReaction joint_reaction_of(const WorldState& s, const JointState& j);
 
 /// Appends the end event of a contact that is reported as touching (a pair that stops existing).
 void report_end(WorldState& s, const Contact& c);

@@ -24,8 +24,12 @@
 // body carries it, (axis_a x axis_b) across each direction. Rotation about the axis is free.
 //
 // A hinge's motor and limit are rows about its axis ("twist"), applied with the point rows held
-// (apply_held): the motor first, without bias and clamped to its torque (Box2D's order), the
-// limit last, one-sided at each end.
+// (apply_held), after the point block: the motor, without bias and clamped to its torque, then
+// the limit, one-sided at each end. (Box2D solves its motor first, before the point: here the
+// point block, soft and with a tiny effective mass across an arm whose body is small, then
+// spins the body about its own centre and has the last word; a motor at speed 0 holding a 1 m
+// arm with 1.25 times the torque its weight needs let it sink 0.4 rad in 2 s. Solved after it,
+// the motor holds the arm, its point rows held, to the point spring's 5 mm sag.)
 //
 // A swing-twist joint is a ball joint plus, with limit_enabled, the hinge's twist limit about its
 // axis and a cone limit (the angle between the axis as each body carries it, at most
@@ -38,7 +42,9 @@
 //
 // A slider is the fixed joint's three angular rows plus two linear rows across its axis (as body
 // a carries it), from body a's centre to body b's anchor (Box2D's prismatic rows), solved as a
-// 2x2 block after the angular block. Translation along the axis is free (no limit or motor yet).
+// 2x2 block after the angular block. Translation along the axis is free, unless a motor (first)
+// or a limit (last) acts on it: one row along the axis at the same anchors, like the hinge's
+// twist row but linear.
 //
 // A distance joint is one row along the anchors' direction. With min_length == max_length it is a
 // rigid rod (soft as above, either sign), or with spring_frequency > 0 a spring of that rest
@@ -192,7 +198,11 @@ void JointSolver::prepare() {
     if (k.type == JointType::hinge) {
       k.angular_impulse_1 = dot(j.angular_impulse, k.across[0]);
       k.angular_impulse_2 = dot(j.angular_impulse, k.across[1]);
-      k.motor_impulse = j.def.motor_enabled ? j.motor_impulse : Fixed::zero();
+    }
+    if (k.type == JointType::hinge || k.type == JointType::slider) {
+      // The motor's warm start within its present force (set_joint_motor may have lowered it).
+      const Fixed most = j.def.motor_max_force * bodies_.h;
+      k.motor_impulse = j.def.motor_enabled ? clamp(j.motor_impulse, -most, most) : Fixed::zero();
       k.lower_limit_impulse =
           j.def.limit_enabled ? max(j.limit_impulse, Fixed::zero()) : Fixed::zero();
       k.upper_limit_impulse =
@@ -230,7 +240,14 @@ void JointSolver::update_geometry(JointConstraint& k) {
   if (twists) {
     k.axis_a = rotate(a.orientation, j.local_axis_a);
     k.axis_b = rotate(b.orientation, j.local_axis_b);
-    k.twist_row = angular_row(da, db, k.axis_a);
+    // A swing-twist's twist turns about the direction half-way between the two axes: the twist
+    // angle below changes at w . (a + b) / (1 + a . b), w the relative angular velocity (the
+    // swing, about a x b, is across both). Along axis_a alone, the row was off by half the swing
+    // angle, and under random torques the twist passed its end by 0.028 rad at a 0.6 rad swing.
+    // A hinge's axes stay together: axis_a is that direction.
+    const Vec3 twist_axis =
+        k.type == JointType::swing_twist ? normalize_or(k.axis_a + k.axis_b, k.axis_a) : k.axis_a;
+    k.twist_row = angular_row(da, db, twist_axis);
     // The rotation from b's pose at creation relative to a to its present one, about axis_a:
     // twice the angle of the error quaternion's part along the axis (the shorter way round).
     const Quat e = b.orientation * conjugate(a.orientation * j.relative_orientation);
@@ -295,6 +312,11 @@ void JointSolver::update_geometry(JointConstraint& k) {
     k.slide_mass = inverse_2x2(entries[0][0], entries[0][1], entries[1][1]);
     k.slide_error_1 = dot(separation, k.across[0]);
     k.slide_error_2 = dot(separation, k.across[1]);
+    if (j.def.motor_enabled || j.def.limit_enabled) {
+      k.axial = make_direction(da, db, k.axis_a);
+      k.axial_row = make_row(da, db, arm_a, k.anchor_b, k.axis_a);
+      k.translation = dot(separation, k.axis_a);
+    }
   }
   if (k.type == JointType::fixed || k.type == JointType::slider) {
     for (std::size_t i = 0; i < 3; ++i)
@@ -360,6 +382,7 @@ void JointSolver::update_geometry(JointConstraint& k) {
       hold_point(k.swing_row, k.swing_coupling, k.swing_mass);
     return;
   }
+  if (k.type != JointType::distance) return;  // a slider: done above
   // Distance: along the anchors' direction (any fixed one when they coincide).
   k.length = length(separation);
   const Vec3 d = normalize_or(separation, Vec3{Fixed::zero(), Fixed::one(), Fixed::zero()});
@@ -409,6 +432,13 @@ void JointSolver::warm_start() {
     if (k.type == JointType::slider) {
       apply_impulses(bodies_.velocities, k.bodies, k.slide_directions[0], k.slide_rows[0],
                      k.slide_impulse_1, k.slide_directions[1], k.slide_rows[1], k.slide_impulse_2);
+      const JointDef& def = s_.joints[k.joint].def;
+      if (def.limit_enabled) {  // the hinge's rule: an end the bodies left carries no load
+        if (k.translation > def.limit_lower) k.lower_limit_impulse = Fixed::zero();
+        if (k.translation < def.limit_upper) k.upper_limit_impulse = Fixed::zero();
+      }
+      const Fixed along = k.motor_impulse + k.lower_limit_impulse - k.upper_limit_impulse;
+      apply_impulse(bodies_.velocities, k.bodies, k.axial, k.axial_row, along);
       continue;
     }
     if (k.type == JointType::swing_twist && s_.joints[k.joint].def.limit_enabled) {
@@ -566,6 +596,44 @@ inline void JointSolver::solve_slide(JointConstraint& k, bool use_bias) {
                  k.slide_directions[1], k.slide_rows[1], impulse.y);
 }
 
+// The slider motor: drives the speed along the axis to motor_speed with at most motor_max_force
+// (N) over each sub-step, as the hinge motor does about its axis.
+inline void JointSolver::solve_slide_motor(JointConstraint& k) {
+  const JointDef& def = s_.joints[k.joint].def;
+  const Fixed speed = row_speed(bodies_.velocities, k.bodies, k.axial, k.axial_row);
+  const Fixed max_impulse = def.motor_max_force * bodies_.h;
+  const Fixed next = clamp(k.motor_impulse - k.axial_row.mass * (speed - def.motor_speed),
+                           -max_impulse, max_impulse);
+  const Fixed impulse = next - k.motor_impulse;
+  k.motor_impulse = next;
+  apply_impulse(bodies_.velocities, k.bodies, k.axial, k.axial_row, impulse);
+}
+
+// The slider limit: each end of limit_lower..limit_upper (m along the axis) a one-sided row, as
+// the hinge limit's ends (speculative while apart, soft at the end while biased, rigid in relax).
+inline void JointSolver::solve_slide_limit(JointConstraint& k, bool use_bias) {
+  const JointDef& def = s_.joints[k.joint].def;
+  const Row& row = k.axial_row;
+  const auto one_sided = [&](Fixed c, Fixed sign, Fixed& accumulated) {
+    const Fixed cdot = sign * row_speed(bodies_.velocities, k.bodies, k.axial, row);
+    Fixed impulse;
+    if (c > Fixed::zero()) {
+      impulse = -row.mass * (cdot + c * bodies_.inv_h);
+    } else if (use_bias) {
+      impulse = -row.mass * soft_.mass_scale * (cdot + soft_.bias_rate * c) -
+                soft_.impulse_scale * accumulated;
+    } else {
+      impulse = -row.mass * cdot;
+    }
+    const Fixed next = max(accumulated + impulse, Fixed::zero());
+    impulse = next - accumulated;
+    accumulated = next;
+    apply_impulse(bodies_.velocities, k.bodies, k.axial, row, sign * impulse);
+  };
+  one_sided(k.translation - def.limit_lower, Fixed::one(), k.lower_limit_impulse);
+  one_sided(def.limit_upper - k.translation, -Fixed::one(), k.upper_limit_impulse);
+}
+
 inline void JointSolver::solve_distance(JointConstraint& k, bool use_bias) {
   const Row& row = k.axial_row;
   const Fixed mass = row.mass;
@@ -611,13 +679,16 @@ void JointSolver::solve_joints(bool use_bias) {
   for (JointConstraint& k : constraints_) {
     if (k.type == JointType::hinge) {
       const JointDef& def = s_.joints[k.joint].def;
-      if (def.motor_enabled) solve_hinge_motor(k);
       solve_hinge_axes(k, use_bias);
       solve_ball(k, use_bias);
+      if (def.motor_enabled) solve_hinge_motor(k);
       if (def.limit_enabled) solve_hinge_limit(k, use_bias);
     } else if (k.type == JointType::slider) {
+      const JointDef& def = s_.joints[k.joint].def;
+      if (def.motor_enabled) solve_slide_motor(k);
       solve_weld(k, use_bias);
       solve_slide(k, use_bias);
+      if (def.limit_enabled) solve_slide_limit(k, use_bias);
     } else if (k.type == JointType::fixed) {
       solve_weld(k, use_bias);
       solve_ball(k, use_bias);
@@ -656,43 +727,115 @@ void JointSolver::relax() {
   solve_joints(false);
 }
 
-// Joints do not bounce.
-void JointSolver::restitution() {}
+// Joints do not bounce. This is the sub-step's last stage: a breakable joint adds up the load it
+// carried in the sub-step, for store_impulses to compare the step's mean with its limits.
+void JointSolver::restitution() {
+  for (JointConstraint& k : constraints_) {
+    const JointDef& def = s_.joints[k.joint].def;
+    if (def.break_force == Fixed::zero() && def.break_torque == Fixed::zero()) continue;
+    const JointReaction r = reaction(k);
+    k.force_sum += r.force;
+    k.torque_sum += r.torque;
+  }
+}
+
+namespace {
+
+// A constraint's accumulated impulses as the joint keeps them (world vectors where its rows turn
+// with body a; a range's two ends as one signed impulse).
+void store(const JointConstraint& k, JointState& j) {
+  j.linear_impulse = k.impulse;
+  if (k.type == JointType::hinge)
+    j.angular_impulse = k.across[0] * k.angular_impulse_1 + k.across[1] * k.angular_impulse_2;
+  if (k.type == JointType::fixed || k.type == JointType::slider) j.angular_impulse = k.weld_impulse;
+  if (k.type == JointType::slider)
+    j.linear_impulse = k.across[0] * k.slide_impulse_1 + k.across[1] * k.slide_impulse_2;
+  if (k.type == JointType::hinge || k.type == JointType::swing_twist ||
+      k.type == JointType::slider) {
+    j.motor_impulse = k.motor_impulse;
+    j.limit_impulse = k.lower_limit_impulse - k.upper_limit_impulse;
+  }
+  j.axial_impulse = k.type == JointType::swing_twist
+                        ? k.swing_impulse
+                        : k.rigid_impulse + k.lower_impulse - k.upper_impulse;
+}
+
+}  // namespace
+
+JointReaction JointSolver::reaction(const JointConstraint& k) const {
+  JointState j = s_.joints[k.joint];
+  store(k, j);
+  return joint_reaction_of(s_, j);
+}
 
 // Breaking: the accumulated impulses act once per sub-step (warm start, then each pass's
-// correction), so the force a joint carries is its impulse times the sub-step rate (Box2D v3's
-// constraint force). Beyond break_force (or break_torque, on the angular rows), the joint breaks
-// at the end of the step: it stays in the list with `broken` set, and is no longer solved, nor
-// joins its bodies' islands, nor keeps them from colliding.
+// correction), so the force a joint carries in a sub-step is its impulse times the sub-step rate
+// (Box2D v3's constraint force, joint_reaction_of). Breaking compares the mean of the step's
+// sub-steps with break_force and break_torque: the last sub-step's alone overshoots when a load
+// comes on suddenly (a beam welded at rest under gravity: 27 % above m g in its first step, as
+// the soft joint stops the sag it let through), while the mean is the step's momentum balance.
+// Beyond either, the joint breaks at the end of the step, reported as a joint event in ascending
+// joint ID: it stays in the list with `broken` set, and is no longer solved, nor joins its
+// bodies' islands, nor keeps them from colliding.
 void JointSolver::store_impulses() {
+  const Fixed substeps = Fixed::from_int(static_cast<std::int32_t>(s_.def.substeps));
   for (const JointConstraint& k : constraints_) {
     JointState& j = s_.joints[k.joint];
-    Fixed force = length(k.impulse);
-    if (k.type == JointType::distance)
-      force = abs(k.rigid_impulse + k.lower_impulse - k.upper_impulse);
-    if (k.type == JointType::slider) force = hypot(k.slide_impulse_1, k.slide_impulse_2);
-    Fixed torque;
-    if (k.type == JointType::hinge) torque = hypot(k.angular_impulse_1, k.angular_impulse_2);
-    if (k.type == JointType::fixed || k.type == JointType::slider) torque = length(k.weld_impulse);
-    if (j.def.break_force > Fixed::zero() && force * bodies_.inv_h > j.def.break_force)
+    store(k, j);
+    if (j.def.break_force == Fixed::zero() && j.def.break_torque == Fixed::zero()) continue;
+    const JointReaction mean{k.force_sum / substeps, k.torque_sum / substeps};
+    if ((j.def.break_force > Fixed::zero() && length(mean.force) > j.def.break_force) ||
+        (j.def.break_torque > Fixed::zero() && length(mean.torque) > j.def.break_torque)) {
       j.broken = true;
-    if (j.def.break_torque > Fixed::zero() && torque * bodies_.inv_h > j.def.break_torque)
-      j.broken = true;
-    j.linear_impulse = k.impulse;
-    if (k.type == JointType::hinge)
-      j.angular_impulse = k.across[0] * k.angular_impulse_1 + k.across[1] * k.angular_impulse_2;
-    if (k.type == JointType::fixed || k.type == JointType::slider)
-      j.angular_impulse = k.weld_impulse;
-    if (k.type == JointType::slider)
-      j.linear_impulse = k.across[0] * k.slide_impulse_1 + k.across[1] * k.slide_impulse_2;
-    if (k.type == JointType::hinge || k.type == JointType::swing_twist) {
-      j.motor_impulse = k.motor_impulse;
-      j.limit_impulse = k.lower_limit_impulse - k.upper_limit_impulse;
+      s_.joint_events.push_back(
+          {JointEvent::Kind::broke, j.id, j.def.body_a, j.def.body_b, j.def.user_data, mean});
     }
-    j.axial_impulse = k.type == JointType::swing_twist
-                          ? k.swing_impulse
-                          : k.rigid_impulse + k.lower_impulse - k.upper_impulse;
   }
+}
+
+// The reaction from the stored impulses: each row's impulse along (or about) its direction, at
+// the bodies' present poses (the directions that turn with body a are where the last sub-step's
+// rows had them), times the sub-step rate. The rows' signs: a positive impulse pushes body b
+// along the row's direction (rows.hpp), so each impulse is the push on b.
+JointReaction joint_reaction_of(const WorldState& s, const JointState& j) {
+  if (j.broken) return {};
+  const BodyState& a = s.bodies[static_cast<std::size_t>(s.find(j.def.body_a.value))];
+  const BodyState& b = s.bodies[static_cast<std::size_t>(s.find(j.def.body_b.value))];
+  const Vec3 axis_a = rotate(a.orientation, j.local_axis_a);
+  Vec3 linear = j.linear_impulse;
+  Vec3 angular;
+  switch (j.def.type) {
+    case JointType::ball:
+      break;
+    case JointType::hinge:
+      angular = j.angular_impulse + axis_a * (j.motor_impulse + j.limit_impulse);
+      break;
+    case JointType::slider:
+      linear = linear + axis_a * (j.motor_impulse + j.limit_impulse);
+      angular = j.angular_impulse;
+      break;
+    case JointType::fixed:
+      angular = j.angular_impulse;
+      break;
+    case JointType::distance: {
+      const Vec3 separation = (b.position + rotate(b.orientation, j.local_anchor_b)) -
+                              (a.position + rotate(a.orientation, j.local_anchor_a));
+      linear = normalize_or(separation, Vec3{Fixed::zero(), Fixed::one(), Fixed::zero()}) *
+               j.axial_impulse;
+      break;
+    }
+    case JointType::swing_twist: {
+      // The twist limit about the axes' half-way direction; the cone's row about the direction
+      // the axes part in, its impulse applied negated (solve_swing_limit).
+      const Vec3 axis_b = rotate(b.orientation, j.local_axis_b);
+      const Vec3 parting = normalize_or(cross(axis_a, axis_b), perpendicular(axis_a));
+      angular = normalize_or(axis_a + axis_b, axis_a) * j.limit_impulse - parting * j.axial_impulse;
+      break;
+    }
+  }
+  const Fixed substeps = Fixed::from_int(static_cast<std::int32_t>(s.def.substeps));
+  const Fixed rate = substeps / s.def.dt;  // SolverBodies::inv_h
+  return {linear * rate, angular * rate};
 }
 
 }  // namespace detsim::sim_detail

@@ -1,6 +1,6 @@
 // Joints as a constraint kind (joint_solver.cpp), run after contacts in every stage (solve.cpp).
-// Work in progress (docs/JOINTS-WIP.md): all six joint types are solved (the slider without its
-// limit and motor, swing-twist without a motor). Internal to detsim::sim.
+// Work in progress (docs/JOINTS-WIP.md): all six joint types are solved (swing-twist without a
+// motor). Internal to detsim::sim.
 #pragma once
 
 #include <array>
@@ -76,17 +76,23 @@ struct JointConstraint {
   Fixed slide_error_2;
   Fixed slide_impulse_1;
   Fixed slide_impulse_2;
-  // Distance: one row along the anchors' direction, at the present poses.
+  // Distance: one row along the anchors' direction, at the present poses. Slider with a motor or
+  // a limit: one row along its axis (as body a carries it), at the slide rows' anchors.
   Direction axial;
   Row axial_row;
-  Fixed length;      ///< the anchors' present distance
-  Fixed min_length;  ///< the range held; equal ends: a rigid rod
+  Fixed translation;  ///< slider: b's anchor from a's along the axis, m (0 at creation)
+  Fixed length;       ///< the anchors' present distance
+  Fixed min_length;   ///< the range held; equal ends: a rigid rod
   Fixed max_length;
   Fixed lower_impulse;  ///< pushing apart (length >= min_length), >= 0
   Fixed upper_impulse;  ///< pulling together (length <= max_length), >= 0
   Fixed rigid_impulse;  ///< a rigid rod's (or a spring's), either sign
   bool spring;          ///< a rod with spring_frequency > 0: a spring of its length
   Softness spring_soft;
+  // Breakable joints: the sum over the step's sub-steps of the load each carried (the reaction of
+  // its accumulated impulses at the sub-step's end), for the mean that breaking compares.
+  Vec3 force_sum;
+  Vec3 torque_sum;
 };
 
 /// The joints of the step, in ascending joint ID.
@@ -116,7 +122,11 @@ class JointSolver final : public ConstraintKind {
   void solve_swing_limit(JointConstraint& k, bool use_bias);
   void solve_weld(JointConstraint& k, bool use_bias);
   void solve_slide(JointConstraint& k, bool use_bias);
+  void solve_slide_motor(JointConstraint& k);
+  void solve_slide_limit(JointConstraint& k, bool use_bias);
   void solve_distance(JointConstraint& k, bool use_bias);
+  /// The reaction of k's accumulated impulses, at the bodies' present poses.
+  [[nodiscard]] JointReaction reaction(const JointConstraint& k) const;
 
   WorldState& s_;
   SolverBodies& bodies_;

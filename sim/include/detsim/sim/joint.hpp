@@ -52,8 +52,8 @@ struct JointDef {
   bool limit_enabled = false;
   Fixed swing_limit{};  ///< swing-twist cone half-angle, radians, >= 0
   bool motor_enabled = false;
-  Fixed motor_speed{};      ///< rad/s (hinge) or m/s (slider)
-  Fixed motor_max_force{};  ///< N m (hinge) or N (slider), >= 0
+  Fixed motor_speed{};      ///< rad/s (hinge) or m/s (slider), within +-2^30
+  Fixed motor_max_force{};  ///< N m (hinge) or N (slider), 0 <= max_force <= 2^31 - 1
   /// Distance joint: metres, 0 <= min_length <= max_length. Both zero: the distance at creation,
   /// held rigidly. A rope is min_length 0, max_length its length (slack below it).
   Fixed min_length{};
@@ -83,14 +83,49 @@ struct JointState {
   /// is impulse * substeps / dt): the point rows' (world x, y, z).
   Vec3 linear_impulse{};
   Vec3 angular_impulse{};  ///< the angular rows' (hinge, ...) as a world vector, N m s
-  Fixed axial_impulse{};   ///< the distance row's (or a limit's along the axis), N s
-  Fixed motor_impulse{};   ///< the hinge motor's, N m s
-  Fixed limit_impulse{};   ///< the hinge limit's: lower end's minus upper end's, N m s
+  Fixed axial_impulse{};   ///< the distance row's, N s (the swing-twist cone's, N m s)
+  Fixed motor_impulse{};   ///< the hinge motor's, N m s (the slider motor's, N s)
+  /// The hinge's or swing-twist's twist limit (the slider's limit, N s): lower end's minus upper
+  /// end's, N m s
+  Fixed limit_impulse{};
   /// Broke under break_force or break_torque (at the end of a step): no longer solved, joins no
   /// island, does not keep its bodies from colliding.
   bool broken = false;
 
   friend constexpr bool operator==(const JointState&, const JointState&) noexcept = default;
+};
+
+/// The constraint force and torque a joint applied to body_b (body_a got the opposite): `force`
+/// (N, world frame) acts at the joint's anchor on body_b (a distance joint's: body_b's centre),
+/// `torque` (N m, world frame) is the couple of its angular rows, limits and motors beside that
+/// force, so that the joint's moment about its anchor is `torque`. World::joint_reaction derives
+/// it from the accumulated impulses the joint keeps, those of the last sub-step of the last step
+/// it was solved (impulse * substeps / dt); zero for a broken joint. break_force and break_torque
+/// are compared with the mean over the step's sub-steps (docs/JOINTS-WIP.md: the last sub-step
+/// alone overshoots when a load comes on suddenly).
+struct JointReaction {
+  Vec3 force{};
+  Vec3 torque{};
+
+  friend constexpr bool operator==(const JointReaction&, const JointReaction&) noexcept = default;
+};
+
+/// Something that happened to a joint without the game asking for it directly.
+struct JointEvent {
+  enum class Kind : std::uint8_t {
+    broke = 0,      ///< its load passed break_force or break_torque in the step (still readable)
+    destroyed = 1,  ///< destroy_body removed one of its bodies, and the joint with it
+  };
+  Kind kind = Kind::broke;
+  JointId joint{};
+  BodyId body_a{};
+  BodyId body_b{};
+  std::uint64_t user_data = 0;  ///< the joint's, since a destroyed joint can no longer be read
+  /// For `broke`, the load that broke it (the mean over the step's sub-steps); for `destroyed`,
+  /// what joint_reaction() gave just before (zero for a joint destroyed after it broke).
+  JointReaction reaction{};
+
+  friend constexpr bool operator==(const JointEvent&, const JointEvent&) noexcept = default;
 };
 
 }  // namespace detsim

@@ -188,6 +188,20 @@ class World {
   [[nodiscard]] Expected<JointState> joint(JointId id) const;
   /// Every joint's ID, ascending.
   [[nodiscard]] std::vector<JointId> joint_ids() const;
+  /// Sets a hinge's or slider's motor: it drives the joint's speed (rad/s about the hinge's axis,
+  /// m/s along the slider's) towards `speed` with at most `max_force` (N m, N). The motor is
+  /// enabled exactly when max_force > 0 (a motor of no force does nothing: 0 switches it off).
+  /// Wakes both bodies. Refused, changing nothing: an unknown ID, a joint type without a motor,
+  /// a speed beyond +-2^30 or a max_force below 0 or above 2^31 - 1 (a saturated value).
+  Status set_joint_motor(JointId id, Fixed speed, Fixed max_force);
+  /// The force and torque the joint applied to body_b in the last step it was solved (the
+  /// convention: JointReaction), or an error for an unknown ID.
+  [[nodiscard]] Expected<JointReaction> joint_reaction(JointId id) const;
+  /// The joint events of the last step (joints that broke), ascending by joint ID, then the
+  /// events of the joints that destroy_body calls since have removed, in call order (each call's
+  /// ascending). destroy_joint reports nothing: the game asked for it. The next step() starts a
+  /// new list; restore() clears it (output, not state, like contact_events()).
+  [[nodiscard]] std::span<const JointEvent> joint_events() const noexcept;
 
   // ---- Game inputs: accumulated until the next step. Each wakes the body. ----
   // A call whose sums, accelerations or resulting velocities would leave the limits of docs/SIM.md
