@@ -438,7 +438,9 @@ Fixed swing_angle(const World& w, const JointState& j) {
 
 TEST(RagdollsScenario, TumbleDownTheStairsAndComeToRestWholeWithinTheirLimits) {
   // Pushed over the landing's edge, every ragdoll ends lying beyond the foot of the stairs (the
-  // last step's far edge, read from the static boxes): its pelvis lower than one step. At rest
+  // last step's far edge, read from the static boxes): its pelvis lower than one step plus the
+  // thickest part of a ragdoll (its chest's depth, 0.36 m), since one may come to rest on
+  // another (seen: a pelvis at 0.37 m on a neighbour's chest). At rest
   // (10 s) every joint holds within 1 cm, every elbow and knee within 0.02 rad of its range, every
   // swing-twist within 0.02 rad of its cone.
   Scenario s = make("ragdolls");
@@ -458,7 +460,7 @@ TEST(RagdollsScenario, TumbleDownTheStairsAndComeToRestWholeWithinTheirLimits) {
     if (b.shape.type != ShapeType::box || b.shape.half_extents.y != 0.1_fx) continue;  // pelvis
     ++ragdolls;
     EXPECT_GT(b.position.x, foot) << "pelvis " << b.id.value << " still on the stairs";
-    EXPECT_LT(b.position.y, rise) << "pelvis " << b.id.value;
+    EXPECT_LT(b.position.y, rise + 0.36_fx) << "pelvis " << b.id.value;
   }
   EXPECT_EQ(ragdolls, s.params().count);
   EXPECT_LT(worst_gap(w), 0.01_fx) << to_string(worst_gap(w));
