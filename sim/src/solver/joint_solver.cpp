@@ -18,6 +18,11 @@
 // joint_damping_ratio on the anchors' separation, Box2D v3's joint softness); in relax, a rigid
 // one without bias, which removes the velocity the spring added.
 //
+// The point blocks of joints that form a tree (JointTrees, joint_tree.cpp) are solved together,
+// exactly, in each solve and relax pass, between their joints' rows that come before the point
+// block (hinge axes, weld) and those after it (motor, limits): Gauss-Seidel passed a load one
+// joint per pass, and a heavy body on a light chain flailed with one iteration.
+//
 // A hinge joint is a ball joint plus two angular rows about the directions across its axis (as
 // body a carries it), solved as one 2x2 block before the point block (Jolt's hinge: rotation,
 // then point), soft in the same way. Their error is the small angle between the axis as each
@@ -73,33 +78,6 @@ Vec3 axis(std::size_t i) {
   if (i == 1) v.y = Fixed::one();
   if (i == 2) v.z = Fixed::one();
   return v;
-}
-
-// Impulses along three rows at once (a ball joint's x, y and z), each velocity component rounded
-// once for all three.
-void apply_impulses(std::vector<Velocity>& v, const BodyPair& k, const std::array<Direction, 3>& d,
-                    const std::array<Row, 3>& r, Vec3 impulse) {
-  if (impulse == Vec3{}) return;
-  const auto push3 = [&](Velocity& velocity, auto linear, auto angular) {
-    velocity.linear = Vec3Sum{velocity.linear}
-                          .add(impulse.x, linear(0))
-                          .add(impulse.y, linear(1))
-                          .add(impulse.z, linear(2))
-                          .result();
-    velocity.angular = Vec3Sum{velocity.angular}
-                           .add(impulse.x, angular(0))
-                           .add(impulse.y, angular(1))
-                           .add(impulse.z, angular(2))
-                           .result();
-  };
-  if (k.takes_impulse_a)
-    push3(
-        v[k.a], [&](std::size_t i) { return d[i].response_a; },
-        [&](std::size_t i) { return r[i].response_a; });
-  if (k.takes_impulse_b)
-    push3(
-        v[k.b], [&](std::size_t i) { return d[i].response_b; },
-        [&](std::size_t i) { return r[i].response_b; });
 }
 
 // A unit vector perpendicular to the unit vector n, chosen by n's components only (the contact
@@ -220,6 +198,7 @@ void JointSolver::prepare() {
       bodies_.in_contact[ib] = true;
     }
   }
+  trees_.find(constraints_, s_.bodies.size());
 }
 
 // The anchors, the rows and the position error at the bodies' present poses.
@@ -360,6 +339,7 @@ void JointSolver::update_geometry(JointConstraint& k) {
       }
       K.rows[i] = {entries[0], entries[1], entries[2]};
     }
+    k.point_k = K;
     k.point_mass = inverse(K);  // K is positive definite: one body is dynamic
     // An angular row's coupling to the point rows, b_i = J_point_i M^-1 J_row^T (the row has no
     // linear part), as K^-1 b, and the row's effective mass with the point rows held,
@@ -675,8 +655,32 @@ inline void JointSolver::solve_distance(JointConstraint& k, bool use_bias) {
   one_sided(k.max_length - k.length, -Fixed::one(), k.upper_impulse);
 }
 
+void JointSolver::solve_before_point(JointConstraint& k, bool use_bias) {
+  if (k.type == JointType::hinge) solve_hinge_axes(k, use_bias);
+  if (k.type == JointType::fixed) solve_weld(k, use_bias);
+}
+
+void JointSolver::solve_after_point(JointConstraint& k, bool use_bias) {
+  const JointDef& def = s_.joints[k.joint].def;
+  if (k.type == JointType::hinge) {
+    if (def.motor_enabled) solve_hinge_motor(k);
+    if (def.limit_enabled) solve_hinge_limit(k, use_bias);
+  } else if (k.type == JointType::swing_twist && def.limit_enabled) {
+    solve_hinge_limit(k, use_bias);
+    solve_swing_limit(k, use_bias);
+  }
+}
+
+// A pass: each joint in ascending ID, except that the point blocks of the joints in trees are
+// solved together, exactly (joint_tree.cpp), after every joint's rows that come before its point
+// block and before those that come after it.
 void JointSolver::solve_joints(bool use_bias) {
-  for (JointConstraint& k : constraints_) {
+  for (std::size_t c = 0; c < constraints_.size(); ++c) {
+    JointConstraint& k = constraints_[c];
+    if (trees_.holds(c)) {
+      solve_before_point(k, use_bias);
+      continue;
+    }
     if (k.type == JointType::hinge) {
       const JointDef& def = s_.joints[k.joint].def;
       solve_hinge_axes(k, use_bias);
@@ -703,6 +707,11 @@ void JointSolver::solve_joints(bool use_bias) {
     } else {
       solve_distance(k, use_bias);
     }
+  }
+  if (trees_.empty()) return;
+  trees_.solve(constraints_, bodies_, s_, use_bias ? &soft_ : nullptr);
+  for (std::size_t c = 0; c < constraints_.size(); ++c) {
+    if (trees_.holds(c)) solve_after_point(constraints_[c], use_bias);
   }
 }
 

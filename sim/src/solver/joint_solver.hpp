@@ -12,6 +12,7 @@
 #include "../world_state.hpp"
 #include "bodies.hpp"
 #include "constraint_kind.hpp"
+#include "joint_tree.hpp"
 #include "rows.hpp"
 
 namespace detsim::sim_detail {
@@ -32,6 +33,7 @@ struct JointConstraint {
   /// Ball: K^-1, the inverse of the point constraint's 3x3 effective mass matrix
   /// K_ij = J_i M^-1 J_j^T at the present anchors.
   Mat3 point_mass;
+  Mat3 point_k;  ///< K itself (the diagonal block of a tree of joints, joint_tree.cpp)
   Vec3 impulse;  ///< ball, hinge: accumulated along x, y, z
   // Hinge: two angular rows about the directions perpendicular to body a's axis, at the present
   // poses, solved as one 2x2 block.
@@ -114,6 +116,10 @@ class JointSolver final : public ConstraintKind {
   void update_geometry(JointConstraint& k);
   void solve_joints(bool use_bias);
   void solve_ball(JointConstraint& k, bool use_bias);
+  /// The rows a joint of a tree solves before (hinge axes, weld) and after (motor, limits) the
+  /// tree's point blocks.
+  void solve_before_point(JointConstraint& k, bool use_bias);
+  void solve_after_point(JointConstraint& k, bool use_bias);
   void solve_hinge_axes(JointConstraint& k, bool use_bias);
   void solve_hinge_motor(JointConstraint& k);
   void solve_hinge_limit(JointConstraint& k, bool use_bias);
@@ -132,6 +138,7 @@ class JointSolver final : public ConstraintKind {
   SolverBodies& bodies_;
   Softness soft_;
   std::vector<JointConstraint> constraints_;
+  JointTrees trees_;
 };
 
 }  // namespace detsim::sim_detail

@@ -28,6 +28,7 @@
 // the same count.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -163,6 +164,34 @@ inline void apply_impulses(std::vector<Velocity>& v, const BodyPair& k, const Di
     push(v[k.b], impulse_1, {d1.response_b, r1.response_b}, impulse_2,
          {d2.response_b, r2.response_b});
   }
+}
+
+/// Impulses along three rows at once (a joint's point rows along x, y and z), each velocity
+/// component rounded once for all three.
+inline void apply_impulses(std::vector<Velocity>& v, const BodyPair& k,
+                           const std::array<Direction, 3>& d, const std::array<Row, 3>& r,
+                           Vec3 impulse) {
+  if (impulse == Vec3{}) return;
+  const auto push3 = [&](Velocity& velocity, auto linear, auto angular) {
+    velocity.linear = Vec3Sum{velocity.linear}
+                          .add(impulse.x, linear(0))
+                          .add(impulse.y, linear(1))
+                          .add(impulse.z, linear(2))
+                          .result();
+    velocity.angular = Vec3Sum{velocity.angular}
+                           .add(impulse.x, angular(0))
+                           .add(impulse.y, angular(1))
+                           .add(impulse.z, angular(2))
+                           .result();
+  };
+  if (k.takes_impulse_a)
+    push3(
+        v[k.a], [&](std::size_t i) { return d[i].response_a; },
+        [&](std::size_t i) { return r[i].response_a; });
+  if (k.takes_impulse_b)
+    push3(
+        v[k.b], [&](std::size_t i) { return d[i].response_b; },
+        [&](std::size_t i) { return r[i].response_b; });
 }
 
 }  // namespace detsim::sim_detail
