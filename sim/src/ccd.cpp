@@ -89,6 +89,9 @@ bool box_overlap(Vec3 amin, Vec3 amax, Vec3 bmin, Vec3 bmax) {
 void continuous(WorldState& s) {
   const Fixed target = s.def.linear_slop;                     // stop this close to the surface
   const std::vector<std::uint64_t> joined = joined_pairs(s);  // these never collide
+  // Each body's bounding radius, or -1 when unbounded (a plane): looked up once per body, not once
+  // per pair, and only in a step that has a body to sweep.
+  std::vector<Fixed> reach;
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
     BodyState& body = s.bodies[i];
     if (body.type != BodyType::dynamic || !body.awake || body.sensor) continue;
@@ -108,8 +111,15 @@ void continuous(WorldState& s) {
                                   : Fixed::zero();
     const Fixed bound = distance_moved + rim;
     if (bound == Fixed::zero()) continue;
+    if (reach.empty()) {
+      reach.resize(s.bodies.size());
+      for (std::size_t k = 0; k < s.bodies.size(); ++k) {
+        const ShapeKind& kind = shape_kind(s.bodies[k].shape.type);
+        reach[k] = kind.bounded ? kind.bounding_radius(s.bodies[k].shape) : -Fixed::one();
+      }
+    }
     // The box the sweep covers.
-    const Fixed r = bounding_radius(body.shape);
+    const Fixed r = reach[i];
     const Vec3 rr{r, r, r};
     const Vec3 lo{min(sweep.p0.x, sweep.p1.x), min(sweep.p0.y, sweep.p1.y),
                   min(sweep.p0.z, sweep.p1.z)};
@@ -124,7 +134,6 @@ void continuous(WorldState& s) {
       const BodyState& other = s.bodies[j];
       if (other.sensor) continue;
       if ((body.layer & other.mask) == 0 || (other.layer & body.mask) == 0) continue;
-      if (is_joined_pair(joined, i, j)) continue;
       // The other body moves too, from its pose at the start of the step to its pose now: the
       // sweep is of the pair, both at the same time t, so a body that moves along with this one
       // is never hit, and one that this body passed during the step always is.
@@ -133,8 +142,10 @@ void continuous(WorldState& s) {
                               other.orientation, other.orientation != od.start_orientation};
       const bool other_moves = other_sweep.p0 != other_sweep.p1 || other_sweep.turns;
       Fixed pair_bound = bound;
-      if (shape_kind(other.shape.type).bounded) {
-        const Fixed o = bounding_radius(other.shape);
+      const Fixed o = reach[j];
+      const bool other_bounded = o >= Fixed::zero();
+      if (other_bounded) {
+        // The swept boxes first: the cheap test that rejects nearly every pair.
         const Vec3 oo{o, o, o};
         const Vec3 olo{min(other_sweep.p0.x, other_sweep.p1.x),
                        min(other_sweep.p0.y, other_sweep.p1.y),
@@ -143,11 +154,12 @@ void continuous(WorldState& s) {
                        max(other_sweep.p0.y, other_sweep.p1.y),
                        max(other_sweep.p0.z, other_sweep.p1.z)};
         if (!box_overlap(sweep_min, sweep_max, olo - oo, ohi + oo)) continue;
-        if (other_moves) {
-          pair_bound += length(other_sweep.p1 - other_sweep.p0);
-          if (other_sweep.turns)
-            pair_bound += angle_bound(other_sweep.q0, other_sweep.q1) * o * Fixed::from_int(2);
-        }
+      }
+      if (is_joined_pair(joined, i, j)) continue;
+      if (other_bounded && other_moves) {
+        pair_bound += length(other_sweep.p1 - other_sweep.p0);
+        if (other_sweep.turns)
+          pair_bound += angle_bound(other_sweep.q0, other_sweep.q1) * o * Fixed::from_int(2);
       }
       const Fixed pair_beyond = pair_bound + target + r;
       // Already touching at the start: the contact solver has it; a sweep would only stick.
