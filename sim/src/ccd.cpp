@@ -8,11 +8,14 @@
 // kept: the next step's speculative contact then stops it as usual. Swept bodies: those with the
 // CCD flag, and any dynamic body whose travel in the step exceeds half its smallest dimension.
 // They are swept in ascending ID order against every other solid body the layers allow, static
-// ones and moving ones alike. A moving one is swept too, from its pose at the start of the step to
-// its pose now (after the solver, possibly already moved back): the time of impact is the pair's,
-// both at the same fraction of the step, so a bullet stops at a crate it hits however fast either
-// moves, and never at a body that moves along with it. Ties are broken by ID: lower IDs are swept
-// first, and a later body sweeps against where they ended.
+// ones and moving ones alike, whose swept box overlaps their own: the candidates come from one
+// sort and sweep of all swept boxes (ccd_pairs.hpp), the very pairs an all-pairs test finds, so
+// the cost follows what a sweep can reach, not the size of the world. A moving one is swept too,
+// from its pose at the start of the step to its pose now (after the solver, possibly already
+// moved back): the time of impact is the pair's, both at the same fraction of the step, so a
+// bullet stops at a crate it hits however fast either moves, and never at a body that moves along
+// with it. Ties are broken by ID: lower IDs are swept first, and a later body sweeps against
+// where they ended.
 //
 // The sweep is conservative advancement: with d the distance at time t of the step and b a bound
 // on how fast the distance can shrink per unit of t, no touch can happen before t + d / b. Every
