@@ -8,11 +8,14 @@
 // kept: the next step's speculative contact then stops it as usual. Swept bodies: those with the
 // CCD flag, and any dynamic body whose travel in the step exceeds half its smallest dimension.
 // They are swept in ascending ID order against every other solid body the layers allow, static
-// ones and moving ones alike. A moving one is swept too, from its pose at the start of the step to
-// its pose now (after the solver, possibly already moved back): the time of impact is the pair's,
-// both at the same fraction of the step, so a bullet stops at a crate it hits however fast either
-// moves, and never at a body that moves along with it. Ties are broken by ID: lower IDs are swept
-// first, and a later body sweeps against where they ended.
+// ones and moving ones alike, whose swept box overlaps their own: the candidates come from one
+// sort and sweep of all swept boxes (ccd_pairs.hpp), the very pairs an all-pairs test finds, so
+// the cost follows what a sweep can reach, not the size of the world. A moving one is swept too,
+// from its pose at the start of the step to its pose now (after the solver, possibly already
+// moved back): the time of impact is the pair's, both at the same fraction of the step, so a
+// bullet stops at a crate it hits however fast either moves, and never at a body that moves along
+// with it. Ties are broken by ID: lower IDs are swept first, and a later body sweeps against
+// where they ended.
 //
 // The sweep is conservative advancement: with d the distance at time t of the step and b a bound
 // on how fast the distance can shrink per unit of t, no touch can happen before t + d / b. Every
@@ -20,12 +23,14 @@
 // target gap, or gives up after a fixed number of iterations (a fixed bound: the same work and
 // result on every machine) and keeps the last safe time.
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include <detsim/fixed/math.hpp>
 #include <detsim/fixed/quat.hpp>
 
+#include "ccd_pairs.hpp"
 #include "shapes.hpp"
 #include "world_state.hpp"
 
@@ -79,18 +84,36 @@ Fixed distance(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, F
   return d;
 }
 
-bool box_overlap(Vec3 amin, Vec3 amax, Vec3 bmin, Vec3 bmax) {
-  return amin.x <= bmax.x && bmin.x <= amax.x && amin.y <= bmax.y && bmin.y <= amax.y &&
-         amin.z <= bmax.z && bmin.z <= amax.z;
+bool swept_boxes_overlap(const SweptBox& a, const SweptBox& b) {
+  return a.min.x <= b.max.x && b.min.x <= a.max.x && a.min.y <= b.max.y && b.min.y <= a.max.y &&
+         a.min.z <= b.max.z && b.min.z <= a.max.z;
 }
 
-}  // namespace
+// The box body i covers from its pose at the start of the step to its pose now, for a body of
+// bounding radius r.
+SweptBox swept_box(const WorldState& s, std::size_t i, Fixed r) {
+  const Vec3 p0 = s.derived[i].start_position;
+  const Vec3 p1 = s.bodies[i].position;
+  const Vec3 rr{r, r, r};
+  const Vec3 lo{min(p0.x, p1.x), min(p0.y, p1.y), min(p0.z, p1.z)};
+  const Vec3 hi{max(p0.x, p1.x), max(p0.y, p1.y), max(p0.z, p1.z)};
+  return {lo - rr, hi + rr, static_cast<std::uint32_t>(i), false};
+}
 
-void continuous(WorldState& s) {
-  const Fixed target = s.def.linear_slop;                     // stop this close to the surface
-  const std::vector<std::uint64_t> joined = joined_pairs(s);  // these never collide
+// A body this pass sweeps: its motion in the step and a bound of how fast the distance to
+// anything can shrink per unit of t.
+struct Mover {
+  std::size_t index = 0;
+  Sweep sweep;
+  Fixed bound;
+};
+
+// The bodies to sweep, ascending by index. Whether a body is swept depends on its own motion
+// alone, which nothing in this pass changes before its turn, so they can be chosen up front.
+std::vector<Mover> movers(const WorldState& s) {
+  std::vector<Mover> out;
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
-    BodyState& body = s.bodies[i];
+    const BodyState& body = s.bodies[i];
     if (body.type != BodyType::dynamic || !body.awake || body.sensor) continue;
     const Derived& d = s.derived[i];
     const Vec3 travel = body.position - d.start_position;
@@ -100,30 +123,84 @@ void continuous(WorldState& s) {
     if (!body.ccd && !fast) continue;
     const Sweep sweep{d.start_position, body.position, d.start_orientation, body.orientation,
                       body.orientation != d.start_orientation};
-    // How fast the distance to anything can shrink per unit of t: the travel plus the rim speed.
-    // Normalised lerp turns at a varying rate, at most twice its mean for any angle up to pi, so
-    // the rim term is doubled.
+    // The travel plus the rim speed. Normalised lerp turns at a varying rate, at most twice its
+    // mean for any angle up to pi, so the rim term is doubled.
     const Fixed rim = sweep.turns ? angle_bound(sweep.q0, sweep.q1) * bounding_radius(body.shape) *
                                         Fixed::from_int(2)
                                   : Fixed::zero();
     const Fixed bound = distance_moved + rim;
     if (bound == Fixed::zero()) continue;
-    // The box the sweep covers.
-    const Fixed r = bounding_radius(body.shape);
-    const Vec3 rr{r, r, r};
-    const Vec3 lo{min(sweep.p0.x, sweep.p1.x), min(sweep.p0.y, sweep.p1.y),
-                  min(sweep.p0.z, sweep.p1.z)};
-    const Vec3 hi{max(sweep.p0.x, sweep.p1.x), max(sweep.p0.y, sweep.p1.y),
-                  max(sweep.p0.z, sweep.p1.z)};
-    const Vec3 sweep_min = lo - rr;
-    const Vec3 sweep_max = hi + rr;
+    out.push_back({i, sweep, bound});
+  }
+  return out;
+}
+
+}  // namespace
+
+void continuous(WorldState& s) {
+  const std::vector<Mover> swept = movers(s);
+  if (swept.empty()) return;
+  const std::size_t n = s.bodies.size();
+  // Each body's bounding radius, or -1 when unbounded (a plane): looked up once per body, not
+  // once per pair. The swept boxes of the solid bounded bodies give the candidates; the planes
+  // reach everything and are candidates of every sweep.
+  std::vector<Fixed> reach(n);
+  std::vector<SweptBox> boxes;
+  std::vector<std::uint32_t> planes;  // ascending
+  boxes.reserve(n);
+  for (std::size_t k = 0, m = 0; k < n; ++k) {
+    const ShapeKind& kind = shape_kind(s.bodies[k].shape.type);
+    reach[k] = kind.bounded ? kind.bounding_radius(s.bodies[k].shape) : -Fixed::one();
+    if (s.bodies[k].sensor) continue;
+    if (!kind.bounded) {
+      planes.push_back(static_cast<std::uint32_t>(k));
+      continue;
+    }
+    boxes.push_back(swept_box(s, k, reach[k]));
+    while (m < swept.size() && swept[m].index < k)
+      ++m;
+    boxes.back().swept = m < swept.size() && swept[m].index == k;
+  }
+  // The candidates are found once, from the boxes at the start of the pass. A hit moves a body
+  // back to p0 + (p1 - p0) t with 0 <= t < 1, which (rounded to nearest, so |(p1 - p0) t| <=
+  // |p1 - p0| on each axis) lies between p0 and p1: a later sweep sees a box within the one it
+  // had here, so no pair it would test is missing. Each candidate is still tested against the
+  // boxes as they are at its turn, as the all-pairs loop did.
+  const std::vector<std::uint64_t> pairs = swept_box_pairs(std::move(boxes));
+  const std::vector<std::uint64_t> joined = joined_pairs(s);  // these never collide
+  const Fixed target = s.def.linear_slop;                     // stop this close to the surface
+  std::vector<std::uint32_t> near;  // the current sweep's candidates, ascending
+  std::size_t next_pair = 0;
+  for (const Mover& mover : swept) {
+    const std::size_t i = mover.index;
+    BodyState& body = s.bodies[i];
+    const Sweep& sweep = mover.sweep;
+    const Fixed bound = mover.bound;
+    // This sweep's candidates: its pairs (ascending by other index) merged with the planes.
+    const std::size_t first_pair = next_pair;
+    while (next_pair < pairs.size() && (pairs[next_pair] >> 32) == i)
+      ++next_pair;
+    near.clear();
+    std::size_t plane = 0;
+    for (std::size_t k = first_pair; k < next_pair; ++k) {
+      const auto j = static_cast<std::uint32_t>(pairs[k] & 0xFFFFFFFFU);
+      for (; plane < planes.size() && planes[plane] < j; ++plane)
+        near.push_back(planes[plane]);
+      near.push_back(j);
+    }
+    near.insert(near.end(), planes.begin() + static_cast<std::ptrdiff_t>(plane), planes.end());
+    const Fixed r = reach[i];
+    const SweptBox box = swept_box(s, i, r);
 
     Fixed first_hit = Fixed::one();  // the earliest touch, as a fraction of the step
-    for (std::size_t j = 0; j < s.bodies.size(); ++j) {
-      if (j == i) continue;
+    for (const std::uint32_t candidate : near) {
+      const std::size_t j = candidate;
       const BodyState& other = s.bodies[j];
-      if (other.sensor) continue;
       if ((body.layer & other.mask) == 0 || (other.layer & body.mask) == 0) continue;
+      const Fixed o = reach[j];
+      const bool other_bounded = o >= Fixed::zero();
+      // The box the other body covers now (an earlier sweep may have moved it back).
+      if (other_bounded && !swept_boxes_overlap(box, swept_box(s, j, o))) continue;
       if (is_joined_pair(joined, i, j)) continue;
       // The other body moves too, from its pose at the start of the step to its pose now: the
       // sweep is of the pair, both at the same time t, so a body that moves along with this one
@@ -133,21 +210,10 @@ void continuous(WorldState& s) {
                               other.orientation, other.orientation != od.start_orientation};
       const bool other_moves = other_sweep.p0 != other_sweep.p1 || other_sweep.turns;
       Fixed pair_bound = bound;
-      if (shape_kind(other.shape.type).bounded) {
-        const Fixed o = bounding_radius(other.shape);
-        const Vec3 oo{o, o, o};
-        const Vec3 olo{min(other_sweep.p0.x, other_sweep.p1.x),
-                       min(other_sweep.p0.y, other_sweep.p1.y),
-                       min(other_sweep.p0.z, other_sweep.p1.z)};
-        const Vec3 ohi{max(other_sweep.p0.x, other_sweep.p1.x),
-                       max(other_sweep.p0.y, other_sweep.p1.y),
-                       max(other_sweep.p0.z, other_sweep.p1.z)};
-        if (!box_overlap(sweep_min, sweep_max, olo - oo, ohi + oo)) continue;
-        if (other_moves) {
-          pair_bound += length(other_sweep.p1 - other_sweep.p0);
-          if (other_sweep.turns)
-            pair_bound += angle_bound(other_sweep.q0, other_sweep.q1) * o * Fixed::from_int(2);
-        }
+      if (other_bounded && other_moves) {
+        pair_bound += length(other_sweep.p1 - other_sweep.p0);
+        if (other_sweep.turns)
+          pair_bound += angle_bound(other_sweep.q0, other_sweep.q1) * o * Fixed::from_int(2);
       }
       const Fixed pair_beyond = pair_bound + target + r;
       // Already touching at the start: the contact solver has it; a sweep would only stick.
