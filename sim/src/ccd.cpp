@@ -105,7 +105,8 @@ SweptBox swept_box(const WorldState& s, std::size_t i, Fixed r) {
 struct Mover {
   std::size_t index = 0;
   Sweep sweep;
-  Fixed bound;
+  Vec3 travel;  ///< p1 - p0
+  Fixed rim;    ///< how fast the turn can move the body's surface, per unit of t
 };
 
 // The bodies to sweep, ascending by index. Whether a body is swept depends on its own motion
@@ -128,11 +129,56 @@ std::vector<Mover> movers(const WorldState& s) {
     const Fixed rim = sweep.turns ? angle_bound(sweep.q0, sweep.q1) * bounding_radius(body.shape) *
                                         Fixed::from_int(2)
                                   : Fixed::zero();
-    const Fixed bound = distance_moved + rim;
-    if (bound == Fixed::zero()) continue;
-    out.push_back({i, sweep, bound});
+    if (distance_moved + rim == Fixed::zero()) continue;
+    out.push_back({i, sweep, travel, rim});
   }
   return out;
+}
+
+// The joint islands of the dynamic bodies. Unbroken joints between two dynamic bodies join;
+// static and kinematic bodies do not carry an island's motion back, so they cut it. Both lists
+// are empty without joints.
+struct JointIslands {
+  /// Per body index: the island's lowest body index (the body's own when it is joined to none).
+  std::vector<std::uint32_t> root;
+  /// Per body index: the next body of its island, in a cycle through the island (ascending by
+  /// index from the lowest, the highest back to the lowest); itself when it is joined to none.
+  std::vector<std::uint32_t> next;
+};
+
+JointIslands joint_islands(const WorldState& s) {
+  if (s.joints.empty()) return {};
+  const std::size_t n = s.bodies.size();
+  std::vector<std::uint32_t> root(n);
+  for (std::size_t k = 0; k < n; ++k)
+    root[k] = static_cast<std::uint32_t>(k);
+  const auto find = [&](std::uint32_t k) {
+    while (root[k] != k)
+      k = root[k] = root[root[k]];
+    return k;
+  };
+  for (const JointState& j : s.joints) {
+    if (j.broken) continue;
+    const std::ptrdiff_t a = s.find(j.def.body_a.value);
+    const std::ptrdiff_t b = s.find(j.def.body_b.value);
+    if (s.bodies[static_cast<std::size_t>(a)].type != BodyType::dynamic ||
+        s.bodies[static_cast<std::size_t>(b)].type != BodyType::dynamic)
+      continue;
+    const std::uint32_t ra = find(static_cast<std::uint32_t>(a));
+    const std::uint32_t rb = find(static_cast<std::uint32_t>(b));
+    root[std::max(ra, rb)] = std::min(ra, rb);  // the lowest index is the root: order-free
+  }
+  // Link each island's members in ascending index order into a cycle.
+  std::vector<std::uint32_t> next(n);
+  std::vector<std::uint32_t> last(n, UINT32_MAX);  // per root: the member seen last
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t r = find(static_cast<std::uint32_t>(k));
+    root[k] = r;
+    next[k] = r;  // the highest member's next stays its root
+    if (last[r] != UINT32_MAX) next[last[r]] = static_cast<std::uint32_t>(k);
+    last[r] = static_cast<std::uint32_t>(k);
+  }
+  return {std::move(root), std::move(next)};
 }
 
 }  // namespace
@@ -169,13 +215,28 @@ void continuous(WorldState& s) {
   const std::vector<std::uint64_t> pairs = swept_box_pairs(std::move(boxes));
   const std::vector<std::uint64_t> joined = joined_pairs(s);  // these never collide
   const Fixed target = s.def.linear_slop;                     // stop this close to the surface
+  // A body moved back to its first touch takes the bodies jointed to it along, each to the same
+  // fraction of its own motion in the step, so that no joint is torn open by the pass (a ragdoll
+  // whose forearm meets a step stops where the forearm touched, as a whole).
+  // Two bodies of one joint island are not swept against each other: the joints hold them
+  // together, so neither can pass the other within a step, and a touch between them (a hand on
+  // its own chest) is the contact solver's. Swept, such a touch would stop the whole island at
+  // the start of every step while its velocity grew.
+  const JointIslands islands = joint_islands(s);
+  const std::vector<std::uint32_t>& island_next = islands.next;
+  std::vector<Mover> movers_now = swept;  // sweeps shortened as islands are moved back
+  std::vector<std::uint32_t> mover_of;    // body index -> position in movers_now, or -1
+  if (!island_next.empty()) {
+    mover_of.assign(n, UINT32_MAX);
+    for (std::size_t m = 0; m < movers_now.size(); ++m)
+      mover_of[movers_now[m].index] = static_cast<std::uint32_t>(m);
+  }
   std::vector<std::uint32_t> near;  // the current sweep's candidates, ascending
   std::size_t next_pair = 0;
-  for (const Mover& mover : swept) {
+  for (const Mover& mover : movers_now) {
     const std::size_t i = mover.index;
     BodyState& body = s.bodies[i];
     const Sweep& sweep = mover.sweep;
-    const Fixed bound = mover.bound;
     // This sweep's candidates: its pairs (ascending by other index) merged with the planes.
     const std::size_t first_pair = next_pair;
     while (next_pair < pairs.size() && (pairs[next_pair] >> 32) == i)
@@ -202,19 +263,22 @@ void continuous(WorldState& s) {
       // The box the other body covers now (an earlier sweep may have moved it back).
       if (other_bounded && !swept_boxes_overlap(box, swept_box(s, j, o))) continue;
       if (is_joined_pair(joined, i, j)) continue;
+      if (!island_next.empty() && islands.root[i] == islands.root[j]) continue;
       // The other body moves too, from its pose at the start of the step to its pose now: the
       // sweep is of the pair, both at the same time t, so a body that moves along with this one
       // is never hit, and one that this body passed during the step always is.
       const Derived& od = s.derived[j];
       const Sweep other_sweep{od.start_position, other.position, od.start_orientation,
                               other.orientation, other.orientation != od.start_orientation};
-      const bool other_moves = other_sweep.p0 != other_sweep.p1 || other_sweep.turns;
-      Fixed pair_bound = bound;
-      if (other_bounded && other_moves) {
-        pair_bound += length(other_sweep.p1 - other_sweep.p0);
-        if (other_sweep.turns)
-          pair_bound += angle_bound(other_sweep.q0, other_sweep.q1) * o * Fixed::from_int(2);
-      }
+      // How fast the pair's distance can shrink per unit of t: their relative travel (both move
+      // linearly in t, so the difference of their positions does too) plus both rims. Two bodies
+      // that move together (the parts of a falling ragdoll, a pile carried on a platform) have
+      // no relative travel: without a turn they cannot meet in this step, and summing their
+      // travels instead made every such sweep run out of iterations and stop the body short.
+      Fixed pair_bound = length(mover.travel - (other_sweep.p1 - other_sweep.p0)) + mover.rim;
+      if (other_bounded && other_sweep.turns)
+        pair_bound += angle_bound(other_sweep.q0, other_sweep.q1) * o * Fixed::from_int(2);
+      if (pair_bound == Fixed::zero()) continue;
       const Fixed pair_beyond = pair_bound + target + r;
       // Already touching at the start: the contact solver has it; a sweep would only stick.
       if (distance(body.shape, sweep.at(Fixed::zero()), other.shape, other_sweep.at(Fixed::zero()),
@@ -239,6 +303,22 @@ void continuous(WorldState& s) {
       const Pose p = sweep.at(first_hit);
       body.position = p.position;
       if (sweep.turns) body.orientation = nlerp(sweep.q0, sweep.q1, first_hit);
+      if (island_next.empty()) continue;
+      for (std::uint32_t k = island_next[i]; k != i; k = island_next[k]) {
+        BodyState& joined_body = s.bodies[k];
+        const Derived& kd = s.derived[k];
+        const Sweep along{kd.start_position, joined_body.position, kd.start_orientation,
+                          joined_body.orientation, joined_body.orientation != kd.start_orientation};
+        joined_body.position = along.at(first_hit).position;
+        if (along.turns) joined_body.orientation = nlerp(along.q0, along.q1, first_hit);
+        // A body still to be swept sweeps from its start to where it is now.
+        if (mover_of[k] != UINT32_MAX) {
+          Mover& later = movers_now[mover_of[k]];
+          later.sweep.p1 = joined_body.position;
+          later.sweep.q1 = joined_body.orientation;
+          later.travel = joined_body.position - kd.start_position;
+        }
+      }
     }
   }
 }
