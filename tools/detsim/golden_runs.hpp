@@ -21,14 +21,20 @@ struct GoldenRun {
 inline constexpr GoldenRun runs[] = {
     {"arena", {.seed = 1, .players = 4, .count = 0}, 1200},
     {"bounce", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"bridge", {.seed = 1, .players = 0, .count = 20}, 1000},
     {"bullet_wall", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"chain", {.seed = 1, .players = 0, .count = 30}, 1200},
     {"dominoes", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"motors", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"pendulum", {.seed = 1, .players = 0, .count = 0}, 1200},
     {"pile_boxes", {.seed = 1, .players = 0, .count = 64}, 1000},
     {"pile_spheres", {.seed = 1, .players = 0, .count = 64}, 1000},
     {"pyramid", {.seed = 1, .players = 0, .count = 8}, 1000},
+    {"ragdolls", {.seed = 3, .players = 0, .count = 4}, 1000},
     {"slope", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"spray", {.seed = 3, .players = 0, .count = 0}, 1200},
     {"stack", {.seed = 1, .players = 0, .count = 0}, 1200},
+    {"wrecking_ball", {.seed = 1, .players = 0, .count = 0}, 1000},
 };
 
 }  // namespace detsim::golden
