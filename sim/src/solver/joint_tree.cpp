@@ -192,16 +192,28 @@ void JointTrees::find(const std::vector<JointConstraint>& constraints, std::size
       node.body_is_a = constraints[f.constraint].bodies.a == f.body;
       node.links_begin = static_cast<std::uint32_t>(links_.size());
       for (std::uint32_t s = d; s > f.first_sibling; --s)
-        links_.push_back({node_of(s - 1), {}, {}});
-      if (via[f.body] != none) links_.push_back({node_of(via[f.body]), {}, {}});
+        links_.push_back({node_of(s - 1), {}, {}, {}});
+      if (via[f.body] != none) links_.push_back({node_of(via[f.body]), {}, {}, {}});
       node.links_end = static_cast<std::uint32_t>(links_.size());
       held_[f.constraint] = true;
     }
   }
 }
 
+void JointTrees::update_couplings(const std::vector<JointConstraint>& constraints,
+                                  const WorldState& s) {
+  for (const Node& node : nodes_) {
+    const JointConstraint& k = constraints[node.constraint];
+    const Fixed inverse_mass = s.derived[node.body].inverse_mass;
+    for (std::uint32_t l = node.links_begin; l < node.links_end; ++l) {
+      const JointConstraint& o = constraints[nodes_[links_[l].node].constraint];
+      links_[l].coupling = coupling(k, node.body_is_a, o, o.bodies.a == node.body, inverse_mass);
+    }
+  }
+}
+
 void JointTrees::solve(std::vector<JointConstraint>& constraints, SolverBodies& bodies,
-                       const WorldState& s, const Softness* soft) {
+                       const Softness* soft) {
   // Every joint's speed before any impulse (one system, solved at once), its pivot and its
   // right-hand side; A's blocks between joints on one body.
   const Fixed scale = soft ? Fixed::one() / soft->mass_scale : Fixed::one();
@@ -218,12 +230,8 @@ void JointTrees::solve(std::vector<JointConstraint>& constraints, SolverBodies& 
       node.pivot = k.point_k;
       node.rhs = -cdot;
     }
-    const Fixed inverse_mass = s.derived[node.body].inverse_mass;
-    for (std::uint32_t l = node.links_begin; l < node.links_end; ++l) {
-      const Node& other = nodes_[links_[l].node];
-      const JointConstraint& o = constraints[other.constraint];
-      links_[l].block = coupling(k, node.body_is_a, o, o.bodies.a == node.body, inverse_mass);
-    }
+    for (std::uint32_t l = node.links_begin; l < node.links_end; ++l)
+      links_[l].block = links_[l].coupling;
   }
   // LDL^T from the leaves: each node's pivot inverted, its later neighbours' blocks and
   // right-hand sides less its part (A_kl -= A_kj pivot^-1 A_jl, all on its parent body).
