@@ -157,15 +157,13 @@ JointIslands joint_islands(const WorldState& s) {
       k = root[k] = root[root[k]];
     return k;
   };
-  for (const JointState& j : s.joints) {
-    if (j.broken) continue;
-    const std::ptrdiff_t a = s.find(j.def.body_a.value);
-    const std::ptrdiff_t b = s.find(j.def.body_b.value);
-    if (s.bodies[static_cast<std::size_t>(a)].type != BodyType::dynamic ||
-        s.bodies[static_cast<std::size_t>(b)].type != BodyType::dynamic)
-      continue;
-    const std::uint32_t ra = find(static_cast<std::uint32_t>(a));
-    const std::uint32_t rb = find(static_cast<std::uint32_t>(b));
+  for (std::size_t ji = 0; ji < s.joints.size(); ++ji) {
+    if (s.joints[ji].broken) continue;
+    const std::uint32_t a = s.joint_bodies[ji][0];
+    const std::uint32_t b = s.joint_bodies[ji][1];
+    if (s.bodies[a].type != BodyType::dynamic || s.bodies[b].type != BodyType::dynamic) continue;
+    const std::uint32_t ra = find(a);
+    const std::uint32_t rb = find(b);
     root[std::max(ra, rb)] = std::min(ra, rb);  // the lowest index is the root: order-free
   }
   // Link each island's members in ascending index order into a cycle.

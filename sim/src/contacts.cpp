@@ -93,10 +93,10 @@ UnionFind islands(const WorldState& s) {
       uf.join(static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
   }
   // Joined bodies are one island: they sleep and wake together.
-  for (const JointState& j : s.joints) {
-    if (j.broken) continue;
-    const std::size_t ia = index_of(s, j.def.body_a.value);
-    const std::size_t ib = index_of(s, j.def.body_b.value);
+  for (std::size_t ji = 0; ji < s.joints.size(); ++ji) {
+    if (s.joints[ji].broken) continue;
+    const std::size_t ia = s.joint_bodies[ji][0];
+    const std::size_t ib = s.joint_bodies[ji][1];
     if (s.bodies[ia].type == BodyType::dynamic && s.bodies[ib].type == BodyType::dynamic)
       uf.join(static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
   }
@@ -106,8 +106,9 @@ UnionFind islands(const WorldState& s) {
 // `f(ia, ib)` for the body indices of every unbroken joint, in joint order.
 template <class F>
 void each_joint(const WorldState& s, F&& f) {
-  for (const JointState& j : s.joints) {
-    if (!j.broken) f(index_of(s, j.def.body_a.value), index_of(s, j.def.body_b.value));
+  for (std::size_t ji = 0; ji < s.joints.size(); ++ji) {
+    if (!s.joints[ji].broken)
+      f(std::size_t{s.joint_bodies[ji][0]}, std::size_t{s.joint_bodies[ji][1]});
   }
 }
 

@@ -39,10 +39,11 @@ void wake_body(WorldState& s, BodyId id) {
 
 std::vector<std::uint64_t> joined_pairs(const WorldState& s) {
   std::vector<std::uint64_t> pairs;
-  for (const JointState& j : s.joints) {
+  for (std::size_t ji = 0; ji < s.joints.size(); ++ji) {
+    const JointState& j = s.joints[ji];
     if (j.broken || j.def.collide_connected) continue;
-    const auto ia = static_cast<std::uint64_t>(s.find(j.def.body_a.value));
-    const auto ib = static_cast<std::uint64_t>(s.find(j.def.body_b.value));
+    const std::uint64_t ia = s.joint_bodies[ji][0];
+    const std::uint64_t ib = s.joint_bodies[ji][1];
     pairs.push_back((std::min(ia, ib) << 32) | std::max(ia, ib));
   }
   std::sort(pairs.begin(), pairs.end());

@@ -32,6 +32,12 @@ void prepare_bodies(WorldState& s) {
   s.derived.resize(s.bodies.size());
   for (std::size_t i = 0; i < s.bodies.size(); ++i)
     prepare_body(s, i);
+  s.joint_bodies.resize(s.joints.size());
+  for (std::size_t j = 0; j < s.joints.size(); ++j) {
+    const JointDef& def = s.joints[j].def;
+    s.joint_bodies[j] = {static_cast<std::uint32_t>(s.find(def.body_a.value)),
+                         static_cast<std::uint32_t>(s.find(def.body_b.value))};
+  }
 }
 
 void prepare_body(WorldState& s, std::size_t i) {

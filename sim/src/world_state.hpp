@@ -84,6 +84,12 @@ struct WorldState {
   std::vector<JointState> joints;  ///< ascending ID
   std::uint32_t next_joint_id = 1;
   std::vector<Derived> derived;  ///< rebuilt each step
+  /// Step scratch, not saved: where each joint's body_a and body_b are in `bodies` (parallel to
+  /// `joints`), set by prepare_bodies for the stages after it so that they need not search for
+  /// the IDs every stage and sub-step (the contacts' index_a and index_b, for joints). Stale
+  /// between steps (bodies and joints are created and destroyed): nothing outside the step reads
+  /// it.
+  std::vector<std::array<std::uint32_t, 2>> joint_bodies;
   /// The broadphase's sweep order at the last step (body indices): where the next step's sort
   /// starts. Not saved: the order sorted to is total, so stale or empty content changes nothing
   /// but the time the sort takes.
@@ -147,6 +153,7 @@ void prepare_body(WorldState& s, std::size_t i);
 
 /// The pairs of bodies that a joint keeps from colliding (unbroken, collide_connected false), as
 /// (lower index << 32 | higher index) into `bodies`, ascending (joints.cpp). Empty without joints.
+/// Within a step only (it reads joint_bodies).
 [[nodiscard]] std::vector<std::uint64_t> joined_pairs(const WorldState& s);
 /// Whether (i, j), in either order, is in a list from joined_pairs.
 [[nodiscard]] bool is_joined_pair(const std::vector<std::uint64_t>& pairs, std::size_t i,

@@ -88,16 +88,27 @@ Vec3 perpendicular(Vec3 n) {
   return normalize(Vec3{Fixed::zero(), n.z, -n.y});
 }
 
-// The row of a relative rotation about the unit vector u: J = (0, -u, 0, u), with its effective
-// mass 1 / (u . I_a^-1 u + u . I_b^-1 u). Its linear parts are a zero Direction.
+// The row of a relative rotation about the unit vector u: J = (0, -u, 0, u). Its linear parts
+// are a zero Direction. Its own effective mass is left zero: every angular row is solved in a
+// block (hinge axes, weld) or with the point rows held (twist, swing), whose masses are computed
+// beside it.
 Row angular_row(const Derived& a, const Derived& b, Vec3 u) {
   Row r;
   r.angular_a = -u;
   r.angular_b = u;
   r.response_a = a.inverse_inertia_world * r.angular_a;
   r.response_b = b.inverse_inertia_world * r.angular_b;
-  r.mass = inverse_or_zero(
-      DotSum{}.add(r.response_a, r.angular_a).add(r.response_b, r.angular_b).result());
+  return r;
+}
+
+// make_row without the row's own effective mass (left zero), for rows solved in a block (the
+// point rows, the slider's rows across its axis): the division and the sum it needs are skipped.
+Row block_row(const Derived& a, const Derived& b, Vec3 ra, Vec3 rb, Vec3 d) {
+  Row r;
+  r.angular_a = cross(d, ra);
+  r.angular_b = cross(rb, d);
+  r.response_a = a.inverse_inertia_world * r.angular_a;
+  r.response_b = b.inverse_inertia_world * r.angular_b;
   return r;
 }
 
@@ -124,8 +135,8 @@ void JointSolver::prepare() {
   for (std::size_t ji = 0; ji < s_.joints.size(); ++ji) {
     const JointState& j = s_.joints[ji];
     if (j.broken) continue;
-    const std::size_t ia = static_cast<std::size_t>(s_.find(j.def.body_a.value));
-    const std::size_t ib = static_cast<std::size_t>(s_.find(j.def.body_b.value));
+    const std::size_t ia = s_.joint_bodies[ji][0];
+    const std::size_t ib = s_.joint_bodies[ji][1];
     const BodyState& a = s_.bodies[ia];
     const BodyState& b = s_.bodies[ib];
     const bool dynamic_a = a.type == BodyType::dynamic && a.awake;
@@ -159,7 +170,15 @@ void JointSolver::prepare() {
                j.def.spring_frequency > Fixed::zero();
     if (k.spring)
       k.spring_soft = make_soft(j.def.spring_frequency, j.def.spring_damping_ratio, bodies_.h);
-    update_geometry(k);
+  }
+  // The trees first (they need only the bodies and types): a joint whose point block a tree
+  // solves needs no inverse of its own block (update_geometry).
+  trees_.find(constraints_, s_.bodies.size());
+  for (std::size_t c = 0; c < constraints_.size(); ++c) {
+    JointConstraint& k = constraints_[c];
+    const JointState& j = s_.joints[k.joint];
+    if (k.type == JointType::fixed || k.type == JointType::slider) prepare_weld(k);
+    update_geometry(k, trees_.holds(c));
     // Angular impulses are kept as a world vector. A fixed joint's rows are the world axes: the
     // vector is its impulse. A hinge's rows turn with body a: last step's impulse is projected
     // onto this step's.
@@ -194,15 +213,40 @@ void JointSolver::prepare() {
                        k.length > k.min_length + s_.def.linear_slop &&
                        k.length < k.max_length - s_.def.linear_slop;
     if (!slack) {
-      bodies_.in_contact[ia] = true;
-      bodies_.in_contact[ib] = true;
+      bodies_.in_contact[k.bodies.a] = true;
+      bodies_.in_contact[k.bodies.b] = true;
     }
   }
-  trees_.find(constraints_, s_.bodies.size());
+  trees_.update_couplings(constraints_, s_);
 }
 
-// The anchors, the rows and the position error at the bodies' present poses.
-void JointSolver::update_geometry(JointConstraint& k) {
+// The weld's three angular rows about world x, y, z and their block's inverse: K = I_a^-1 +
+// I_b^-1 (world), from the rows as for the point block. The rows' directions are fixed and the
+// world inverse inertia is the step's start's, so they are the same at every sub-step: built once
+// per step.
+void JointSolver::prepare_weld(JointConstraint& k) {
+  const Derived& da = s_.derived[k.bodies.a];
+  const Derived& db = s_.derived[k.bodies.b];
+  for (std::size_t i = 0; i < 3; ++i)
+    k.weld_rows[i] = angular_row(da, db, axis(i));
+  Mat3 K;
+  for (std::size_t i = 0; i < 3; ++i) {
+    Fixed entries[3];
+    for (std::size_t c = 0; c < 3; ++c) {
+      const Row& ri = k.weld_rows[i];
+      const Row& rc = k.weld_rows[c];
+      entries[c] =
+          DotSum{}.add(ri.angular_a, rc.response_a).add(ri.angular_b, rc.response_b).result();
+    }
+    K.rows[i] = {entries[0], entries[1], entries[2]};
+  }
+  k.weld_mass = inverse(K);
+}
+
+// The anchors, the rows and the position error at the bodies' present poses. `held`: a tree
+// solves the joint's point block, so the block's own inverse is needed only for the rows solved
+// with the point rows held (twist, swing).
+void JointSolver::update_geometry(JointConstraint& k, bool held) {
   const JointState& j = s_.joints[k.joint];
   const BodyState& a = s_.bodies[k.bodies.a];
   const BodyState& b = s_.bodies[k.bodies.b];
@@ -273,7 +317,7 @@ void JointSolver::update_geometry(JointConstraint& k) {
     const Vec3 arm_a = k.anchor_a + separation;
     for (std::size_t i = 0; i < 2; ++i) {
       k.slide_directions[i] = make_direction(da, db, k.across[i]);
-      k.slide_rows[i] = make_row(da, db, arm_a, k.anchor_b, k.across[i]);
+      k.slide_rows[i] = block_row(da, db, arm_a, k.anchor_b, k.across[i]);
     }
     Fixed entries[2][2];
     for (std::size_t i = 0; i < 2; ++i) {
@@ -298,23 +342,9 @@ void JointSolver::update_geometry(JointConstraint& k) {
     }
   }
   if (k.type == JointType::fixed || k.type == JointType::slider) {
-    for (std::size_t i = 0; i < 3; ++i)
-      k.weld_rows[i] = angular_row(da, db, axis(i));
-    // K = I_a^-1 + I_b^-1 (world), from the rows as for the point block.
-    Mat3 K;
-    for (std::size_t i = 0; i < 3; ++i) {
-      Fixed entries[3];
-      for (std::size_t c = 0; c < 3; ++c) {
-        const Row& ri = k.weld_rows[i];
-        const Row& rc = k.weld_rows[c];
-        entries[c] =
-            DotSum{}.add(ri.angular_a, rc.response_a).add(ri.angular_b, rc.response_b).result();
-      }
-      K.rows[i] = {entries[0], entries[1], entries[2]};
-    }
-    k.weld_mass = inverse(K);
-    // The rotation from where b should be (q_a times the relative orientation at creation) to
-    // where it is, q_b conj(q_a q_rel), as a small-angle vector 2 vec(q) (the shorter way round).
+    // The weld's rows and block: prepare_weld, once per step. The rotation from where b should be
+    // (q_a times the relative orientation at creation) to where it is, q_b conj(q_a q_rel), as a
+    // small-angle vector 2 vec(q) (the shorter way round).
     const Quat e = b.orientation * conjugate(a.orientation * j.relative_orientation);
     const Vec3 v = e.vector() * Fixed::from_int(2);
     k.weld_error = e.w < Fixed::zero() ? -v : v;
@@ -323,7 +353,7 @@ void JointSolver::update_geometry(JointConstraint& k) {
       k.type == JointType::swing_twist) {
     k.separation = separation;
     for (std::size_t i = 0; i < 3; ++i)
-      k.rows[i] = make_row(da, db, k.anchor_a, k.anchor_b, axis(i));
+      k.rows[i] = block_row(da, db, k.anchor_a, k.anchor_b, axis(i));
     // K_ij = (m_a^-1 + m_b^-1) d_i . d_j + angular_i . response_j on each side; the directions
     // are the world axes, so the linear part is diagonal.
     const Fixed linear = da.inverse_mass + db.inverse_mass;
@@ -340,11 +370,14 @@ void JointSolver::update_geometry(JointConstraint& k) {
       K.rows[i] = {entries[0], entries[1], entries[2]};
     }
     k.point_k = K;
-    k.point_mass = inverse(K);  // K is positive definite: one body is dynamic
+    const bool swings = k.type == JointType::swing_twist && j.def.limit_enabled;
+    // K is positive definite: one body is dynamic. A tree's joint without twist or swing rows
+    // never reads its inverse.
+    if (!held || twists || swings) k.point_mass = inverse(K);
     // An angular row's coupling to the point rows, b_i = J_point_i M^-1 J_row^T (the row has no
     // linear part), as K^-1 b, and the row's effective mass with the point rows held,
     // 1 / (c - b . K^-1 b).
-    const auto hold_point = [&](const Row& t, Vec3& held, Fixed& mass) {
+    const auto hold_point = [&](const Row& t, Vec3& compensation, Fixed& mass) {
       Vec3 coupling;
       Fixed* entries[3] = {&coupling.x, &coupling.y, &coupling.z};
       for (std::size_t i = 0; i < 3; ++i)
@@ -352,14 +385,13 @@ void JointSolver::update_geometry(JointConstraint& k) {
                           .add(k.rows[i].angular_a, t.response_a)
                           .add(k.rows[i].angular_b, t.response_b)
                           .result();
-      held = k.point_mass * coupling;
+      compensation = k.point_mass * coupling;
       const Fixed own =
           DotSum{}.add(t.angular_a, t.response_a).add(t.angular_b, t.response_b).result();
-      mass = inverse_or_zero(own - dot(coupling, held));
+      mass = inverse_or_zero(own - dot(coupling, compensation));
     };
     if (twists) hold_point(k.twist_row, k.twist_coupling, k.twist_mass);
-    if (k.type == JointType::swing_twist && j.def.limit_enabled)
-      hold_point(k.swing_row, k.swing_coupling, k.swing_mass);
+    if (swings) hold_point(k.swing_row, k.swing_coupling, k.swing_mass);
     return;
   }
   if (k.type != JointType::distance) return;  // a slider: done above
@@ -709,7 +741,7 @@ void JointSolver::solve_joints(bool use_bias) {
     }
   }
   if (trees_.empty()) return;
-  trees_.solve(constraints_, bodies_, s_, use_bias ? &soft_ : nullptr);
+  trees_.solve(constraints_, bodies_, use_bias ? &soft_ : nullptr);
   for (std::size_t c = 0; c < constraints_.size(); ++c) {
     if (trees_.holds(c)) solve_after_point(constraints_[c], use_bias);
   }
@@ -728,8 +760,9 @@ void JointSolver::hold() {}
 void JointSolver::push_out() {}
 
 void JointSolver::positions_moved() {
-  for (JointConstraint& k : constraints_)
-    update_geometry(k);
+  for (std::size_t c = 0; c < constraints_.size(); ++c)
+    update_geometry(constraints_[c], trees_.holds(c));
+  trees_.update_couplings(constraints_, s_);
 }
 
 void JointSolver::relax() {

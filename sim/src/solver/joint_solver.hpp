@@ -113,7 +113,8 @@ class JointSolver final : public ConstraintKind {
   void store_impulses() override;
 
  private:
-  void update_geometry(JointConstraint& k);
+  void prepare_weld(JointConstraint& k);
+  void update_geometry(JointConstraint& k, bool held);
   void solve_joints(bool use_bias);
   void solve_ball(JointConstraint& k, bool use_bias);
   /// The rows a joint of a tree solves before (hinge axes, weld) and after (motor, limits) the

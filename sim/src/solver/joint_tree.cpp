@@ -200,42 +200,43 @@ void JointTrees::find(const std::vector<JointConstraint>& constraints, std::size
   }
 }
 
-void JointTrees::solve(std::vector<JointConstraint>& constraints, SolverBodies& bodies,
-                       const WorldState& s, const Softness* soft) {
-  // Every joint's speed before any impulse (one system, solved at once), its pivot and its
-  // right-hand side; A's blocks between joints on one body.
-  const Fixed scale = soft ? Fixed::one() / soft->mass_scale : Fixed::one();
-  const Fixed carry = soft ? soft->impulse_scale / soft->mass_scale : Fixed::zero();
-  for (Node& node : nodes_) {
+void JointTrees::update_couplings(const std::vector<JointConstraint>& constraints,
+                                  const WorldState& s) {
+  for (const Node& node : nodes_) {
     const JointConstraint& k = constraints[node.constraint];
-    const Vec3 cdot{row_speed(bodies.velocities, k.bodies, k.axes[0], k.rows[0]),
-                    row_speed(bodies.velocities, k.bodies, k.axes[1], k.rows[1]),
-                    row_speed(bodies.velocities, k.bodies, k.axes[2], k.rows[2])};
-    if (soft) {
-      node.pivot = k.point_k * scale;
-      node.rhs = -(cdot + k.separation * soft->bias_rate) - (k.point_k * k.impulse) * carry;
-    } else {
-      node.pivot = k.point_k;
-      node.rhs = -cdot;
-    }
     const Fixed inverse_mass = s.derived[node.body].inverse_mass;
     for (std::uint32_t l = node.links_begin; l < node.links_end; ++l) {
-      const Node& other = nodes_[links_[l].node];
-      const JointConstraint& o = constraints[other.constraint];
-      links_[l].block = coupling(k, node.body_is_a, o, o.bodies.a == node.body, inverse_mass);
+      const JointConstraint& o = constraints[nodes_[links_[l].node].constraint];
+      links_[l].coupling = coupling(k, node.body_is_a, o, o.bodies.a == node.body, inverse_mass);
     }
   }
-  // LDL^T from the leaves: each node's pivot inverted, its later neighbours' blocks and
-  // right-hand sides less its part (A_kl -= A_kj pivot^-1 A_jl, all on its parent body).
+  soft_factor_.valid = false;
+  rigid_factor_.valid = false;
+}
+
+// LDL^T from the leaves: each node's pivot inverted, its later neighbours' blocks less its part
+// (A_kl -= A_kj pivot^-1 A_jl, all on its parent body). With `soft`, the pivots are the joints'
+// soft blocks K_j / mass_scale (A + D); without, K_j.
+void JointTrees::factor(const std::vector<JointConstraint>& constraints, const Softness* soft,
+                        Factor& f) {
+  const Fixed scale = soft ? Fixed::one() / soft->mass_scale : Fixed::one();
   for (Node& node : nodes_) {
-    node.inverse = inverse(node.pivot);
+    const JointConstraint& k = constraints[node.constraint];
+    node.pivot = soft ? k.point_k * scale : k.point_k;
     for (std::uint32_t l = node.links_begin; l < node.links_end; ++l)
-      links_[l].gain = node.inverse * links_[l].block;
+      links_[l].block = links_[l].coupling;
+  }
+  f.inverse.resize(nodes_.size());
+  f.gain.resize(links_.size());
+  for (std::size_t e = 0; e < nodes_.size(); ++e) {
+    const Node& node = nodes_[e];
+    f.inverse[e] = inverse(node.pivot);
+    for (std::uint32_t l = node.links_begin; l < node.links_end; ++l)
+      f.gain[l] = f.inverse[e] * links_[l].block;
     for (std::uint32_t p = node.links_begin; p < node.links_end; ++p) {
       Node& later = nodes_[links_[p].node];
-      const Mat3 gain_t = transpose(links_[p].gain);
+      const Mat3 gain_t = transpose(f.gain[p]);
       later.pivot = later.pivot - gain_t * links_[p].block;
-      later.rhs = later.rhs - gain_t * node.rhs;
       // later's own links are node's links after p, in the same order (joint_tree.hpp).
       for (std::uint32_t q = p + 1; q < node.links_end; ++q) {
         Link& fill = links_[later.links_begin + (q - p - 1)];
@@ -243,12 +244,38 @@ void JointTrees::solve(std::vector<JointConstraint>& constraints, SolverBodies& 
       }
     }
   }
+  f.valid = true;
+}
+
+void JointTrees::solve(std::vector<JointConstraint>& constraints, SolverBodies& bodies,
+                       const Softness* soft) {
+  // The factorization depends on the rows and the kind of pass only, not on the velocities:
+  // made once per change of the rows (update_couplings) for each kind of pass.
+  Factor& f = soft ? soft_factor_ : rigid_factor_;
+  if (!f.valid) factor(constraints, soft, f);
+  // Every joint's speed before any impulse (one system, solved at once) and its right-hand side.
+  const Fixed carry = soft ? soft->impulse_scale / soft->mass_scale : Fixed::zero();
+  for (Node& node : nodes_) {
+    const JointConstraint& k = constraints[node.constraint];
+    const Vec3 cdot{row_speed(bodies.velocities, k.bodies, k.axes[0], k.rows[0]),
+                    row_speed(bodies.velocities, k.bodies, k.axes[1], k.rows[1]),
+                    row_speed(bodies.velocities, k.bodies, k.axes[2], k.rows[2])};
+    node.rhs =
+        soft ? -(cdot + k.separation * soft->bias_rate) - (k.point_k * k.impulse) * carry : -cdot;
+  }
+  // Forward elimination of the right-hand sides, as the factorization eliminated the blocks.
+  for (const Node& node : nodes_) {
+    for (std::uint32_t p = node.links_begin; p < node.links_end; ++p) {
+      Node& later = nodes_[links_[p].node];
+      later.rhs = later.rhs - transpose(f.gain[p]) * node.rhs;
+    }
+  }
   // Back substitution from the roots, then the impulses.
   for (std::size_t e = nodes_.size(); e-- > 0;) {
     Node& node = nodes_[e];
-    Vec3 lambda = node.inverse * node.rhs;
+    Vec3 lambda = f.inverse[e] * node.rhs;
     for (std::uint32_t l = node.links_begin; l < node.links_end; ++l)
-      lambda = lambda - links_[l].gain * nodes_[links_[l].node].lambda;
+      lambda = lambda - f.gain[l] * nodes_[links_[l].node].lambda;
     node.lambda = lambda;
   }
   for (const Node& node : nodes_) {

@@ -28,13 +28,17 @@ class JointTrees {
   /// Whether constraint c's point block is solved by a tree (not by its own block).
   [[nodiscard]] bool holds(std::size_t c) const { return !held_.empty() && held_[c]; }
   [[nodiscard]] bool empty() const { return nodes_.empty(); }
+  /// A's blocks between joints on one body, from the joints' present rows: after every change of
+  /// the rows (prepare, positions_moved), before solve. The solve pass and the relax pass at the
+  /// same rows share them; each kind of pass factorizes the system once per change of the rows
+  /// (with iterations > 1, the later passes of a sub-step reuse it).
+  void update_couplings(const std::vector<JointConstraint>& constraints, const WorldState& s);
   /// Solves every tree's point blocks at once: (J M^-1 J^T + D) lambda = rhs, exactly (within
   /// rounding), and applies the impulses. With `soft`, each joint's block is its soft
   /// constraint (D_j = (1 / mass_scale - 1) K_j, rhs_j = -(J_j v + bias_rate C_j) -
   /// impulse_scale / mass_scale K_j lambda_j): the fixed point of the joints' soft blocks solved
   /// one after another until they agree. Without, rigid: D = 0, rhs = -J v.
-  void solve(std::vector<JointConstraint>& constraints, SolverBodies& bodies, const WorldState& s,
-             const Softness* soft);
+  void solve(std::vector<JointConstraint>& constraints, SolverBodies& bodies, const Softness* soft);
 
  private:
   /// A joint of a tree, in elimination order (leaves first).
@@ -44,21 +48,30 @@ class JointTrees {
     bool body_is_a;             ///< body is the constraint's body a
     std::uint32_t links_begin;  ///< its later neighbours: links_[links_begin, links_end)
     std::uint32_t links_end;
-    Mat3 pivot;    ///< its diagonal block, then that block less the eliminated nodes' part
-    Mat3 inverse;  ///< pivot^-1
+    Mat3 pivot;  ///< its diagonal block, then that block less the eliminated nodes' part (factor)
     Vec3 rhs;
     Vec3 lambda;
   };
   /// A later neighbour of a node (a joint on the same body, eliminated after it).
   struct Link {
     std::uint32_t node;
-    Mat3 block;  ///< A_jk = J_j,body M^-1 J_k,body^T, less the eliminated nodes' part
-    Mat3 gain;   ///< pivot_j^-1 A_jk
+    Mat3 coupling;  ///< A_jk = J_j,body M^-1 J_k,body^T (update_couplings)
+    Mat3 block;     ///< A_jk less the eliminated nodes' part (factor)
   };
+  /// An LDL^T factorization of the trees' system: per node its pivot's inverse, per link
+  /// pivot_j^-1 A_jk (less the eliminated nodes' part).
+  struct Factor {
+    std::vector<Mat3> inverse;
+    std::vector<Mat3> gain;
+    bool valid = false;
+  };
+  void factor(const std::vector<JointConstraint>& constraints, const Softness* soft, Factor& f);
 
   std::vector<bool> held_;  ///< per constraint
   std::vector<Node> nodes_;
   std::vector<Link> links_;
+  Factor soft_factor_;   ///< (A + D): the solve passes', at the present rows
+  Factor rigid_factor_;  ///< A: the relax passes', at the present rows
 };
 
 }  // namespace detsim::sim_detail
