@@ -51,7 +51,7 @@ constexpr JointField u64_field(const char* name, const char* what,
 #define DETSIM_JOINT_REF(type, member) [](JointState& j) -> type& { return j.member; }
 
 // Every field: the definition's (JointDef's order), then JointState's own (its order).
-constexpr JointField kFields[] = {
+constexpr JointField kJointFields[] = {
     vec3_field("anchor", "joint anchor", DETSIM_JOINT_REF(Vec3, def.anchor)),
     vec3_field("axis", "joint axis", DETSIM_JOINT_REF(Vec3, def.axis)),
     fixed_field("limit_lower", "joint limit lower", DETSIM_JOINT_REF(Fixed, def.limit_lower)),
@@ -92,7 +92,7 @@ constexpr JointField kFields[] = {
 
 constexpr unsigned count_flags() {
   unsigned n = 0;
-  for (const JointField& f : kFields)
+  for (const JointField& f : kJointFields)
     n += f.kind == JointFieldKind::flag || f.optional ? 1U : 0U;
   return n;
 }
@@ -103,25 +103,25 @@ static_assert(count_flags() == joint_flag_count && joint_flag_count <= 8, "one f
 constexpr std::size_t kMinJointBytes = 1 + 1 + 1 + 1 + 1 + 3 * 8 + 4 + 15;
 
 // The record's flags byte of `j`.
-std::uint8_t flags_of(const JointState& j) {
+std::uint8_t joint_flags_of(const JointState& j) {
   auto& m = const_cast<JointState&>(j);  // the accessors take a mutable joint; nothing is written
   unsigned bits = 0;
   unsigned bit = 0;
-  for (const JointField& f : kFields) {
+  for (const JointField& f : kJointFields) {
     if (f.kind == JointFieldKind::flag) bits |= (f.flag(m) ? 1U : 0U) << bit++;
   }
-  for (const JointField& f : kFields) {
+  for (const JointField& f : kJointFields) {
     if (f.optional) bits |= (f.u64(m) != 0 ? 1U : 0U) << bit++;
   }
   return static_cast<std::uint8_t>(bits);
 }
 
-const std::string& flags_expected() {
+const std::string& joint_flags_expected() {
   static const std::string text = [] {
     std::string s = "only bits ";
     unsigned bit = 0;
     for (int pass = 0; pass < 2; ++pass) {
-      for (const JointField& f : kFields) {
+      for (const JointField& f : kJointFields) {
         const bool listed = pass == 0 ? f.kind == JointFieldKind::flag : f.optional;
         if (!listed) continue;
         s += (bit > 0 ? ", " : "") + std::to_string(bit) + " (" + f.name +
@@ -134,7 +134,7 @@ const std::string& flags_expected() {
   return text;
 }
 
-void write_value(const JointField& f, JointState& j, ByteWriter& w) {
+void write_joint_value(const JointField& f, JointState& j, ByteWriter& w) {
   switch (f.kind) {
     case JointFieldKind::fixed:
       w.var_fixed(f.fixed(j));
@@ -153,7 +153,7 @@ void write_value(const JointField& f, JointState& j, ByteWriter& w) {
   }
 }
 
-void read_value(const JointField& f, JointState& j, ByteReader& r) {
+void read_joint_value(const JointField& f, JointState& j, ByteReader& r) {
   switch (f.kind) {
     case JointFieldKind::fixed:
       f.fixed(j) = r.var_fixed(f.what);
@@ -175,11 +175,11 @@ void read_value(const JointField& f, JointState& j, ByteReader& r) {
 }  // namespace
 
 std::span<const JointField> joint_fields() noexcept {
-  return kFields;
+  return kJointFields;
 }
 
 const JointField* find_joint_field(std::string_view name) noexcept {
-  for (const JointField& f : kFields) {
+  for (const JointField& f : kJointFields) {
     if (name == f.name) return &f;
   }
   return nullptr;
@@ -200,18 +200,18 @@ void write_joints(const WorldState& s, ByteWriter& w) {
   w.u32(static_cast<std::uint32_t>(s.joints.size()));
   std::uint32_t previous = 0;
   for (const JointState& joint : s.joints) {
-    auto& j = const_cast<JointState&>(joint);  // write_value reads through the accessors only
+    auto& j = const_cast<JointState&>(joint);  // write_joint_value reads through the accessors only
     w.var(j.id.value - previous);
     previous = j.id.value;
     w.u8(static_cast<std::uint8_t>(j.def.type));
     w.var(j.def.body_a.value);
     w.var(j.def.body_b.value);
-    w.u8(flags_of(j));
-    for (const JointField& f : kFields) {
-      if (!f.optional) write_value(f, j, w);
+    w.u8(joint_flags_of(j));
+    for (const JointField& f : kJointFields) {
+      if (!f.optional) write_joint_value(f, j, w);
     }
-    for (const JointField& f : kFields) {
-      if (f.optional && f.u64(j) != 0) write_value(f, j, w);
+    for (const JointField& f : kJointFields) {
+      if (f.optional && f.u64(j) != 0) write_joint_value(f, j, w);
     }
   }
 }
@@ -252,19 +252,19 @@ bool read_joints(std::span<const std::uint8_t>, ByteReader& r, WorldState& s, st
     const std::size_t flags_at = r.offset();
     const std::uint8_t flags = r.u8("joint flags");
     if (r.ok() && (flags >> joint_flag_count) != 0)
-      r.fail_at(flags_at, "joint flags", flags_expected().c_str());
+      r.fail_at(flags_at, "joint flags", joint_flags_expected().c_str());
     if (!r.ok()) break;
     unsigned bit = 0;
-    for (const JointField& f : kFields) {
+    for (const JointField& f : kJointFields) {
       if (f.kind == JointFieldKind::flag) f.flag(j) = ((flags >> bit++) & 1U) != 0;
     }
-    for (const JointField& f : kFields) {
-      if (!f.optional) read_value(f, j, r);
+    for (const JointField& f : kJointFields) {
+      if (!f.optional) read_joint_value(f, j, r);
     }
-    for (const JointField& f : kFields) {
+    for (const JointField& f : kJointFields) {
       if (!f.optional || ((flags >> bit++) & 1U) == 0) continue;
       const std::size_t value_at = r.offset();
-      read_value(f, j, r);
+      read_joint_value(f, j, r);
       if (r.ok() && f.u64(j) == 0)
         return failed_at(value_at, std::string(f.what) + " flagged present but zero");
     }
