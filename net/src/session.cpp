@@ -15,10 +15,10 @@
 namespace detsim::net {
 namespace {
 
+using detail::max_input_delay;
+using detail::max_prediction_limit;
 using detail::never;
 constexpr std::uint32_t max_players = 8;
-constexpr std::uint32_t max_input_delay = 16;
-constexpr std::uint32_t max_prediction_limit = 32;
 
 Status validate(const SessionConfig& c) {
   const auto bad = [](const std::string& what) { return Status::error("session config: " + what); };
@@ -41,6 +41,8 @@ Status validate(const SessionConfig& c) {
     return bad("hello_interval_us, keepalive_us and ping_interval_us must be > 0");
   if (c.disconnect_warning_us == 0 || c.disconnect_timeout_us <= c.disconnect_warning_us)
     return bad("disconnect_timeout_us must exceed disconnect_warning_us, which must be > 0");
+  if (c.progress_timeout_us <= c.disconnect_timeout_us)
+    return bad("progress_timeout_us must exceed disconnect_timeout_us");
   if (c.remotes.size() != c.players - 1)
     return bad("remotes must list every other player once: expected " +
                std::to_string(c.players - 1) + ", got " + std::to_string(c.remotes.size()));
@@ -311,11 +313,34 @@ void Session::Impl::receive_input(detail::Peer& peer, std::uint64_t frame,
   q.confirm(input);
 }
 
-void Session::Impl::disconnect(detail::Peer& peer) {
-  player_gone(peer.player, queues[peer.player].next_confirmed());
+void Session::Impl::disconnect(detail::Peer& peer, std::string_view reason) {
+  player_gone(peer.player, queues[peer.player].next_confirmed(), reason);
 }
 
-void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame) {
+bool Session::Impl::hears(std::uint32_t player) const noexcept {
+  for (const detail::Peer& peer : peers)
+    if (peer.player == player)
+      return peer.synchronized && !peer.disconnected &&
+             now_us - peer.last_receive_us < config.disconnect_timeout_us;
+  return false;
+}
+
+bool Session::Impl::holds_back(const detail::Peer& peer) const noexcept {
+  const std::uint64_t confirmed = confirmed_frame();
+  // Its inputs are the oldest this machine lacks.
+  if (disconnect_frame[peer.player] == never &&
+      queues[peer.player].next_confirmed() <= std::min(confirmed, current))
+    return true;
+  // Its held frame is what keeps the frames this machine confirmed from being final.
+  if (peer.reported_held <= next_emit && next_emit < std::min(confirmed, current)) return true;
+  // It has not agreed to a disconnect frame this machine waits on.
+  for (std::uint32_t p = 0; p < config.players; ++p)
+    if (disconnect_frame[p] != never && peer.reported_gone[p] != disconnect_frame[p]) return true;
+  return false;
+}
+
+void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame,
+                                std::string_view reason) {
   // Frames already emitted are final: no peer can report an earlier frame unless the network is
   // partitioned, and then the hash checks will tell.
   frame = std::max(frame, next_emit);
@@ -328,7 +353,7 @@ void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame) {
       peer.disconnected = true;
       peer.stats.disconnected = true;
     }
-    raise(Event{EventType::disconnected, player, frame, 0, 0, {}});
+    raise(Event{EventType::disconnected, player, frame, 0, 0, reason});
     retire_checks();
   } else if (frame < disconnect_frame[player]) {
     disconnect_frame[player] = frame;
@@ -372,10 +397,14 @@ Expected<Advance> Session::advance_frame(std::span<const std::uint8_t> local_inp
   // saved (rollbacks and emission read them).
   const bool ring_full = s.current + 2 - s.next_emit > s.states.size();
   if (s.current >= s.confirmed_frame() + s.max_prediction || ring_full) {
+    ++s.window_held;
+    s.last_advance_held = true;
     if (s.max_prediction == 0) return Advance::waiting_for_inputs;
     ++s.stats.prediction_limit_waits;
     return Advance::prediction_limit;
   }
+  ++s.window_advanced;
+  s.last_advance_held = false;
   s.simulate(s.current, false);
   ++s.stats.frames;
   s.emit_confirmed();

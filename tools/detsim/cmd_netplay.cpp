@@ -54,6 +54,14 @@ class Netplay {
     if (!args_.json) std::printf("%s\n", line.c_str());
     std::fflush(stdout);
   }
+  /// Why a player was disconnected, in words: the event's reason with its limit.
+  [[nodiscard]] std::string disconnect_reason(std::string_view reason) const {
+    const net::SessionConfig& c = session_->config();
+    if (reason == "silent") return "silent for " + milliseconds(c.disconnect_timeout_us);
+    if (reason == "no progress")
+      return "no progress: it held the match back for " + milliseconds(c.progress_timeout_us);
+    return std::string(reason);
+  }
   /// Handles the session's events; false (with failure_ set) when a player disconnected.
   bool handle_events();
   void write_desync_report();
@@ -218,8 +226,8 @@ bool Netplay::handle_events() {
                        static_cast<unsigned long long>(e.frame));
           break;
         }
-        failure_ = who + " disconnected at frame " + std::to_string(e.frame) + " (silent for " +
-                   milliseconds(session_->config().disconnect_timeout_us) + ")";
+        failure_ = who + " disconnected at frame " + std::to_string(e.frame) + " (" +
+                   disconnect_reason(e.reason) + ")";
         return false;
     }
   }

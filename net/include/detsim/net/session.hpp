@@ -69,7 +69,12 @@ struct SessionConfig {
   std::uint64_t ping_interval_us = 1'000'000;       ///< round-trip measurement
   std::uint64_t disconnect_warning_us = 500'000;    ///< silence before Event::interrupted
   std::uint64_t disconnect_timeout_us = 5'000'000;  ///< silence before Event::disconnected
-  std::vector<RemotePlayer> remotes;                ///< every other player, each exactly once
+  /// The longest a peer that keeps talking may hold the match back (docs/NET.md, "Progress"):
+  /// over a window of this length in which this machine's game wanted to advance but ran less
+  /// than a third of the time, the peers it waited on are disconnected ("no progress"). Must
+  /// exceed disconnect_timeout_us (a silent peer is the disconnect timeout's to handle).
+  std::uint64_t progress_timeout_us = 10'000'000;
+  std::vector<RemotePlayer> remotes;  ///< every other player, each exactly once
   /// Spectators this machine serves (at most 16; ids distinct from the remotes'): each receives
   /// every confirmed frame's inputs from here (SpectatorSession). Events about spectator k use
   /// player = players + k.
@@ -89,8 +94,8 @@ enum class EventType : std::uint8_t {
   running,         ///< every peer is synchronized: frames can advance
   interrupted,     ///< `player` has been silent for disconnect_warning_us
   resumed,         ///< `player` was heard from again after an interruption
-  disconnected,    ///< `player` was silent for disconnect_timeout_us: its inputs are zero from
-                   ///< `frame` on (InputStatus::disconnected)
+  disconnected,    ///< `player` is gone (`reason`: "silent", "no progress" or "reported gone"):
+                   ///< its inputs are zero from `frame` on (InputStatus::disconnected)
   desync,          ///< `player` hashed confirmed frame `frame` differently
   hello_rejected,  ///< a hello from `player`'s peer did not match this session (`reason`)
 };
@@ -101,7 +106,8 @@ struct Event {
   std::uint64_t frame = 0;
   std::uint64_t local_hash = 0;   ///< desync: this machine's hash of `frame`
   std::uint64_t remote_hash = 0;  ///< desync: the peer's
-  std::string_view reason;  ///< hello_rejected: what differed (a string literal: never dangles)
+  /// hello_rejected: what differed; disconnected: why (string literals: never dangle)
+  std::string_view reason;
 };
 
 /// A frame whose inputs are all final, in frame order, each once: what a replay records.
@@ -157,6 +163,13 @@ struct SessionStats {
   std::array<std::uint64_t, protocol::decode_error_count> dropped_malformed{};
   std::uint64_t dropped_wrong_session = 0;  ///< a nonce or peer this session does not know
   std::uint64_t dropped_out_of_window = 0;  ///< frames outside what the session can hold
+  /// Input datagrams dropped whole for a field no honest peer sends: a held frame beyond the
+  /// inputs it acknowledges, a current frame outside what its inputs and ours allow.
+  std::uint64_t dropped_implausible = 0;
+  /// Pongs that answer no ping this session has outstanding (replayed or forged).
+  std::uint64_t dropped_stale_pongs = 0;
+  /// Gone reports ignored: about this machine's own player, or about a player it still hears.
+  std::uint64_t ignored_gone_reports = 0;
 };
 
 /// Predicts a remote player's input for a frame not received yet: writes the prediction to `out`
