@@ -200,6 +200,57 @@ TEST(NetAttack, ReplayedPongsAndOldDatagramsChangeNoTimeSync) {
   EXPECT_LT(peer->ping_us, 80'000U);
 }
 
+// ---- every confirmed check accounted for ----
+
+TEST(NetAttack, ARelayThatRewritesInputsAndStripsChecksIsCaughtNotASilentSplit) {
+  // The relay between peers 0 and 1 flips a bit of player 1's inputs on their way to peer 0 and
+  // removes every hash check both ways: the peers confirm different frames, and before this
+  // guard both ended "fine" with different final hashes. Now each raises check_missing for the
+  // other, about the first check (frame 30), once the deadline passes.
+  MatchOptions o;
+  o.frames = 1200;
+  o.link.latency_us = 20'000;
+  o.wrap = [](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
+    return std::make_unique<Tamper>(inner, [p](net::PeerId, Packet& packet, std::uint64_t) {
+      if (packet.header.type != PacketType::input) return true;
+      packet.input.checks.clear();
+      if (p == 1 && !packet.input.deltas.empty()) packet.input.deltas[0] ^= 0x10;
+      return true;
+    });
+  };
+  Match m(o);
+  ASSERT_TRUE(m.run());
+  EXPECT_NE(m.compare(), "");  // the split happened...
+  for (std::uint32_t p = 0; p < 2; ++p) {
+    SCOPED_TRACE("peer " + std::to_string(p));
+    const net::Event* missing = find(m.record(p), EventType::check_missing);
+    ASSERT_NE(missing, nullptr);  // ...and is reported, not passed
+    EXPECT_EQ(missing->player, 1 - p);
+    EXPECT_EQ(missing->frame, 30U);
+    EXPECT_EQ(m.session(p).stats().checks_missing, 1U);
+    EXPECT_EQ(m.session(p).stats().checks_compared, 0U);
+  }
+}
+
+TEST(NetAttack, ChecksStrippedOneWayAreMissingOnTheSideThatLacksThem) {
+  // Only peer 1's checks are removed: peer 0 cannot verify anything and says so; peer 1 compares
+  // peer 0's checks as usual and raises nothing.
+  MatchOptions o;
+  o.frames = 1200;
+  o.link = net::internet_link();
+  o.wrap = tamper(1, [](net::PeerId, Packet& p, std::uint64_t) {
+    if (p.header.type == PacketType::input) p.input.checks.clear();
+    return true;
+  });
+  Match m(o);
+  ASSERT_TRUE(m.run()) << m.compare();
+  EXPECT_EQ(m.compare(), "");
+  EXPECT_TRUE(m.record(0).has(EventType::check_missing));
+  EXPECT_FALSE(m.record(1).has(EventType::check_missing));
+  EXPECT_GT(m.session(1).stats().checks_compared, 30U);
+  EXPECT_EQ(m.session(0).peer_stats(1)->checks_received_through, 0U);
+}
+
 // ---- progress ----
 
 /// The tick at which peer 0 first shows player 1 as disconnected, via on_tick.

@@ -251,8 +251,14 @@ void Session::Impl::emit_confirmed() {
 void Session::Impl::add_local_check(std::uint64_t frame, std::uint64_t hash,
                                     const detail::State* state) {
   if (peers.empty()) return;
-  if (local_checks.size() >= detail::max_pending_checks) local_checks.pop_front();
-  local_checks.push_back(detail::LocalCheck{frame, hash, state->bytes});
+  if (local_checks.size() >= detail::max_pending_checks) {
+    // A peer whose check of the dropped frame has not arrived can no longer be compared with it.
+    for (detail::Peer& peer : peers)
+      if (!peer.disconnected && peer.checks_through < local_checks.front().frame)
+        check_missing(peer, local_checks.front().frame);
+    local_checks.pop_front();
+  }
+  local_checks.push_back(detail::LocalCheck{frame, hash, state->bytes, now_us});
   for (detail::Peer& peer : peers)
     compare_checks(peer);
   retire_checks();
@@ -280,6 +286,25 @@ void Session::Impl::compare_checks(detail::Peer& peer) {
       const std::size_t logged = std::min<std::size_t>(frame_log.size() / unit_size, remote.frame);
       evidence->confirmed_frames.assign(
           frame_log.begin(), frame_log.begin() + static_cast<std::ptrdiff_t>(logged * unit_size));
+    }
+  }
+}
+
+void Session::Impl::check_missing(detail::Peer& peer, std::uint64_t frame) {
+  if (peer.check_missing) return;
+  peer.check_missing = true;
+  ++stats.checks_missing;
+  raise(Event{EventType::check_missing, peer.player, frame, 0, 0, {}});
+}
+
+void Session::Impl::check_deadlines() {
+  for (detail::Peer& peer : peers) {
+    if (!peer.synchronized || peer.disconnected || peer.check_missing) continue;
+    // Checks arrive in frame order: the first local check beyond what arrived is the one due.
+    for (const detail::LocalCheck& c : local_checks) {
+      if (c.frame <= peer.checks_through) continue;
+      if (now_us - c.confirmed_us >= config.progress_timeout_us) check_missing(peer, c.frame);
+      break;
     }
   }
 }

@@ -36,6 +36,7 @@ struct LocalCheck {
   std::uint64_t frame = 0;
   std::uint64_t hash = 0;
   std::vector<std::uint8_t> state;  ///< this machine's state at `frame` (desync evidence)
+  std::uint64_t confirmed_us = 0;   ///< when this machine confirmed it (the peers' deadline)
 };
 
 /// A remote player's connection.
@@ -63,6 +64,7 @@ struct Peer {
   std::uint64_t checks_through = 0;  ///< every check of the peer up to this frame received
   std::deque<protocol::HashCheck> pending_checks;  ///< received, not yet compared
   bool desynced = false;
+  bool check_missing = false;  ///< Event::check_missing raised (once per peer)
   // Liveness and statistics.
   std::uint64_t last_receive_us = 0;
   std::uint64_t last_send_us = 0;
@@ -106,6 +108,11 @@ struct Session::Impl {
   void add_local_check(std::uint64_t frame, std::uint64_t hash, const detail::State* state);
   void compare_checks(detail::Peer& peer);
   void retire_checks();
+  /// Raises Event::check_missing for `peer` about `frame` (once per peer).
+  void check_missing(detail::Peer& peer, std::uint64_t frame);
+  /// Every peer's check of each frame this machine confirmed must arrive within
+  /// progress_timeout_us: a missing one is an error, never a pass.
+  void check_deadlines();
   void receive_input(detail::Peer& peer, std::uint64_t frame, std::span<const std::uint8_t> input);
   /// Takes the peer's player as gone from its first input this machine does not hold; `reason`
   /// (a string literal) goes into the event.

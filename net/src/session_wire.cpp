@@ -436,6 +436,7 @@ void Session::poll(std::uint64_t now_us) {
   s.receive_all();
   s.check_timeouts();
   s.check_progress();
+  s.check_deadlines();
   if (s.running) {
     // As GGPO does while idle: a correction received here is applied now, so a game that stops
     // advancing (at a match's end, or waiting) still gets its confirmed frames out.
@@ -470,6 +471,7 @@ std::optional<PeerStats> Session::peer_stats(std::uint32_t player) const {
     stats.jitter_us = peer.jitter_x16 / 16;
     stats.frames_ahead = peer.advantage_x16 / 16;
     stats.acknowledged_frame = peer.acked_inputs;
+    stats.checks_received_through = peer.spectator ? 0 : peer.checks_through;
     return stats;
   }
   return std::nullopt;

@@ -182,9 +182,10 @@ std::string Match::checks_complete() const {
   const std::uint64_t expected = (per_peer > 2 ? per_peer - 2 : 0) * (options_.players - 1);
   for (std::uint32_t p = 0; p < options_.players; ++p) {
     const net::SessionStats& s = sessions_[p]->stats();
-    if (s.checks_compared < expected || s.checks_skipped != 0)
+    if (s.checks_compared < expected || s.checks_skipped != 0 || s.checks_missing != 0)
       out << "peer " << p << " compared " << s.checks_compared << " checks (expected at least "
-          << expected << ") and skipped " << s.checks_skipped << "; ";
+          << expected << "), skipped " << s.checks_skipped << " and missed " << s.checks_missing
+          << "; ";
   }
   return out.str();
 }

@@ -69,7 +69,9 @@ struct SessionConfig {
   std::uint64_t ping_interval_us = 1'000'000;       ///< round-trip measurement
   std::uint64_t disconnect_warning_us = 500'000;    ///< silence before Event::interrupted
   std::uint64_t disconnect_timeout_us = 5'000'000;  ///< silence before Event::disconnected
-  /// The longest a peer that keeps talking may hold the match back (docs/NET.md, "Progress"):
+  /// The longest a peer that keeps talking may hold the match back (docs/NET.md, "Progress"),
+  /// and the longest its hash check of a frame this machine confirmed may take to arrive
+  /// (Event::check_missing):
   /// over a window of this length in which this machine's game wanted to advance but ran less
   /// than a third of the time, the peers it waited on are disconnected ("no progress"). Must
   /// exceed disconnect_timeout_us (a silent peer is the disconnect timeout's to handle).
@@ -98,6 +100,11 @@ enum class EventType : std::uint8_t {
                    ///< its inputs are zero from `frame` on (InputStatus::disconnected)
   desync,          ///< `player` hashed confirmed frame `frame` differently
   hello_rejected,  ///< a hello from `player`'s peer did not match this session (`reason`)
+  /// `player`'s hash check of confirmed frame `frame` did not arrive within progress_timeout_us
+  /// of this machine confirming it (or can no longer be compared): that frame, and every later
+  /// one, is unverified with that peer. Raised once per peer. A relay that strips checks, or a
+  /// peer that does not send them, ends here instead of passing unchecked.
+  check_missing,
 };
 
 struct Event {
@@ -142,6 +149,8 @@ struct PeerStats {
   std::uint64_t remote_frame = 0;  ///< the peer's frame as last reported
   /// The peer holds every local input before this frame (spectators: every confirmed frame).
   std::uint64_t acknowledged_frame = 0;
+  /// Every hash check of the peer up to this frame has arrived (players only; 0: none yet).
+  std::uint64_t checks_received_through = 0;
   std::uint64_t packets_sent = 0;
   std::uint64_t packets_received = 0;
   std::uint64_t packets_lost = 0;  ///< gaps in the peer's sequence numbers
@@ -170,6 +179,8 @@ struct SessionStats {
   std::uint64_t dropped_stale_pongs = 0;
   /// Gone reports ignored: about this machine's own player, or about a player it still hears.
   std::uint64_t ignored_gone_reports = 0;
+  /// Peers whose hash check of some confirmed frame never arrived (Event::check_missing).
+  std::uint64_t checks_missing = 0;
 };
 
 /// Predicts a remote player's input for a frame not received yet: writes the prediction to `out`
