@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <functional>
 #include <memory>
+#include <random>
 
 #include <detsim/net/protocol.hpp>
 #include <detsim/net/session.hpp>
@@ -61,6 +62,104 @@ const net::Event* find(const test::PeerRecord& r, EventType type) {
   for (const net::Event& e : r.events)
     if (e.type == type) return &e;
   return nullptr;
+}
+
+// ---- the challenge-bound handshake ----
+
+/// A third party with a spoofed source address: every receive of the victim's transport also
+/// delivers, "from" the other player's peer, `hellos` hellos with the match's public settings and
+/// random session ids and challenges, replies to random challenges, and input datagrams of its
+/// own session carrying junk inputs for the frames around the victim's.
+class Spoofer final : public net::Transport {
+ public:
+  Spoofer(net::Transport& inner, net::PeerId as, std::uint8_t player, std::uint64_t fingerprint,
+          std::size_t hellos)
+      : inner_(inner), as_(as), player_(player), fingerprint_(fingerprint), hellos_(hellos) {}
+  void send(net::PeerId to, std::span<const std::uint8_t> bytes) override {
+    inner_.send(to, bytes);
+  }
+  void receive(std::vector<net::Datagram>& out) override {
+    ++calls_;
+    for (std::size_t i = 0; i < hellos_; ++i) {
+      Packet hello;
+      hello.header = {PacketType::hello, rng_(), static_cast<std::uint16_t>(rng_())};
+      hello.hello = {fingerprint_, 2, player_, input_size, rng_()};
+      push(out, hello);
+    }
+    Packet reply;
+    reply.header = {PacketType::hello_reply, attacker_, static_cast<std::uint16_t>(calls_)};
+    reply.hello_reply.challenge = rng_();
+    push(out, reply);
+    Packet input;
+    input.header = {PacketType::input, attacker_, static_cast<std::uint16_t>(calls_)};
+    input.input.ack_frame = static_cast<std::uint32_t>(calls_);
+    input.input.current_frame = static_cast<std::uint32_t>(calls_);
+    input.input.start_frame = static_cast<std::uint32_t>(calls_ > 4 ? calls_ - 4 : 0);
+    input.input.held_frame = static_cast<std::uint32_t>(calls_);
+    input.input.count = 8;
+    input.input.deltas.assign(8 * input_size, 0x5A);
+    push(out, input);
+    inner_.receive(out);  // the genuine datagrams after the forged ones: the worst order
+  }
+
+ private:
+  void push(std::vector<net::Datagram>& out, const Packet& p) {
+    std::vector<std::uint8_t> bytes;
+    if (net::protocol::encode(p, input_size, bytes)) out.push_back({as_, bytes});
+  }
+  net::Transport& inner_;
+  net::PeerId as_;
+  std::uint8_t player_;
+  std::uint64_t fingerprint_;
+  std::size_t hellos_;
+  std::mt19937_64 rng_{31};
+  std::uint64_t attacker_ = 0xA77AC6E5'5E55100DULL;  // the session id it plays under
+  std::uint64_t calls_ = 0;
+};
+
+constexpr std::uint64_t two_player_fingerprint = 0xD5'1A'77ULL + 2;  // net_match's
+
+TEST(NetAttack, ASpoofedHelloCannotTakeASeat) {
+  // From before the first genuine hello to the end, a third party spoofing player 1's address
+  // offers its own session to peer 0 (hellos, guessed replies) and plays under it. Peer 0 learns
+  // player 1's session only from the reply to its own challenge, so it plays the whole match
+  // with the genuine peer: the honest hashes, every forged datagram dropped.
+  MatchOptions o;
+  o.frames = 900;
+  o.link = net::internet_link();
+  o.wrap = [](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
+    if (p != 0) return nullptr;
+    return std::make_unique<Spoofer>(inner, 1, 1, two_player_fingerprint, 4);
+  };
+  Match m(o);
+  ASSERT_TRUE(m.run()) << m.compare();
+  EXPECT_EQ(m.compare(), "");
+  EXPECT_EQ(m.checks_complete(), "");
+  EXPECT_GT(m.session(0).stats().dropped_wrong_session, 2 * m.ticks());
+  EXPECT_FALSE(m.record(0).has(EventType::hello_rejected));
+}
+
+TEST(NetAttack, AHelloFloodCannotStopTheMatchFromStarting) {
+  // 200 forged hellos before every genuine datagram, both ways: each is answered (to the genuine
+  // peer's address) and changes nothing, so the genuine hellos' answers still get through.
+  std::vector<std::uint64_t> running_at(2, 0);
+  MatchOptions o;
+  o.frames = 600;
+  o.link.latency_us = 30'000;
+  o.wrap = [](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
+    return std::make_unique<Spoofer>(inner, 1 - p, static_cast<std::uint8_t>(1 - p),
+                                     two_player_fingerprint, 200);
+  };
+  o.on_tick = [&running_at](std::uint32_t p, std::uint64_t tick, net::Session& s) {
+    if (running_at[p] == 0 && s.running()) running_at[p] = tick;
+  };
+  Match m(o);
+  ASSERT_TRUE(m.run()) << m.compare();
+  EXPECT_EQ(m.compare(), "");
+  for (std::uint32_t p = 0; p < 2; ++p) {
+    EXPECT_GT(running_at[p], 0U);
+    EXPECT_LE(running_at[p], 10U) << "peer " << p;  // a round trip or two, as without the flood
+  }
 }
 
 // ---- corroborated disconnects ----

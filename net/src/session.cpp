@@ -10,6 +10,7 @@
 
 #include <detsim/core/assert.hpp>
 
+#include "secure_random.hpp"
 #include "session_impl.hpp"
 
 namespace detsim::net {
@@ -72,8 +73,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
       game(&g),
       transport(&t),
       max_prediction(c.mode == SessionMode::lockstep ? 0 : c.max_prediction),
-      rng(c.random_seed) {
-  nonce = static_cast<std::uint32_t>(rng.next_u64());
+      session_id(detail::secure_random_u64()) {
   for (std::uint32_t p = 0; p < c.players; ++p)
     queues.emplace_back(c.input_size, detail::input_capacity);
   disconnect_frame.assign(c.players, never);
@@ -85,7 +85,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
     peer.player = r.player;
     peer.reported_gone.assign(c.players, never);
     peer.id = r.peer;
-    peer.challenge = static_cast<std::uint32_t>(rng.next_u64());
+    peer.challenge = detail::secure_random_u64();
     peer.stats.player = r.player;
     peers.push_back(std::move(peer));
   }
@@ -94,7 +94,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
     spectator.player = c.players + static_cast<std::uint32_t>(k);
     spectator.spectator = true;
     spectator.id = c.spectators[k];
-    spectator.challenge = static_cast<std::uint32_t>(rng.next_u64());
+    spectator.challenge = detail::secure_random_u64();
     spectator.stats.player = spectator.player;
     spectators.push_back(std::move(spectator));
   }
@@ -393,6 +393,7 @@ void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame,
 
 Expected<Session> Session::create(const SessionConfig& config, Game& game, Transport& transport) {
   if (Status s = validate(config); !s) return s;
+  if (Status s = detail::secure_random_ready(); !s) return s;
   return Session(std::make_unique<Impl>(config, game, transport));
 }
 

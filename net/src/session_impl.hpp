@@ -8,7 +8,6 @@
 #include <optional>
 #include <vector>
 
-#include <detsim/core/rng.hpp>
 #include <detsim/net/session.hpp>
 
 #include "input_queue.hpp"
@@ -44,12 +43,15 @@ struct Peer {
   std::uint32_t player = 0;  ///< a spectator's is players + its index
   bool spectator = false;
   PeerId id = 0;
-  // Handshake: synchronized once the peer answered our challenge and we know its nonce.
-  std::uint32_t challenge = 0;
-  bool answered = false;     ///< the peer replied to our challenge
-  bool nonce_known = false;  ///< we received the peer's hello
-  std::uint32_t remote_nonce = 0;
+  // Handshake (docs/NET.md, "Handshake"): synchronized once the peer answered our challenge; its
+  // session id comes from that answer only and never changes after.
+  std::uint64_t challenge = 0;  ///< 64 random bits, sent only to the peer's address
+  bool answered = false;        ///< the peer replied to our challenge
+  std::uint64_t remote_session = 0;
   bool synchronized = false;
+  /// A datagram beyond the handshake arrived from the peer's session: it knows our id, so its
+  /// hellos need no more answers (nor does a flood of forged ones get any).
+  bool knows_us = false;
   std::uint64_t last_hello_us = 0;
   bool hello_sent = false;
   bool hello_rejected = false;  ///< reported once
@@ -146,8 +148,9 @@ struct Session::Impl {
   // session_wire.cpp: the network.
   void receive_all();
   void handle(detail::Peer& peer, const protocol::Packet& packet);
-  /// False when the hello was rejected (counted, maybe reported).
-  bool handle_hello(detail::Peer& peer, const protocol::Packet& packet);
+  /// Answers a hello that matches this session with a reply echoing its challenge. Changes no
+  /// handshake state: a hello, forged or not, can neither set nor reset the peer's session id.
+  void handle_hello(detail::Peer& peer, const protocol::Packet& packet);
   /// `fresh`: the datagram is newer than every one handled before from this peer. False (nothing
   /// changed) when a field is implausible.
   bool handle_input(detail::Peer& peer, const protocol::InputBody& body, bool fresh);
@@ -167,8 +170,7 @@ struct Session::Impl {
   Game* game;
   Transport* transport;
   std::uint32_t max_prediction = 0;  ///< 0 in lockstep
-  Rng rng;
-  std::uint32_t nonce = 0;
+  std::uint64_t session_id = 0;      ///< this session's id: 64 random bits from a CSPRNG
   std::uint64_t now_us = 0;
   bool running = false;
 

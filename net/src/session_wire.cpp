@@ -61,19 +61,27 @@ void Session::Impl::receive_all() {
 void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
   using protocol::PacketType;
   if (p.header.type == PacketType::hello) {
-    if (!handle_hello(peer, p)) return;  // a rejected hello says nothing about the peer's liveness
+    // Answered, never believed: a hello proves nothing about who sent it (its source address can
+    // be spoofed), so it is not a sign of life either.
+    handle_hello(peer, p);
+    return;
   } else if (p.header.type == PacketType::hello_reply) {
+    // The peer's session id is taken from the reply to our own challenge only — 64 random bits
+    // sent to its address alone, which a third party off the path never sees — and once.
     if (p.hello_reply.challenge != peer.challenge ||
-        (peer.nonce_known && p.header.nonce != peer.remote_nonce)) {
+        (peer.answered && p.header.session != peer.remote_session)) {
       ++stats.dropped_wrong_session;
       return;
     }
+    if (peer.answered) return;  // a duplicate: nothing new
     peer.answered = true;
+    peer.remote_session = p.header.session;
   } else {
-    if (!peer.synchronized || p.header.nonce != peer.remote_nonce) {
+    if (!peer.synchronized || p.header.session != peer.remote_session) {
       ++stats.dropped_wrong_session;
       return;
     }
+    peer.knows_us = true;
     // Fresh: newer than every datagram handled from the peer (sequence numbers modulo 2^16).
     const auto step = static_cast<std::uint16_t>(
         p.header.sequence - peer.last_sequence.value_or(std::uint16_t(p.header.sequence - 1)));
@@ -120,7 +128,7 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
     peer.interrupted = false;
     raise(Event{EventType::resumed, peer.player, current, 0, 0, {}});
   }
-  if (!peer.synchronized && peer.answered && peer.nonce_known) {
+  if (!peer.synchronized && peer.answered) {
     peer.synchronized = true;
     peer.stats.synchronized = true;
     raise(Event{EventType::synchronized, peer.player, current, 0, 0, {}});
@@ -133,7 +141,7 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
   }
 }
 
-bool Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) {
+void Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) {
   const protocol::Hello& h = p.hello;
   std::string_view reason;
   if (h.fingerprint != config.fingerprint)
@@ -150,22 +158,19 @@ bool Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) 
       peer.hello_rejected = true;
       raise(Event{EventType::hello_rejected, peer.player, current, 0, 0, reason});
     }
-    return false;
+    return;
   }
-  if (peer.nonce_known && p.header.nonce != peer.remote_nonce) {
-    if (peer.synchronized) {  // a stale or foreign session on the same address
-      ++stats.dropped_wrong_session;
-      return false;
-    }
-    peer.answered = false;  // the peer restarted before we finished: start over with it
+  if (peer.knows_us) {  // the genuine peer has our id already: this one is stale or forged
+    ++stats.dropped_wrong_session;
+    return;
   }
-  peer.remote_nonce = p.header.nonce;
-  peer.nonce_known = true;
+  // Every matching hello is answered (to the peer's address, whoever sent it): a flood of forged
+  // hellos cannot crowd out the genuine one's answer, and a reply to a forged challenge is
+  // dropped by the genuine peer.
   protocol::Packet reply;
   reply.header.type = protocol::PacketType::hello_reply;
   reply.hello_reply.challenge = h.challenge;
   send(peer, reply);
-  return true;
 }
 
 bool Session::Impl::plausible(const detail::Peer& peer, const protocol::InputBody& b) const {
@@ -265,7 +270,7 @@ bool Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& 
 }
 
 void Session::Impl::send(detail::Peer& peer, protocol::Packet& p) {
-  p.header.nonce = nonce;
+  p.header.session = session_id;
   p.header.sequence = peer.send_sequence++;
   const std::size_t unit = peer.spectator && p.header.type == protocol::PacketType::input
                                ? unit_size
@@ -360,7 +365,7 @@ void Session::Impl::send_due() {
   for (std::vector<detail::Peer>* group : {&peers, &spectators}) {
     for (detail::Peer& peer : *group) {
       if (peer.disconnected) continue;
-      if ((!peer.answered || !peer.nonce_known) &&
+      if (!peer.answered &&
           (!peer.hello_sent || now_us - peer.last_hello_us >= config.hello_interval_us))
         send_hello(peer);
       if (!peer.synchronized) continue;

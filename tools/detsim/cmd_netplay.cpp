@@ -162,7 +162,6 @@ Status Netplay::start() {
   config.input_size = net::ScenarioGame::input_size;
   config.input_delay = args_.input_delay;
   config.fingerprint = session_fingerprint(*scenario_, plan_.mode, args_.frames);
-  config.random_seed = os_random_seed();
   config.frame_us =
       args_.fps == 0 ? 1000 : std::clamp<std::uint32_t>(1'000'000 / args_.fps, 1000, 1'000'000);
   for (const net::UdpPeer& p : plan_.peers)

@@ -60,9 +60,6 @@ struct SessionConfig {
   /// What every peer must agree on to play together (the game's settings, version, scenario): a
   /// hello with another fingerprint is rejected. Use a hash of the replay fingerprint.
   std::uint64_t fingerprint = 0;
-  /// Seeds this session's nonce and handshake challenges. Give each session a fresh random value
-  /// (from the operating system) in a real game; a fixed value in tests.
-  std::uint64_t random_seed = 0;
   std::uint32_t frame_us = 16'667;  ///< the nominal frame duration (time sync): 1000 .. 1'000'000
   std::uint64_t hello_interval_us = 200'000;        ///< handshake resend interval
   std::uint64_t keepalive_us = 100'000;             ///< the longest silence towards a peer
