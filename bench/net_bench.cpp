@@ -61,7 +61,6 @@ struct Match {
       c.players = players;
       c.local_player = p;
       c.input_size = 4;
-      c.random_seed = p + 1;
       for (std::uint32_t q = 0; q < players; ++q)
         if (q != p) c.remotes.push_back({q, q});
       sessions.push_back(net::Session::create(c, *games.back(), network->endpoint(p)).value());

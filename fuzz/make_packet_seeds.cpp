@@ -47,13 +47,13 @@ int main(int argc, char** argv) {
   };
   std::vector<Seed> seeds;
   protocol::Packet p;
-  p.header = {protocol::PacketType::hello, 0x12345678, 1};
+  p.header = {protocol::PacketType::hello, 0x1234'5678'9ABC'DEF0ULL, 1};
   p.hello = {0x0123456789ABCDEFULL, 2, 1, 4, 0xC0FFEE};
   seeds.push_back({"hello", p, 4});
   p.hello.player = protocol::spectator_player;
   seeds.push_back({"hello_spectator", p, 4});
   p.header.type = protocol::PacketType::hello_reply;
-  p.hello_reply.challenge = 0xC0FFEE;
+  p.hello_reply.challenge = 0xC0FFEE'0000C0FFEEULL;
   seeds.push_back({"hello_reply", p, 4});
   p.ping.time_us = 1'000'000;
   p.header.type = protocol::PacketType::ping;
@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
                               {4, 60, 8}, {64, 6, 3}, {protocol::max_unit_size, 2, 1}};
   for (const InputSeed& s : inputs) {
     protocol::Packet q;
-    q.header = {protocol::PacketType::input, 0x12345678, 7};
+    q.header = {protocol::PacketType::input, 0x1234'5678'9ABC'DEF0ULL, 7};
     q.input.ack_frame = 100;
     q.input.check_ack = 90;
     q.input.current_frame = 104;

@@ -33,7 +33,7 @@ void reseal(std::vector<std::uint8_t>& b) {
 }
 
 bool same(const protocol::Packet& a, const protocol::Packet& b) {
-  if (a.header.type != b.header.type || a.header.nonce != b.header.nonce ||
+  if (a.header.type != b.header.type || a.header.session != b.header.session ||
       a.header.sequence != b.header.sequence)
     return false;
   switch (a.header.type) {
@@ -48,7 +48,8 @@ bool same(const protocol::Packet& a, const protocol::Packet& b) {
              a.input.current_frame == b.input.current_frame &&
              a.input.advantage == b.input.advantage && a.input.start_frame == b.input.start_frame &&
              a.input.count == b.input.count && a.input.deltas == b.input.deltas &&
-             a.input.checks == b.input.checks;
+             a.input.checks == b.input.checks && a.input.held_frame == b.input.held_frame &&
+             a.input.gone == b.input.gone;
     case protocol::PacketType::ping:
     case protocol::PacketType::pong:
       return a.ping.time_us == b.ping.time_us;

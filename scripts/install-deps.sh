@@ -8,6 +8,7 @@ packages=(
   cmake ninja-build g++ clang clang-format libclang-rt-14-dev  # toolchains, sanitizer runtimes
   libgtest-dev                                                 # tests
   libxxhash-dev libcli11-dev                                   # state hashing, the CLI
+  libsodium-dev pkg-config                                     # net/: session ids, challenges
   libmpfr-dev libgmp-dev                                       # reference for the accuracy tests
   libbenchmark-dev libfixmath-dev libbullet-dev               # benchmarks and their peers
   python3                                                      # docs/ table generation

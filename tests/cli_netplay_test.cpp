@@ -18,6 +18,9 @@
 
 #include <gtest/gtest.h>
 
+#include <detsim/net/protocol.hpp>
+#include <detsim/net/udp.hpp>
+
 #include "support/cli.hpp"
 #include "support/replay_files.hpp"
 
@@ -206,6 +209,106 @@ TEST(CliNetplay, TwoProcessesPlayTheSameMatchAndRecordTheSameReplay) {
   EXPECT_EQ(json_value(verify.out, "ok"), "true");
   EXPECT_EQ(json_value(verify.out, "frames"), "3000");
   EXPECT_EQ(json_value(verify.out, "final_hash"), json_value(out_a, "final_hash"));
+}
+
+/// A relay between two netplay processes that removes every hash check from their datagrams
+/// (resealing them: the checksum is no key). Player 0 talks to `to_b` as if it were player 1,
+/// player 1 to `to_a` as if it were player 0.
+class CheckStripper {
+ public:
+  static std::optional<CheckStripper> open(std::uint16_t port_a, std::uint16_t port_b,
+                                           std::uint16_t relay_port) {
+    const auto at = [](std::uint16_t port) { return net::parse_endpoint(endpoint(port)).value(); };
+    const net::UdpPeer a[] = {{0, at(port_a)}};
+    const net::UdpPeer b[] = {{1, at(port_b)}};
+    auto to_b = net::UdpTransport::open(at(relay_port), a);  // receives from A, sends to A
+    auto to_a = net::UdpTransport::open(at(static_cast<std::uint16_t>(relay_port + 1)), b);
+    if (!to_b || !to_a) return std::nullopt;
+    return CheckStripper(std::move(to_b.value()), std::move(to_a.value()));
+  }
+  /// Forwards what arrived, without its checks; returns how many checks it removed so far.
+  std::uint64_t pump() {
+    forward(from_a_, from_b_, 1);
+    forward(from_b_, from_a_, 0);
+    return stripped_;
+  }
+
+ private:
+  CheckStripper(net::UdpTransport a, net::UdpTransport b)
+      : from_a_(std::move(a)), from_b_(std::move(b)) {}
+  void forward(net::UdpTransport& in, net::UdpTransport& out, net::PeerId to) {
+    inbox_.clear();
+    in.receive(inbox_);
+    for (const net::Datagram& d : inbox_) {
+      net::protocol::Packet p;
+      std::vector<std::uint8_t> bytes = d.bytes;
+      if (net::protocol::decode(d.bytes, 3, p) == net::protocol::DecodeError::none &&
+          p.header.type == net::protocol::PacketType::input && !p.input.checks.empty()) {
+        stripped_ += p.input.checks.size();
+        p.input.checks.clear();
+        if (!net::protocol::encode(p, 3, bytes)) continue;
+      }
+      out.send(to, bytes);
+    }
+  }
+  net::UdpTransport from_a_;
+  net::UdpTransport from_b_;
+  std::vector<net::Datagram> inbox_;
+  std::uint64_t stripped_ = 0;
+};
+
+TEST(CliNetplay, ARelayThatStripsTheHashChecksMakesBothPeersExitUnverified) {
+  // Before: every frame "passed" with no check compared at all. Now each peer says which checks
+  // never arrived and exits 1, like a desync.
+  for (int attempt = 0; attempt < 6; ++attempt) {
+    const std::uint16_t base = port_for(attempt + 20);
+    auto relay = CheckStripper::open(base, static_cast<std::uint16_t>(base + 1),
+                                     static_cast<std::uint16_t>(base + 2));
+    if (!relay) continue;
+    const std::vector<std::string> common = {"--players", "2",      "--frames",  "600", "--fps",
+                                             "1000",      "--json", "--timeout", "3"};
+    std::vector<std::string> a = {"netplay",
+                                  "--me",
+                                  "0",
+                                  "--bind",
+                                  endpoint(base),
+                                  "--peer",
+                                  "1=" + endpoint(static_cast<std::uint16_t>(base + 2))};
+    std::vector<std::string> b = {"netplay",
+                                  "--me",
+                                  "1",
+                                  "--bind",
+                                  endpoint(static_cast<std::uint16_t>(base + 1)),
+                                  "--peer",
+                                  "0=" + endpoint(static_cast<std::uint16_t>(base + 3))};
+    a.insert(a.end(), common.begin(), common.end());
+    b.insert(b.end(), common.begin(), common.end());
+    Process pa(a, "strip_a");
+    Process pb(b, "strip_b");
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    std::uint64_t stripped = 0;
+    bool done_a = false;
+    bool done_b = false;
+    while (!(done_a && done_b) && std::chrono::steady_clock::now() < deadline) {
+      stripped = relay->pump();
+      done_a = done_a || pa.poll();
+      done_b = done_b || pb.poll();
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    if (bind_failed(pa) || bind_failed(pb)) continue;
+    ASSERT_TRUE(done_a && done_b) << "killed after 60 s\nA: " << pa.err() << "\nB: " << pb.err();
+    EXPECT_GT(stripped, 10U);
+    for (const Process* p : {&pa, &pb}) {
+      EXPECT_EQ(p->exit_code(), 1) << p->out() << p->err();
+      EXPECT_EQ(json_value(p->out(), "frames"), "600") << p->out();
+      EXPECT_EQ(json_value(p->out(), "desyncs"), "0") << p->out();
+      EXPECT_EQ(json_value(p->out(), "unverified"), "1") << p->out();
+      EXPECT_TRUE(has(p->err(), "UNVERIFIED")) << p->err();
+      EXPECT_TRUE(has(p->err(), "checks of frames 1 .. 600")) << p->err();
+    }
+    return;
+  }
+  FAIL() << "no free ports after 6 attempts";
 }
 
 TEST(CliNetplay, AnInjectedPeerDesyncsAndBisectNamesTheFrameBodyAndField) {

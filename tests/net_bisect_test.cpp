@@ -73,7 +73,6 @@ TEST_P(NetBisect, PeersReportsNameTheInjectedFrameBodyAndField) {
     c.local_player = p;
     c.input_size = net::ScenarioGame::input_size;
     c.check_interval = kInterval;
-    c.random_seed = 300 + p;
     for (std::uint32_t q = 0; q < kPlayers; ++q)
       if (q != p) c.remotes.push_back({q, q});
     auto s = net::Session::create(c, *games.back(), network.endpoint(p));

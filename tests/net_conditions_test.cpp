@@ -198,7 +198,6 @@ TEST(NetConditions, ANudgedBodyIsDetectedWithinOneCheckInterval) {
     c.local_player = p;
     c.input_size = net::ScenarioGame::input_size;
     c.check_interval = interval;
-    c.random_seed = 900 + p;
     for (std::uint32_t q = 0; q < players; ++q)
       if (q != p) c.remotes.push_back({q, q});
     auto s = net::Session::create(c, *games.back(), network.endpoint(p));

@@ -1,5 +1,5 @@
 // Hostile datagrams reaching a session: garbage, truncations, corruptions, other versions, foreign
-// nonces, replayed stale packets and well-formed packets with out-of-window frames. Each is
+// session ids, replayed stale packets and well-formed packets with out-of-window frames. Each is
 // dropped and counted by kind, and the match still ends with every peer equal to an offline replay.
 #include <gtest/gtest.h>
 
@@ -72,7 +72,7 @@ class Injector final : public net::Transport {
     net::protocol::Packet p;
     if (net::protocol::decode(real, input_size_, p) != DecodeError::none) return;
     net::protocol::Packet foreign = p;
-    foreign.header.nonce ^= 0x5A5A5A5AU;  // another session's nonce
+    foreign.header.session ^= 0x5A5A5A5AU;  // another session's id
     push_encoded(out, foreign);
     net::protocol::Packet far = p;  // inputs far beyond any window
     far.input.start_frame += 100'000;
@@ -132,7 +132,7 @@ TEST(NetHostile, ForgedAndBrokenDatagramsAreDroppedAndCountedAndChangeNothing) {
   EXPECT_GT(dropped(DecodeError::bad_magic), injector->calls() / 2);
   EXPECT_GT(dropped(DecodeError::bad_checksum), 500U);
   EXPECT_GT(dropped(DecodeError::bad_version), 500U);
-  EXPECT_GT(s.dropped_wrong_session, 1000U);  // unknown peer ids and foreign nonces
+  EXPECT_GT(s.dropped_wrong_session, 1000U);  // unknown peer ids and foreign session ids
   EXPECT_GT(s.dropped_out_of_window, 1000U);  // far frames and impossible check frames
   EXPECT_EQ(dropped(DecodeError::none), 0U);
   // Nothing forged reached the game: peer 0 never saw a desync nor a rollback storm.

@@ -42,7 +42,7 @@ std::vector<Sample> samples() {
   hello.hello = {0x0123456789ABCDEFULL, 4, 2, 3, 0xCAFEF00D};
   out.push_back({"hello", hello, 3});
   Packet reply = make(PacketType::hello_reply, 5, 6);
-  reply.hello_reply.challenge = 0xCAFEF00D;
+  reply.hello_reply.challenge = 0xCAFEF00D'0BADBEEFULL;
   out.push_back({"hello_reply", reply, 1});
   for (const PacketType type : {PacketType::ping, PacketType::pong}) {
     Packet ping = make(type, 9, 10);
@@ -483,7 +483,7 @@ Packet random_packet(std::mt19937_64& rng, std::size_t size) {
   Packet p = make(type, static_cast<std::uint32_t>(rng()), static_cast<std::uint16_t>(rng()));
   p.hello = {rng(), static_cast<std::uint8_t>(rng()), static_cast<std::uint8_t>(rng()),
              static_cast<std::uint8_t>(rng()), static_cast<std::uint32_t>(rng())};
-  p.hello_reply.challenge = static_cast<std::uint32_t>(rng());
+  p.hello_reply.challenge = rng();
   p.ping.time_us = rng();
   InputBody& b = p.input;
   b.ack_frame = static_cast<std::uint32_t>(rng() % 2 == 0 ? rng() : rng() % 20'000);

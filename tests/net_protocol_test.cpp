@@ -32,10 +32,10 @@ using namespace test_support;
 TEST(NetProtocolRoundTrip, HelloAtExtremes) {
   for (const bool high : {false, true}) {
     const std::uint16_t sequence = high ? 0xFFFF : 0;
-    Packet p = make(PacketType::hello, high ? max_u32 : 0, sequence);
-    p.hello = high ? Hello{max_u64, 0xFF, spectator_player, 0xFF, max_u32} : Hello{};
+    Packet p = make(PacketType::hello, high ? max_u64 : 0, sequence);
+    p.hello = high ? Hello{max_u64, 0xFF, spectator_player, 0xFF, max_u64} : Hello{};
     const Bytes expected = plain_bytes(p);
-    EXPECT_EQ(expected.size(), header_size + 8 + 1 + 1 + 1 + 4 + trailer_size);
+    EXPECT_EQ(expected.size(), header_size + 8 + 1 + 1 + 1 + 8 + trailer_size);
     for (const std::size_t size : {std::size_t{1}, max_input_size, max_unit_size})
       expect_round_trip(p, size, expected);
   }
@@ -44,11 +44,11 @@ TEST(NetProtocolRoundTrip, HelloAtExtremes) {
 TEST(NetProtocolRoundTrip, HelloReplyPingPongAtExtremes) {
   for (const bool high : {false, true}) {
     const std::uint16_t sequence = high ? 0xFFFF : 0;
-    Packet reply = make(PacketType::hello_reply, high ? max_u32 : 0, sequence);
-    reply.hello_reply.challenge = high ? max_u32 : 0;
+    Packet reply = make(PacketType::hello_reply, high ? max_u64 : 0, sequence);
+    reply.hello_reply.challenge = high ? max_u64 : 0;
     expect_round_trip(reply, 4, plain_bytes(reply));
     for (const PacketType type : {PacketType::ping, PacketType::pong}) {
-      Packet p = make(type, high ? max_u32 : 0, sequence);
+      Packet p = make(type, high ? max_u64 : 0, sequence);
       p.ping.time_us = high ? max_u64 : 0;
       const Bytes expected = plain_bytes(p);
       EXPECT_EQ(expected.size(), header_size + 8 + trailer_size);
@@ -58,13 +58,13 @@ TEST(NetProtocolRoundTrip, HelloReplyPingPongAtExtremes) {
 }
 
 TEST(NetProtocolRoundTrip, HeaderFieldsAreLittleEndian) {
-  Packet p = make(PacketType::ping, 0xA1B2C3D4, 0xE5F6);
+  Packet p = make(PacketType::ping, 0x1122334455667788ULL, 0xE5F6);
   p.ping.time_us = 0x0102030405060708ULL;
   Bytes out;
   ASSERT_TRUE(encode(p, 1, out));
   const Bytes head(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(header_size + 8));
-  EXPECT_EQ(head, (Bytes{'D', 'N', version, 4, 0xD4, 0xC3, 0xB2, 0xA1, 0xF6, 0xE5, 0x08, 0x07, 0x06,
-                         0x05, 0x04, 0x03, 0x02, 0x01}));
+  EXPECT_EQ(head, (Bytes{'D',  'N',  version, 4,    0x88, 0x77, 0x66, 0x55, 0x44, 0x33, 0x22,
+                         0x11, 0xF6, 0xE5,    0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01}));
 }
 
 TEST(NetProtocolRoundTrip, EmptyInputAtMinimum) {
@@ -85,7 +85,7 @@ TEST(NetProtocolRoundTrip, FullInputAtMaximum) {
   // 255 inputs of one byte, every delta 0xFF (two literal tokens), 8 checks, every field at its
   // maximum; then every frame as far from ack_frame as u32 allows (5 varint bytes each).
   Packet p = input_packet(255, Bytes(255, 0xFF), max_checks());
-  p.header = {PacketType::input, max_u32, 0xFFFF};
+  p.header = {PacketType::input, max_u64, 0xFFFF};
   p.input.ack_frame = p.input.check_ack = p.input.current_frame = p.input.start_frame =
       p.input.held_frame = max_u32;
   for (std::uint8_t player = 0; player < max_gone_reports; ++player)
@@ -280,7 +280,7 @@ TEST(NetProtocolVarint, TypicalInputPacketIsAtMostThirtyBytes) {
       largest = std::max(largest, out.size());
     }
   }
-  EXPECT_EQ(largest, 26U);
+  EXPECT_EQ(largest, 30U);  // version 4: the 64-bit session id added 4 bytes
   EXPECT_LE(largest, 30U);
   RecordProperty("typical_input_bytes", std::to_string(largest));
 }

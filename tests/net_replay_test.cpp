@@ -52,7 +52,6 @@ TEST(NetReplay, EveryPeerRecordsTheSameReplayAndItVerifies) {
     c.players = players;
     c.local_player = p;
     c.input_size = net::ScenarioGame::input_size;
-    c.random_seed = 40 + p;
     for (std::uint32_t q = 0; q < players; ++q)
       if (q != p) c.remotes.push_back({q, q});
     if (p == 0) c.spectators = {players};

@@ -191,7 +191,7 @@ bool encode(const Packet& packet, std::size_t input_size, std::vector<std::uint8
   out.push_back(magic1);
   out.push_back(version);
   out.push_back(static_cast<std::uint8_t>(packet.header.type));
-  put(out, packet.header.nonce, 4);
+  put(out, packet.header.session, 8);
   put(out, packet.header.sequence, 2);
   switch (packet.header.type) {
     case PacketType::hello:
@@ -199,10 +199,10 @@ bool encode(const Packet& packet, std::size_t input_size, std::vector<std::uint8
       out.push_back(packet.hello.players);
       out.push_back(packet.hello.player);
       out.push_back(packet.hello.input_size);
-      put(out, packet.hello.challenge, 4);
+      put(out, packet.hello.challenge, 8);
       break;
     case PacketType::hello_reply:
-      put(out, packet.hello_reply.challenge, 4);
+      put(out, packet.hello_reply.challenge, 8);
       break;
     case PacketType::input: {
       const InputBody& b = packet.input;
@@ -258,7 +258,7 @@ DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, 
   Reader in(signed_part);
   in.get(4);  // magic, version, type: checked above
   out.header.type = static_cast<PacketType>(bytes[3]);
-  out.header.nonce = in.u32();
+  out.header.session = in.u64();
   out.header.sequence = in.u16();
   switch (out.header.type) {
     case PacketType::hello:
@@ -266,10 +266,10 @@ DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, 
       out.hello.players = in.u8();
       out.hello.player = in.u8();
       out.hello.input_size = in.u8();
-      out.hello.challenge = in.u32();
+      out.hello.challenge = in.u64();
       break;
     case PacketType::hello_reply:
-      out.hello_reply.challenge = in.u32();
+      out.hello_reply.challenge = in.u64();
       break;
     case PacketType::input: {
       InputBody& b = out.input;

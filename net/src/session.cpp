@@ -10,15 +10,16 @@
 
 #include <detsim/core/assert.hpp>
 
+#include "secure_random.hpp"
 #include "session_impl.hpp"
 
 namespace detsim::net {
 namespace {
 
+using detail::max_input_delay;
+using detail::max_prediction_limit;
 using detail::never;
 constexpr std::uint32_t max_players = 8;
-constexpr std::uint32_t max_input_delay = 16;
-constexpr std::uint32_t max_prediction_limit = 32;
 
 Status validate(const SessionConfig& c) {
   const auto bad = [](const std::string& what) { return Status::error("session config: " + what); };
@@ -41,6 +42,8 @@ Status validate(const SessionConfig& c) {
     return bad("hello_interval_us, keepalive_us and ping_interval_us must be > 0");
   if (c.disconnect_warning_us == 0 || c.disconnect_timeout_us <= c.disconnect_warning_us)
     return bad("disconnect_timeout_us must exceed disconnect_warning_us, which must be > 0");
+  if (c.progress_timeout_us <= c.disconnect_timeout_us)
+    return bad("progress_timeout_us must exceed disconnect_timeout_us");
   if (c.remotes.size() != c.players - 1)
     return bad("remotes must list every other player once: expected " +
                std::to_string(c.players - 1) + ", got " + std::to_string(c.remotes.size()));
@@ -70,8 +73,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
       game(&g),
       transport(&t),
       max_prediction(c.mode == SessionMode::lockstep ? 0 : c.max_prediction),
-      rng(c.random_seed) {
-  nonce = static_cast<std::uint32_t>(rng.next_u64());
+      session_id(detail::secure_random_u64()) {
   for (std::uint32_t p = 0; p < c.players; ++p)
     queues.emplace_back(c.input_size, detail::input_capacity);
   disconnect_frame.assign(c.players, never);
@@ -83,7 +85,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
     peer.player = r.player;
     peer.reported_gone.assign(c.players, never);
     peer.id = r.peer;
-    peer.challenge = static_cast<std::uint32_t>(rng.next_u64());
+    peer.challenge = detail::secure_random_u64();
     peer.stats.player = r.player;
     peers.push_back(std::move(peer));
   }
@@ -92,7 +94,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
     spectator.player = c.players + static_cast<std::uint32_t>(k);
     spectator.spectator = true;
     spectator.id = c.spectators[k];
-    spectator.challenge = static_cast<std::uint32_t>(rng.next_u64());
+    spectator.challenge = detail::secure_random_u64();
     spectator.stats.player = spectator.player;
     spectators.push_back(std::move(spectator));
   }
@@ -249,8 +251,14 @@ void Session::Impl::emit_confirmed() {
 void Session::Impl::add_local_check(std::uint64_t frame, std::uint64_t hash,
                                     const detail::State* state) {
   if (peers.empty()) return;
-  if (local_checks.size() >= detail::max_pending_checks) local_checks.pop_front();
-  local_checks.push_back(detail::LocalCheck{frame, hash, state->bytes});
+  if (local_checks.size() >= detail::max_pending_checks) {
+    // A peer whose check of the dropped frame has not arrived can no longer be compared with it.
+    for (detail::Peer& peer : peers)
+      if (!peer.disconnected && peer.checks_through < local_checks.front().frame)
+        check_missing(peer, local_checks.front().frame);
+    local_checks.pop_front();
+  }
+  local_checks.push_back(detail::LocalCheck{frame, hash, state->bytes, now_us});
   for (detail::Peer& peer : peers)
     compare_checks(peer);
   retire_checks();
@@ -278,6 +286,25 @@ void Session::Impl::compare_checks(detail::Peer& peer) {
       const std::size_t logged = std::min<std::size_t>(frame_log.size() / unit_size, remote.frame);
       evidence->confirmed_frames.assign(
           frame_log.begin(), frame_log.begin() + static_cast<std::ptrdiff_t>(logged * unit_size));
+    }
+  }
+}
+
+void Session::Impl::check_missing(detail::Peer& peer, std::uint64_t frame) {
+  if (peer.check_missing) return;
+  peer.check_missing = true;
+  ++stats.checks_missing;
+  raise(Event{EventType::check_missing, peer.player, frame, 0, 0, {}});
+}
+
+void Session::Impl::check_deadlines() {
+  for (detail::Peer& peer : peers) {
+    if (!peer.synchronized || peer.disconnected || peer.check_missing) continue;
+    // Checks arrive in frame order: the first local check beyond what arrived is the one due.
+    for (const detail::LocalCheck& c : local_checks) {
+      if (c.frame <= peer.checks_through) continue;
+      if (now_us - c.confirmed_us >= config.progress_timeout_us) check_missing(peer, c.frame);
+      break;
     }
   }
 }
@@ -311,11 +338,34 @@ void Session::Impl::receive_input(detail::Peer& peer, std::uint64_t frame,
   q.confirm(input);
 }
 
-void Session::Impl::disconnect(detail::Peer& peer) {
-  player_gone(peer.player, queues[peer.player].next_confirmed());
+void Session::Impl::disconnect(detail::Peer& peer, std::string_view reason) {
+  player_gone(peer.player, queues[peer.player].next_confirmed(), reason);
 }
 
-void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame) {
+bool Session::Impl::hears(std::uint32_t player) const noexcept {
+  for (const detail::Peer& peer : peers)
+    if (peer.player == player)
+      return peer.synchronized && !peer.disconnected &&
+             now_us - peer.last_receive_us < config.disconnect_timeout_us;
+  return false;
+}
+
+bool Session::Impl::holds_back(const detail::Peer& peer) const noexcept {
+  const std::uint64_t confirmed = confirmed_frame();
+  // Its inputs are the oldest this machine lacks.
+  if (disconnect_frame[peer.player] == never &&
+      queues[peer.player].next_confirmed() <= std::min(confirmed, current))
+    return true;
+  // Its held frame is what keeps the frames this machine confirmed from being final.
+  if (peer.reported_held <= next_emit && next_emit < std::min(confirmed, current)) return true;
+  // It has not agreed to a disconnect frame this machine waits on.
+  for (std::uint32_t p = 0; p < config.players; ++p)
+    if (disconnect_frame[p] != never && peer.reported_gone[p] != disconnect_frame[p]) return true;
+  return false;
+}
+
+void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame,
+                                std::string_view reason) {
   // Frames already emitted are final: no peer can report an earlier frame unless the network is
   // partitioned, and then the hash checks will tell.
   frame = std::max(frame, next_emit);
@@ -328,7 +378,7 @@ void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame) {
       peer.disconnected = true;
       peer.stats.disconnected = true;
     }
-    raise(Event{EventType::disconnected, player, frame, 0, 0, {}});
+    raise(Event{EventType::disconnected, player, frame, 0, 0, reason});
     retire_checks();
   } else if (frame < disconnect_frame[player]) {
     disconnect_frame[player] = frame;
@@ -343,6 +393,7 @@ void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame) {
 
 Expected<Session> Session::create(const SessionConfig& config, Game& game, Transport& transport) {
   if (Status s = validate(config); !s) return s;
+  if (Status s = detail::secure_random_ready(); !s) return s;
   return Session(std::make_unique<Impl>(config, game, transport));
 }
 
@@ -372,10 +423,14 @@ Expected<Advance> Session::advance_frame(std::span<const std::uint8_t> local_inp
   // saved (rollbacks and emission read them).
   const bool ring_full = s.current + 2 - s.next_emit > s.states.size();
   if (s.current >= s.confirmed_frame() + s.max_prediction || ring_full) {
+    ++s.window_held;
+    s.last_advance_held = true;
     if (s.max_prediction == 0) return Advance::waiting_for_inputs;
     ++s.stats.prediction_limit_waits;
     return Advance::prediction_limit;
   }
+  ++s.window_advanced;
+  s.last_advance_held = false;
   s.simulate(s.current, false);
   ++s.stats.frames;
   s.emit_confirmed();

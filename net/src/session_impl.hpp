@@ -8,7 +8,6 @@
 #include <optional>
 #include <vector>
 
-#include <detsim/core/rng.hpp>
 #include <detsim/net/session.hpp>
 
 #include "input_queue.hpp"
@@ -21,6 +20,9 @@ namespace detsim::net::detail {
 inline constexpr std::size_t input_capacity = 256;
 /// Hash checks this side keeps for comparison, and accepts ahead from one peer.
 inline constexpr std::size_t max_pending_checks = 64;
+/// The largest input delay and prediction window a session may be configured with.
+inline constexpr std::uint32_t max_input_delay = 16;
+inline constexpr std::uint32_t max_prediction_limit = 32;
 /// "No frame": a connected player's disconnect frame.
 inline constexpr std::uint64_t never = ~std::uint64_t{0};
 /// States the ring keeps beyond twice the prediction window: room for the frames between the last
@@ -33,6 +35,7 @@ struct LocalCheck {
   std::uint64_t frame = 0;
   std::uint64_t hash = 0;
   std::vector<std::uint8_t> state;  ///< this machine's state at `frame` (desync evidence)
+  std::uint64_t confirmed_us = 0;   ///< when this machine confirmed it (the peers' deadline)
 };
 
 /// A remote player's connection.
@@ -40,12 +43,15 @@ struct Peer {
   std::uint32_t player = 0;  ///< a spectator's is players + its index
   bool spectator = false;
   PeerId id = 0;
-  // Handshake: synchronized once the peer answered our challenge and we know its nonce.
-  std::uint32_t challenge = 0;
-  bool answered = false;     ///< the peer replied to our challenge
-  bool nonce_known = false;  ///< we received the peer's hello
-  std::uint32_t remote_nonce = 0;
+  // Handshake (docs/NET.md, "Handshake"): synchronized once the peer answered our challenge; its
+  // session id comes from that answer only and never changes after.
+  std::uint64_t challenge = 0;  ///< 64 random bits, sent only to the peer's address
+  bool answered = false;        ///< the peer replied to our challenge
+  std::uint64_t remote_session = 0;
   bool synchronized = false;
+  /// A datagram beyond the handshake arrived from the peer's session: it knows our id, so its
+  /// hellos need no more answers (nor does a flood of forged ones get any).
+  bool knows_us = false;
   std::uint64_t last_hello_us = 0;
   bool hello_sent = false;
   bool hello_rejected = false;  ///< reported once
@@ -60,10 +66,14 @@ struct Peer {
   std::uint64_t checks_through = 0;  ///< every check of the peer up to this frame received
   std::deque<protocol::HashCheck> pending_checks;  ///< received, not yet compared
   bool desynced = false;
+  bool check_missing = false;  ///< Event::check_missing raised (once per peer)
   // Liveness and statistics.
   std::uint64_t last_receive_us = 0;
   std::uint64_t last_send_us = 0;
   std::uint64_t last_ping_us = 0;
+  /// The time our latest ping carried, until its pong arrives: the only pong accepted (a replayed
+  /// or forged pong would otherwise make up a round-trip time).
+  std::optional<std::uint64_t> ping_out;
   bool interrupted = false;
   bool disconnected = false;
   bool needs_ack = false;  ///< received data since the last packet we sent
@@ -100,12 +110,28 @@ struct Session::Impl {
   void add_local_check(std::uint64_t frame, std::uint64_t hash, const detail::State* state);
   void compare_checks(detail::Peer& peer);
   void retire_checks();
+  /// Raises Event::check_missing for `peer` about `frame` (once per peer).
+  void check_missing(detail::Peer& peer, std::uint64_t frame);
+  /// Every peer's check of each frame this machine confirmed must arrive within
+  /// progress_timeout_us: a missing one is an error, never a pass.
+  void check_deadlines();
   void receive_input(detail::Peer& peer, std::uint64_t frame, std::span<const std::uint8_t> input);
-  void disconnect(detail::Peer& peer);
+  /// Takes the peer's player as gone from its first input this machine does not hold; `reason`
+  /// (a string literal) goes into the event.
+  void disconnect(detail::Peer& peer, std::string_view reason);
   /// Takes `player` as gone from `frame` (or from the frame of its first input this machine does
   /// not hold, if earlier); a later call can only move the frame earlier. Peers converge on the
   /// lowest frame any of them reports (docs/NET.md, "Disconnects").
-  void player_gone(std::uint32_t player, std::uint64_t frame);
+  void player_gone(std::uint32_t player, std::uint64_t frame, std::string_view reason);
+  /// Whether this machine heard from `player`'s peer within disconnect_timeout_us (a gone report
+  /// about such a player is not believed).
+  [[nodiscard]] bool hears(std::uint32_t player) const noexcept;
+  /// Whether the match waits on `peer` now: its inputs are the oldest missing, its held frame is
+  /// what keeps frames from being final, or it has not agreed to a disconnect frame.
+  [[nodiscard]] bool holds_back(const detail::Peer& peer) const noexcept;
+  /// The progress guard (docs/NET.md, "Progress"): at the end of each window of
+  /// progress_timeout_us, disconnects the peers that held the match back through it.
+  void check_progress();
   /// Every player's input before this frame is held, or known final (zero) for a gone player whose
   /// disconnect frame every connected peer reports: what this machine may simulate as confirmed.
   [[nodiscard]] std::uint64_t confirmed_frame() const noexcept;
@@ -122,10 +148,16 @@ struct Session::Impl {
   // session_wire.cpp: the network.
   void receive_all();
   void handle(detail::Peer& peer, const protocol::Packet& packet);
-  /// False when the hello was rejected (counted, maybe reported).
-  bool handle_hello(detail::Peer& peer, const protocol::Packet& packet);
-  /// `fresh`: the datagram is newer than every one handled before from this peer.
-  void handle_input(detail::Peer& peer, const protocol::InputBody& body, bool fresh);
+  /// Answers a hello that matches this session with a reply echoing its challenge. Changes no
+  /// handshake state: a hello, forged or not, can neither set nor reset the peer's session id.
+  void handle_hello(detail::Peer& peer, const protocol::Packet& packet);
+  /// `fresh`: the datagram is newer than every one handled before from this peer. False (nothing
+  /// changed) when a field is implausible.
+  bool handle_input(detail::Peer& peer, const protocol::InputBody& body, bool fresh);
+  /// Whether an input datagram's fields are what an honest peer can send (checked before any is
+  /// used): its held frame within the inputs it acknowledges, its current frame within what its
+  /// inputs and ours allow.
+  [[nodiscard]] bool plausible(const detail::Peer& peer, const protocol::InputBody& body) const;
   void send_due();
   void send_inputs(detail::Peer& peer);
   void send_frames(detail::Peer& spectator);
@@ -138,8 +170,7 @@ struct Session::Impl {
   Game* game;
   Transport* transport;
   std::uint32_t max_prediction = 0;  ///< 0 in lockstep
-  Rng rng;
-  std::uint32_t nonce = 0;
+  std::uint64_t session_id = 0;      ///< this session's id: 64 random bits from a CSPRNG
   std::uint64_t now_us = 0;
   bool running = false;
 
@@ -158,6 +189,12 @@ struct Session::Impl {
   std::uint64_t current = 0;
   std::optional<std::uint64_t> first_incorrect;
   std::uint64_t next_emit = 0;  ///< the next frame to hand to the confirmed listener
+  // The progress guard's window: since when, and how many advance_frame() calls simulated a new
+  // frame or were held at the prediction limit (or waited, in lockstep) during it.
+  std::uint64_t window_start_us = 0;
+  std::uint64_t window_advanced = 0;
+  std::uint64_t window_held = 0;
+  bool last_advance_held = false;
 
   // Scratch for simulate(), sized once.
   std::vector<std::uint8_t> frame_inputs;

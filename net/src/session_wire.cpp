@@ -61,70 +61,87 @@ void Session::Impl::receive_all() {
 void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
   using protocol::PacketType;
   if (p.header.type == PacketType::hello) {
-    if (!handle_hello(peer, p)) return;  // a rejected hello says nothing about the peer's liveness
+    // Answered, never believed: a hello proves nothing about who sent it (its source address can
+    // be spoofed), so it is not a sign of life either.
+    handle_hello(peer, p);
+    return;
   } else if (p.header.type == PacketType::hello_reply) {
+    // The peer's session id is taken from the reply to our own challenge only — 64 random bits
+    // sent to its address alone, which a third party off the path never sees — and once.
     if (p.hello_reply.challenge != peer.challenge ||
-        (peer.nonce_known && p.header.nonce != peer.remote_nonce)) {
+        (peer.answered && p.header.session != peer.remote_session)) {
       ++stats.dropped_wrong_session;
       return;
     }
+    if (peer.answered) return;  // a duplicate: nothing new
     peer.answered = true;
+    peer.remote_session = p.header.session;
   } else {
-    if (!peer.synchronized || p.header.nonce != peer.remote_nonce) {
+    if (!peer.synchronized || p.header.session != peer.remote_session) {
       ++stats.dropped_wrong_session;
       return;
     }
-    // Loss statistics from the sequence numbers (modulo 2^16; a late one fills a gap).
-    bool fresh = true;
-    if (peer.last_sequence) {
-      const auto step = static_cast<std::uint16_t>(p.header.sequence - *peer.last_sequence);
-      if (step != 0 && step < 0x8000U) {
-        peer.stats.packets_lost += step - 1U;
-        peer.last_sequence = p.header.sequence;
-      } else {
-        fresh = false;
-        if (step >= 0x8000U && peer.stats.packets_lost > 0) --peer.stats.packets_lost;
-      }
-    } else {
-      peer.last_sequence = p.header.sequence;
-    }
+    peer.knows_us = true;
+    // Fresh: newer than every datagram handled from the peer (sequence numbers modulo 2^16).
+    const auto step = static_cast<std::uint16_t>(
+        p.header.sequence - peer.last_sequence.value_or(std::uint16_t(p.header.sequence - 1)));
+    const bool fresh = step != 0 && step < 0x8000U;
     if (p.header.type == PacketType::ping) {
       protocol::Packet pong;
       pong.header.type = PacketType::pong;
       pong.ping.time_us = p.ping.time_us;
       send(peer, pong);
     } else if (p.header.type == PacketType::pong) {
-      if (p.ping.time_us <= now_us) {
-        const std::uint64_t rtt = now_us - p.ping.time_us;
-        const bool first = peer.rtt_x16 == 0;
-        const std::uint64_t deviation =
-            rtt * 16 > peer.rtt_x16 ? rtt * 16 - peer.rtt_x16 : peer.rtt_x16 - rtt * 16;
-        peer.rtt_x16 = smooth(peer.rtt_x16, rtt, first);
-        peer.jitter_x16 = smooth(peer.jitter_x16, deviation / 16, first);
+      // Only the pong of the ping we have outstanding measures anything: a replayed or forged
+      // one (any time it carries) would make up a round-trip time and with it the frame advantage.
+      if (!peer.ping_out || p.ping.time_us != *peer.ping_out) {
+        ++stats.dropped_stale_pongs;
+        return;
       }
-    } else {
-      handle_input(peer, p.input, fresh);
+      peer.ping_out.reset();
+      const std::uint64_t rtt = now_us - p.ping.time_us;
+      const bool first = peer.rtt_x16 == 0;
+      const std::uint64_t deviation =
+          rtt * 16 > peer.rtt_x16 ? rtt * 16 - peer.rtt_x16 : peer.rtt_x16 - rtt * 16;
+      peer.rtt_x16 = smooth(peer.rtt_x16, rtt, first);
+      peer.jitter_x16 = smooth(peer.jitter_x16, deviation / 16, first);
+    } else if (!handle_input(peer, p.input, fresh)) {
+      ++stats.dropped_implausible;
+      return;
     }
+    ++peer.stats.packets_received;
+    // Loss statistics from the sequence numbers (a late one fills a gap).
+    if (fresh) {
+      if (peer.last_sequence) peer.stats.packets_lost += step - 1U;
+      peer.last_sequence = p.header.sequence;
+    } else if (step >= 0x8000U && peer.stats.packets_lost > 0) {
+      --peer.stats.packets_lost;
+    }
+    // A duplicate or a late datagram says nothing about the peer now (a relay replaying old
+    // packets must not keep a departed peer alive).
+    if (!fresh) return;
   }
-  ++peer.stats.packets_received;
+  if (p.header.type == PacketType::hello || p.header.type == PacketType::hello_reply)
+    ++peer.stats.packets_received;
   peer.last_receive_us = now_us;
   if (peer.interrupted) {
     peer.interrupted = false;
     raise(Event{EventType::resumed, peer.player, current, 0, 0, {}});
   }
-  if (!peer.synchronized && peer.answered && peer.nonce_known) {
+  if (!peer.synchronized && peer.answered) {
     peer.synchronized = true;
     peer.stats.synchronized = true;
     raise(Event{EventType::synchronized, peer.player, current, 0, 0, {}});
     if (!peer.spectator && std::all_of(peers.begin(), peers.end(),
                                        [](const detail::Peer& x) { return x.synchronized; })) {
       running = true;
+      window_start_us = now_us;  // the progress guard counts from here
       raise(Event{EventType::running, 0, current, 0, 0, {}});
     }
   }
 }
 
-bool Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) {
+void Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) {
   const protocol::Hello& h = p.hello;
   std::string_view reason;
   if (h.fingerprint != config.fingerprint)
@@ -141,33 +158,45 @@ bool Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) 
       peer.hello_rejected = true;
       raise(Event{EventType::hello_rejected, peer.player, current, 0, 0, reason});
     }
-    return false;
+    return;
   }
-  if (peer.nonce_known && p.header.nonce != peer.remote_nonce) {
-    if (peer.synchronized) {  // a stale or foreign session on the same address
-      ++stats.dropped_wrong_session;
-      return false;
-    }
-    peer.answered = false;  // the peer restarted before we finished: start over with it
+  if (peer.knows_us) {  // the genuine peer has our id already: this one is stale or forged
+    ++stats.dropped_wrong_session;
+    return;
   }
-  peer.remote_nonce = p.header.nonce;
-  peer.nonce_known = true;
+  // Every matching hello is answered (to the peer's address, whoever sent it): a flood of forged
+  // hellos cannot crowd out the genuine one's answer, and a reply to a forged challenge is
+  // dropped by the genuine peer.
   protocol::Packet reply;
   reply.header.type = protocol::PacketType::hello_reply;
   reply.hello_reply.challenge = h.challenge;
   send(peer, reply);
-  return true;
 }
 
-void Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& b, bool fresh) {
+bool Session::Impl::plausible(const detail::Peer& peer, const protocol::InputBody& b) const {
+  // The sender's held frame counts our inputs (it plays with us, or it would not send to us),
+  // so it cannot exceed the inputs of ours it acknowledges in the same datagram.
+  if (b.held_frame > b.ack_frame) return false;
+  // Its current frame: at most max_prediction_limit beyond the inputs of ours it can hold, and at
+  // most max_input_delay + 1 behind the inputs it sent (its own input runs that far ahead).
+  const std::uint64_t ours = queues[config.local_player].next_confirmed();
+  if (b.current_frame > ours + detail::max_prediction_limit) return false;
+  const std::uint64_t sent =
+      std::max<std::uint64_t>(queues[peer.player].next_confirmed(), b.start_frame + b.count);
+  return std::uint64_t{b.current_frame} + detail::max_input_delay + 1 >= sent;
+}
+
+bool Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& b, bool fresh) {
   if (peer.spectator) {  // a spectator only acknowledges frames
     const std::uint64_t logged = frame_log.size() / unit_size;
     if (b.ack_frame <= logged)
       peer.acked_inputs = std::max<std::uint64_t>(peer.acked_inputs, b.ack_frame);
     peer.remote_frame = b.current_frame;
     peer.stats.remote_frame = b.current_frame;
-    return;
+    return true;
   }
+  // Every field is checked before any is used: an implausible datagram changes nothing.
+  if (fresh && !plausible(peer, b)) return false;
   const detail::InputQueue& mine = queues[config.local_player];
   // Acknowledgements never move backwards, nor beyond what was sent.
   if (b.ack_frame <= mine.next_confirmed())
@@ -175,13 +204,15 @@ void Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& 
   const std::uint64_t last_check = local_checks.empty() ? agreed_frame : local_checks.back().frame;
   if (b.check_ack <= std::max(last_check, peer.acked_checks))
     peer.acked_checks = std::max<std::uint64_t>(peer.acked_checks, b.check_ack);
-  peer.remote_frame = b.current_frame;
-  peer.stats.remote_frame = b.current_frame;
-  peer.remote_advantage_x16 = smooth_signed(peer.remote_advantage_x16, b.advantage);
-  const std::uint64_t half_rtt_frames = peer.rtt_x16 / 32 / config.frame_us;
-  const auto ahead = static_cast<std::int64_t>(current) -
-                     static_cast<std::int64_t>(b.current_frame + half_rtt_frames);
-  peer.advantage_x16 = smooth_signed(peer.advantage_x16, ahead);
+  if (fresh) {  // time sync from the newest datagram only: a late one's frames are out of date
+    peer.remote_frame = b.current_frame;
+    peer.stats.remote_frame = b.current_frame;
+    peer.remote_advantage_x16 = smooth_signed(peer.remote_advantage_x16, b.advantage);
+    const std::uint64_t half_rtt_frames = peer.rtt_x16 / 32 / config.frame_us;
+    const auto ahead = static_cast<std::int64_t>(current) -
+                       static_cast<std::int64_t>(b.current_frame + half_rtt_frames);
+    peer.advantage_x16 = smooth_signed(peer.advantage_x16, ahead);
+  }
 
   detail::InputQueue& q = queues[peer.player];
   if (b.count > 0 && disconnect_frame[peer.player] == detail::never) {
@@ -217,21 +248,29 @@ void Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& 
   compare_checks(peer);
   retire_checks();
   // Disconnect agreement, with the peers this machine still plays with only.
-  if (peer.disconnected) return;
+  if (peer.disconnected) return true;
   if (fresh) peer.reported_held = b.held_frame;  // a late datagram's may be out of date
   for (const protocol::GoneReport& g : b.gone) {
     if (g.player >= config.players) {
       ++stats.dropped_out_of_window;
       continue;
     }
+    // Corroborated disconnects: a report about this machine's own player, or about a player it
+    // still hears from (the sender itself included), is not believed. One peer alone cannot
+    // remove a player the others still play with; a peer this machine no longer hears either is
+    // gone here too, and the report only moves its frame earlier.
+    if (g.player == config.local_player || hears(g.player)) {
+      ++stats.ignored_gone_reports;
+      continue;
+    }
     peer.reported_gone[g.player] = std::min<std::uint64_t>(peer.reported_gone[g.player], g.frame);
-    player_gone(g.player, g.frame);
-    if (peer.disconnected) return;  // the report was about the peer itself
+    player_gone(g.player, g.frame, "reported gone");
   }
+  return true;
 }
 
 void Session::Impl::send(detail::Peer& peer, protocol::Packet& p) {
-  p.header.nonce = nonce;
+  p.header.session = session_id;
   p.header.sequence = peer.send_sequence++;
   const std::size_t unit = peer.spectator && p.header.type == protocol::PacketType::input
                                ? unit_size
@@ -326,7 +365,7 @@ void Session::Impl::send_due() {
   for (std::vector<detail::Peer>* group : {&peers, &spectators}) {
     for (detail::Peer& peer : *group) {
       if (peer.disconnected) continue;
-      if ((!peer.answered || !peer.nonce_known) &&
+      if (!peer.answered &&
           (!peer.hello_sent || now_us - peer.last_hello_us >= config.hello_interval_us))
         send_hello(peer);
       if (!peer.synchronized) continue;
@@ -336,6 +375,7 @@ void Session::Impl::send_due() {
         ping.ping.time_us = now_us;
         send(peer, ping);
         peer.last_ping_us = now_us;
+        peer.ping_out = now_us;
       }
       const std::uint64_t quiet = now_us - peer.last_send_us;
       if (peer.spectator) {
@@ -365,9 +405,9 @@ void Session::Impl::check_timeouts() {
         if (peer.spectator) {
           peer.disconnected = true;
           peer.stats.disconnected = true;
-          raise(Event{EventType::disconnected, peer.player, current, 0, 0, {}});
+          raise(Event{EventType::disconnected, peer.player, current, 0, 0, "silent"});
         } else {
-          disconnect(peer);
+          disconnect(peer, "silent");
         }
       } else if (silence >= config.disconnect_warning_us && !peer.interrupted) {
         peer.interrupted = true;
@@ -377,11 +417,31 @@ void Session::Impl::check_timeouts() {
   }
 }
 
+void Session::Impl::check_progress() {
+  if (!running || now_us - window_start_us < config.progress_timeout_us) return;
+  // Held back: the game asked to advance at least twice as often as it could (it ran less than a
+  // third of the time through the window), and cannot now. Honest peers keep a match far above
+  // that however slow their link (a 400 ms one-way trip still confirms a frame per frame), and a
+  // silent one is disconnected by the shorter disconnect timeout first.
+  const bool held_back = last_advance_held && window_held > 2 * window_advanced;
+  window_start_us = now_us;
+  window_advanced = 0;
+  window_held = 0;
+  if (!held_back) return;
+  std::vector<detail::Peer*> blamed;
+  for (detail::Peer& peer : peers)
+    if (peer.synchronized && !peer.disconnected && holds_back(peer)) blamed.push_back(&peer);
+  for (detail::Peer* peer : blamed)
+    disconnect(*peer, "no progress");
+}
+
 void Session::poll(std::uint64_t now_us) {
   Impl& s = *impl_;
   s.now_us = std::max(s.now_us, now_us);
   s.receive_all();
   s.check_timeouts();
+  s.check_progress();
+  s.check_deadlines();
   if (s.running) {
     // As GGPO does while idle: a correction received here is applied now, so a game that stops
     // advancing (at a match's end, or waiting) still gets its confirmed frames out.
@@ -392,10 +452,17 @@ void Session::poll(std::uint64_t now_us) {
 }
 
 std::uint32_t Session::recommended_wait_frames() const noexcept {
+  // The peer's own estimate of its advantage should mirror ours; it is trusted only within
+  // `tolerance` frames of that, so a lying peer can hold this machine back by at most
+  // tolerance / 2 frames beyond what its (range-checked) frame numbers show.
+  constexpr std::int64_t tolerance_x16 = 8 * 16;
   std::int64_t wait_x16 = 0;
   for (const detail::Peer& peer : impl_->peers) {
     if (!peer.synchronized || peer.disconnected) continue;
-    wait_x16 = std::max(wait_x16, (peer.advantage_x16 - peer.remote_advantage_x16) / 2);
+    const std::int64_t mirror = -peer.advantage_x16;
+    const std::int64_t remote =
+        std::clamp(peer.remote_advantage_x16, mirror - tolerance_x16, mirror + tolerance_x16);
+    wait_x16 = std::max(wait_x16, (peer.advantage_x16 - remote) / 2);
   }
   return static_cast<std::uint32_t>(wait_x16 / 16);
 }
@@ -409,6 +476,7 @@ std::optional<PeerStats> Session::peer_stats(std::uint32_t player) const {
     stats.jitter_us = peer.jitter_x16 / 16;
     stats.frames_ahead = peer.advantage_x16 / 16;
     stats.acknowledged_frame = peer.acked_inputs;
+    stats.checks_received_through = peer.spectator ? 0 : peer.checks_through;
     return stats;
   }
   return std::nullopt;

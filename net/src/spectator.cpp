@@ -6,8 +6,9 @@
 #include <deque>
 #include <string>
 
-#include <detsim/core/rng.hpp>
 #include <detsim/net/protocol.hpp>
+
+#include "secure_random.hpp"
 
 namespace detsim::net {
 
@@ -16,11 +17,13 @@ struct SpectatorSession::Impl {
   Game* game = nullptr;
   Transport* transport = nullptr;
   std::size_t unit = 0;  ///< bytes per received frame
-  std::uint32_t nonce = 0;
-  std::uint32_t challenge = 0;
+  // The handshake (docs/NET.md, "Handshake"): the host's session id comes only from its reply to
+  // our challenge, and never changes after.
+  std::uint64_t session_id = 0;
+  std::uint64_t challenge = 0;
   bool answered = false;
-  bool nonce_known = false;
-  std::uint32_t host_nonce = 0;
+  std::uint64_t host_session = 0;
+  bool host_knows_us = false;  ///< the host's session sent frames or pings: it has our id
   bool running = false;
   bool disconnected = false;
   std::uint64_t now_us = 0;
@@ -49,7 +52,7 @@ struct SpectatorSession::Impl {
   [[nodiscard]] std::uint64_t next_needed() const noexcept { return current + buffered(); }
 
   void send(protocol::Packet& p) {
-    p.header.nonce = nonce;
+    p.header.session = session_id;
     p.header.sequence = sequence++;
     if (!protocol::encode(p, config.input_size, out)) return;
     transport->send(config.host, out);
@@ -61,32 +64,35 @@ struct SpectatorSession::Impl {
     switch (p.header.type) {
       case PacketType::hello: {
         const protocol::Hello& h = p.hello;
+        // Answered (unless the host has shown it knows our id), never believed: a hello changes
+        // nothing here, nor is it a sign of life.
         if (h.fingerprint != config.fingerprint || h.players != config.players ||
-            h.input_size != config.input_size || h.player >= config.players ||
-            (nonce_known && running && p.header.nonce != host_nonce)) {
+            h.input_size != config.input_size || h.player >= config.players || host_knows_us) {
           ++stats.dropped;
           return;
         }
-        host_nonce = p.header.nonce;
-        nonce_known = true;
         protocol::Packet reply;
         reply.header.type = PacketType::hello_reply;
         reply.hello_reply.challenge = h.challenge;
         send(reply);
-        break;
+        return;
       }
       case PacketType::hello_reply:
-        if (p.hello_reply.challenge != challenge) {
+        if (p.hello_reply.challenge != challenge ||
+            (answered && p.header.session != host_session)) {
           ++stats.dropped;
           return;
         }
+        if (answered) return;  // a duplicate
         answered = true;
+        host_session = p.header.session;
         break;
       case PacketType::ping: {
-        if (!running || p.header.nonce != host_nonce) {
+        if (!running || p.header.session != host_session) {
           ++stats.dropped;
           return;
         }
+        host_knows_us = true;
         protocol::Packet pong;
         pong.header.type = PacketType::pong;
         pong.ping.time_us = p.ping.time_us;
@@ -96,16 +102,17 @@ struct SpectatorSession::Impl {
       case PacketType::pong:
         return;
       case PacketType::input:
-        if (!running || p.header.nonce != host_nonce) {
+        if (!running || p.header.session != host_session) {
           ++stats.dropped;
           return;
         }
+        host_knows_us = true;
         receive_frames(p.input);
         break;
     }
     ++stats.packets_received;
     last_receive_us = now_us;
-    if (!running && answered && nonce_known) {
+    if (!running && answered) {
       running = true;
       events.push_back(Event{EventType::synchronized, 0, current, 0, 0, {}});
       events.push_back(Event{EventType::running, 0, current, 0, 0, {}});
@@ -174,9 +181,9 @@ Expected<SpectatorSession> SpectatorSession::create(const SpectatorConfig& c, Ga
   impl->game = &game;
   impl->transport = &transport;
   impl->unit = 1 + std::size_t{c.players} * c.input_size;
-  Rng rng(c.random_seed);
-  impl->nonce = static_cast<std::uint32_t>(rng.next_u64());
-  impl->challenge = static_cast<std::uint32_t>(rng.next_u64());
+  if (Status s = detail::secure_random_ready(); !s) return s;
+  impl->session_id = detail::secure_random_u64();
+  impl->challenge = detail::secure_random_u64();
   impl->last_frame.assign(impl->unit, 0);
   impl->frame_inputs.assign(std::size_t{c.players} * c.input_size, 0);
   impl->frame_status.assign(c.players, InputStatus::confirmed);
@@ -215,8 +222,7 @@ void SpectatorSession::poll(std::uint64_t now_us) {
     s.events.push_back(Event{EventType::disconnected, 0, s.current, 0, 0, {}});
     return;
   }
-  if ((!s.answered || !s.nonce_known) &&
-      (!s.hello_sent || s.now_us - s.last_hello_us >= s.config.hello_interval_us)) {
+  if (!s.answered && (!s.hello_sent || s.now_us - s.last_hello_us >= s.config.hello_interval_us)) {
     protocol::Packet hello;
     hello.header.type = protocol::PacketType::hello;
     hello.hello = protocol::Hello{s.config.fingerprint, static_cast<std::uint8_t>(s.config.players),

@@ -22,7 +22,6 @@ Match::Match(const MatchOptions& options) : options_(options) {
     config.max_prediction = options.max_prediction;
     config.check_interval = options.check_interval;
     config.fingerprint = 0xD5'1A'77ULL + options.players;
-    config.random_seed = options.seed * 1000 + p;
     for (std::uint32_t q = 0; q < options.players; ++q)
       if (q != p) config.remotes.push_back(net::RemotePlayer{q, q});
     if (p == 0)
@@ -68,7 +67,6 @@ void Match::add_spectators() {
     config.players = options_.players;
     config.input_size = sessions_[0]->config().input_size;
     config.fingerprint = sessions_[0]->config().fingerprint;
-    config.random_seed = options_.seed * 1000 + 100 + k;
     config.host = 0;
     if (options_.configure_spectator) options_.configure_spectator(k, config);
     auto s = net::SpectatorSession::create(config, *spectator_games_.back(),
@@ -182,9 +180,10 @@ std::string Match::checks_complete() const {
   const std::uint64_t expected = (per_peer > 2 ? per_peer - 2 : 0) * (options_.players - 1);
   for (std::uint32_t p = 0; p < options_.players; ++p) {
     const net::SessionStats& s = sessions_[p]->stats();
-    if (s.checks_compared < expected || s.checks_skipped != 0)
+    if (s.checks_compared < expected || s.checks_skipped != 0 || s.checks_missing != 0)
       out << "peer " << p << " compared " << s.checks_compared << " checks (expected at least "
-          << expected << ") and skipped " << s.checks_skipped << "; ";
+          << expected << "), skipped " << s.checks_skipped << " and missed " << s.checks_missing
+          << "; ";
   }
   return out.str();
 }

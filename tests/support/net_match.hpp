@@ -98,7 +98,9 @@ struct MatchOptions {
   /// Called for each peer every tick before it advances (mid-match changes).
   std::function<void(std::uint32_t peer, std::uint64_t tick, net::Session&)> on_tick;
   /// Wraps peer p's transport (hostile-datagram tests); nullptr keeps the network's endpoint.
-  std::function<std::unique_ptr<net::Transport>(std::uint32_t peer, net::Transport& inner)> wrap;
+  using Wrap =
+      std::function<std::unique_ptr<net::Transport>(std::uint32_t peer, net::Transport& inner)>;
+  Wrap wrap;
   std::optional<std::uint64_t> fault_frame;  ///< CounterGame fault on peer fault_peer
   std::uint32_t fault_peer = 0;
   std::uint64_t max_ticks = 0;  ///< 0: frames * 4 + 2000

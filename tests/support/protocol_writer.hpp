@@ -83,8 +83,8 @@ class Writer {
     bytes_.insert(bytes_.end(), b.begin(), b.end());
     return *this;
   }
-  Writer& header(std::uint8_t type, std::uint32_t nonce, std::uint16_t sequence) {
-    return u8('D').u8('N').u8(version).u8(type).u32(nonce).u16(sequence);
+  Writer& header(std::uint8_t type, std::uint64_t session, std::uint16_t sequence) {
+    return u8('D').u8('N').u8(version).u8(type).u64(session).u16(sequence);
   }
   /// The bytes so far followed by the trailer: the low 32 bits of XXH3-64 over them.
   [[nodiscard]] Bytes sealed() const {
@@ -146,7 +146,7 @@ inline std::size_t literal_bound(std::size_t length) {
 inline Bytes input_bytes(const Packet& p, std::span<const std::uint8_t> tokens) {
   const InputBody& b = p.input;
   Writer w;
-  w.header(static_cast<std::uint8_t>(PacketType::input), p.header.nonce, p.header.sequence)
+  w.header(static_cast<std::uint8_t>(PacketType::input), p.header.session, p.header.sequence)
       .varint(b.ack_frame)
       .frame(b.check_ack, b.ack_frame)
       .frame(b.current_frame, b.ack_frame)
@@ -166,17 +166,17 @@ inline Bytes input_bytes(const Packet& p, std::span<const std::uint8_t> tokens) 
 /// The bytes of a hello, hello_reply, ping or pong packet.
 inline Bytes plain_bytes(const Packet& p) {
   Writer w;
-  w.header(static_cast<std::uint8_t>(p.header.type), p.header.nonce, p.header.sequence);
+  w.header(static_cast<std::uint8_t>(p.header.type), p.header.session, p.header.sequence);
   switch (p.header.type) {
     case PacketType::hello:
       w.u64(p.hello.fingerprint)
           .u8(p.hello.players)
           .u8(p.hello.player)
           .u8(p.hello.input_size)
-          .u32(p.hello.challenge);
+          .u64(p.hello.challenge);
       break;
     case PacketType::hello_reply:
-      w.u32(p.hello_reply.challenge);
+      w.u64(p.hello_reply.challenge);
       break;
     case PacketType::ping:
     case PacketType::pong:
@@ -243,9 +243,9 @@ inline std::vector<std::size_t> all_sizes() {
   return sizes;
 }
 
-inline Packet make(PacketType type, std::uint32_t nonce, std::uint16_t sequence) {
+inline Packet make(PacketType type, std::uint64_t session, std::uint16_t sequence) {
   Packet p;
-  p.header = {type, nonce, sequence};
+  p.header = {type, session, sequence};
   return p;
 }
 
@@ -292,7 +292,7 @@ inline Bytes non_zero_run(std::size_t n, std::size_t salt) {
 /// Compares the header and the body that header.type says is meaningful.
 inline testing::AssertionResult same_packet(const Packet& a, const Packet& b) {
   if (a.header.type != b.header.type) return testing::AssertionFailure() << "type differs";
-  if (a.header.nonce != b.header.nonce) return testing::AssertionFailure() << "nonce differs";
+  if (a.header.session != b.header.session) return testing::AssertionFailure() << "session differs";
   if (a.header.sequence != b.header.sequence)
     return testing::AssertionFailure() << "sequence differs";
   switch (a.header.type) {

@@ -117,7 +117,6 @@ Status Demo::set_up(const std::string& replay_path) {
     config.input_size = net::ScenarioGame::input_size;
     config.input_delay = demo_input_delay;
     config.fingerprint = session_fingerprint(*peer.scenario, config.mode, args_.frames);
-    config.random_seed = args_.seed * 1000 + p;  // fixed: the demo gives the same result each run
     for (std::uint32_t q = 0; q < demo_players; ++q)
       if (q != p) config.remotes.push_back(net::RemotePlayer{q, q});
     auto session = net::Session::create(config, *peer.game, network_->endpoint(p));

@@ -54,11 +54,22 @@ class Netplay {
     if (!args_.json) std::printf("%s\n", line.c_str());
     std::fflush(stdout);
   }
+  /// Why a player was disconnected, in words: the event's reason with its limit.
+  [[nodiscard]] std::string disconnect_reason(std::string_view reason) const {
+    const net::SessionConfig& c = session_->config();
+    if (reason == "silent") return "silent for " + milliseconds(c.disconnect_timeout_us);
+    if (reason == "no progress")
+      return "no progress: it held the match back for " + milliseconds(c.progress_timeout_us);
+    return std::string(reason);
+  }
   /// Handles the session's events; false (with failure_ set) when a player disconnected.
   bool handle_events();
   void write_desync_report();
   void advance();
   [[nodiscard]] bool peers_at_end() const;
+  /// The connected players whose hash checks of the match's frames have not all arrived ("" when
+  /// every one has): a frame whose check never arrives is unverified, never a pass.
+  [[nodiscard]] std::string checks_behind() const;
   [[nodiscard]] std::string unconfirmed_players() const;
   /// Spectator `player` (players + k) acknowledged every frame of the match.
   [[nodiscard]] bool has_every_frame(std::uint32_t player) const {
@@ -87,6 +98,8 @@ class Netplay {
   /// Per player, then per spectator: why its hello was rejected, if it was.
   std::vector<std::string> rejected_;
   std::vector<net::Event> desyncs_;
+  /// Hash checks that never arrived (Event::check_missing, or still missing at the end).
+  std::vector<std::string> unverified_;
   std::string failure_;
   std::uint64_t confirmed_ = 0;
   std::optional<std::uint64_t> final_hash_;
@@ -149,7 +162,6 @@ Status Netplay::start() {
   config.input_size = net::ScenarioGame::input_size;
   config.input_delay = args_.input_delay;
   config.fingerprint = session_fingerprint(*scenario_, plan_.mode, args_.frames);
-  config.random_seed = os_random_seed();
   config.frame_us =
       args_.fps == 0 ? 1000 : std::clamp<std::uint32_t>(1'000'000 / args_.fps, 1000, 1'000'000);
   for (const net::UdpPeer& p : plan_.peers)
@@ -211,6 +223,14 @@ bool Netplay::handle_events() {
             hex(e.local_hash) + ", player " + std::to_string(e.player) + " " + hex(e.remote_hash));
         if (!args_.desync_report.empty() && desyncs_.size() == 1) write_desync_report();
         break;
+      case net::EventType::check_missing: {
+        const std::string line = who + ": its hash check of frame " + std::to_string(e.frame) +
+                                 " did not arrive within " +
+                                 milliseconds(session_->config().progress_timeout_us);
+        unverified_.push_back(line);
+        std::fprintf(stderr, "detsim netplay: UNVERIFIED: %s\n", line.c_str());
+        break;
+      }
       case net::EventType::disconnected:
         if (left) break;
         if (spectator) {  // the match goes on without it
@@ -218,8 +238,8 @@ bool Netplay::handle_events() {
                        static_cast<unsigned long long>(e.frame));
           break;
         }
-        failure_ = who + " disconnected at frame " + std::to_string(e.frame) + " (silent for " +
-                   milliseconds(session_->config().disconnect_timeout_us) + ")";
+        failure_ = who + " disconnected at frame " + std::to_string(e.frame) + " (" +
+                   disconnect_reason(e.reason) + ")";
         return false;
     }
   }
@@ -277,6 +297,21 @@ bool Netplay::peers_at_end() const {
     if (!stats || stats->remote_frame < args_.frames) return false;
   }
   return true;
+}
+
+std::string Netplay::checks_behind() const {
+  const std::uint32_t interval = session_->config().check_interval;
+  if (interval == 0) return "";
+  const std::uint64_t last = args_.frames / interval * interval;
+  std::string out;
+  for (const net::UdpPeer& p : plan_.peers) {
+    const auto stats = session_->peer_stats(p.id);
+    if (!stats || stats->disconnected || stats->checks_received_through >= last) continue;
+    if (!out.empty()) out += ", ";
+    out += who(p.id) + " (checks of frames " + std::to_string(stats->checks_received_through + 1) +
+           " .. " + std::to_string(last) + ")";
+  }
+  return out;
 }
 
 std::string Netplay::unconfirmed_players() const {
@@ -358,7 +393,15 @@ int Netplay::run() {
       continue;
     }
     if (!ended_at) ended_at = now;
-    if (confirmed_ >= args_.frames && peers_at_end()) match_complete_ = true;
+    if (!match_complete_ && confirmed_ >= args_.frames && peers_at_end()) {
+      if (checks_behind().empty()) {
+        match_complete_ = true;
+      } else if (now - *ended_at >= timeout_us) {  // every frame is here, some checks never came
+        unverified_.push_back("no hash check arrived from " + checks_behind());
+        std::fprintf(stderr, "detsim netplay: UNVERIFIED: %s\n", unverified_.back().c_str());
+        match_complete_ = true;
+      }
+    }
     if (match_complete_ && spectators_behind().empty()) {
       if (!settled_at) settled_at = now;
       if (now - *settled_at >= netplay_linger_us) break;
@@ -389,7 +432,7 @@ int Netplay::run() {
 
 int Netplay::report(double handshake_seconds, double match_seconds) {
   const net::SessionStats& st = session_->stats();
-  const int code = desyncs_.empty() ? exit_ok : exit_check_failed;
+  const int code = desyncs_.empty() && unverified_.empty() ? exit_ok : exit_check_failed;
   if (args_.json) {
     std::vector<std::string> peers;
     for (const net::UdpPeer& p : plan_.peers) {
@@ -445,6 +488,7 @@ int Netplay::report(double handshake_seconds, double match_seconds) {
         .num("stalled_advances", stalled_)
         .num("skipped_advances", skipped_)
         .num("desyncs", desyncs_.size())
+        .num("unverified", unverified_.size())
         .raw("desync_events", Json::array(desyncs))
         .raw("peers", Json::array(peers))
         .raw("spectators", Json::array(spectators));
@@ -473,6 +517,8 @@ void Netplay::print_text_report(double handshake_seconds, double match_seconds) 
               static_cast<unsigned long long>(st.rollbacks),
               static_cast<unsigned long long>(st.resimulated_frames));
   std::printf("desyncs      %zu\n", desyncs_.size());
+  for (const std::string& line : unverified_)
+    std::printf("UNVERIFIED   %s\n", line.c_str());
   for (const net::UdpPeer& p : plan_.peers) {
     const net::PeerStats s = session_->peer_stats(p.id).value_or(net::PeerStats{});
     std::printf(

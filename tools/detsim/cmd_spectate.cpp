@@ -91,7 +91,6 @@ Status Spectate::start() {
   config.input_size = net::ScenarioGame::input_size;
   // The players' own fingerprint: a spectator of another match (or length) is never served.
   config.fingerprint = session_fingerprint(*scenario_, plan_.mode, args_.frames);
-  config.random_seed = os_random_seed();
   config.host = host_.id;
   auto session = net::SpectatorSession::create(config, *game_, *transport_);
   if (!session) return session.status();

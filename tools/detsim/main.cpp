@@ -236,9 +236,10 @@ A player waits for its connected spectators to have every frame before it exits 
 --timeout; a spectator that lags is only warned about).
 
 Exit status: 0 the match completed; 1 a desync (the frame, both hashes and the player are
-printed; --desync-report writes this machine's side for bisection); 2 bad usage, a port in use, a
-handshake timeout or a peer that disconnected (the message on stderr names it). --json prints
-exactly one JSON object on stdout.)";
+printed; --desync-report writes this machine's side for bisection) or an unverified frame (a
+peer's hash check that never arrived: "UNVERIFIED" on stderr, "unverified" in --json); 2 bad
+usage, a port in use, a handshake timeout or a peer that disconnected (the message on stderr names
+it and why: silent, or no progress). --json prints exactly one JSON object on stdout.)";
 
 #if !DETSIM_WITH_UDP
 // Without UDP the command stays, takes any arguments and says why it cannot run, so that a script

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <optional>
-#include <random>
 
 namespace detsim::cli {
 
@@ -142,11 +141,6 @@ std::string milliseconds(std::uint64_t us) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1f ms", static_cast<double>(us) / 1000.0);
   return text;
-}
-
-std::uint64_t os_random_seed() {
-  std::random_device device;
-  return (std::uint64_t{device()} << 32) ^ device();
 }
 
 }  // namespace detsim::cli

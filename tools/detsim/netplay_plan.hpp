@@ -43,8 +43,6 @@ Expected<NetplayPlan> netplay_plan(const NetplayArgs& args);
 
 /// "12.3 ms"
 std::string milliseconds(std::uint64_t us);
-/// A fresh seed from the operating system (session nonces and challenges).
-std::uint64_t os_random_seed();
 
 /// Watches the match as a spectator of plan.peers[0] (`detsim netplay --spectate`); the exit code.
 int spectate(const NetplayArgs& args, const NetplayPlan& plan);

@@ -4,17 +4,18 @@
 // decode() is the gate every received byte passes through. It is pure (no session state) and
 // checks every field before the session sees it: magic, version, type, lengths, counts and the
 // trailing XXH3 checksum. A datagram that fails is dropped and counted by its DecodeError; nothing
-// in a session changes. The checksum catches corruption, not attackers: the session nonce and the
-// frame windows in the session are what keep stale and foreign datagrams out.
+// in a session changes. The checksum catches corruption, not attackers: the session ids (bound to
+// the handshake's challenges) and the frame windows in the session are what keep stale and foreign
+// datagrams out.
 //
 // Layout (all integers little-endian):
 //
-//     header   magic "DN" | version u8 | type u8 | sender nonce u32 | sequence u16     (10 bytes)
+//     header   magic "DN" | version u8 | type u8 | sender session u64 | sequence u16  (14 bytes)
 //     body     by type (below)
 //     trailer  low 32 bits of XXH3-64 over header and body                             (4 bytes)
 //
-//     hello        fingerprint u64 | players u8 | player u8 | input_size u8 | challenge u32
-//     hello_reply  challenge u32
+//     hello        fingerprint u64 | players u8 | player u8 | input_size u8 | challenge u64
+//     hello_reply  challenge u64 (the hello's, echoed; the header carries the replier's session)
 //     input        ack_frame v | check_ack z | current_frame z | advantage i8 | start_frame z |
 //                  count u8 | held_frame z | gone u8 | gone x (player u8, frame z) |
 //                  deltas: run-length coded bytes (below) | checks u8 | checks x (frame z, hash
@@ -45,10 +46,10 @@ namespace detsim::net::protocol {
 
 /// Changes whenever the layout above changes; peers of different versions drop each other's
 /// datagrams (counted as bad_version) and never synchronise.
-inline constexpr std::uint8_t version = 3;
+inline constexpr std::uint8_t version = 4;
 inline constexpr std::uint8_t magic0 = 'D';
 inline constexpr std::uint8_t magic1 = 'N';
-inline constexpr std::size_t header_size = 10;
+inline constexpr std::size_t header_size = 14;
 inline constexpr std::size_t trailer_size = 4;
 /// The largest input a player sends, in bytes.
 inline constexpr std::size_t max_input_size = 64;
@@ -65,7 +66,9 @@ enum class PacketType : std::uint8_t { hello = 1, hello_reply = 2, input = 3, pi
 
 struct Header {
   PacketType type = PacketType::hello;
-  std::uint32_t nonce = 0;     ///< the sender's session nonce (learned in the handshake)
+  /// The sender's session id: 64 random bits (a CSPRNG), learned only from a hello_reply that
+  /// echoes the receiver's challenge, and fixed from then on.
+  std::uint64_t session = 0;
   std::uint16_t sequence = 0;  ///< per destination, +1 per datagram (loss statistics)
 };
 
@@ -75,11 +78,11 @@ struct Hello {
   std::uint8_t players = 0;
   std::uint8_t player = 0;  ///< spectator_player for a spectator
   std::uint8_t input_size = 0;
-  std::uint32_t challenge = 0;
+  std::uint64_t challenge = 0;  ///< 64 random bits (a CSPRNG), sent only to the peer's address
 };
 
 struct HelloReply {
-  std::uint32_t challenge = 0;  ///< the challenge of the hello it answers
+  std::uint64_t challenge = 0;  ///< the challenge of the hello it answers
 };
 
 /// A confirmed-frame state hash, sent for desync detection until acknowledged.

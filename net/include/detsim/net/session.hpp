@@ -60,16 +60,20 @@ struct SessionConfig {
   /// What every peer must agree on to play together (the game's settings, version, scenario): a
   /// hello with another fingerprint is rejected. Use a hash of the replay fingerprint.
   std::uint64_t fingerprint = 0;
-  /// Seeds this session's nonce and handshake challenges. Give each session a fresh random value
-  /// (from the operating system) in a real game; a fixed value in tests.
-  std::uint64_t random_seed = 0;
   std::uint32_t frame_us = 16'667;  ///< the nominal frame duration (time sync): 1000 .. 1'000'000
   std::uint64_t hello_interval_us = 200'000;        ///< handshake resend interval
   std::uint64_t keepalive_us = 100'000;             ///< the longest silence towards a peer
   std::uint64_t ping_interval_us = 1'000'000;       ///< round-trip measurement
   std::uint64_t disconnect_warning_us = 500'000;    ///< silence before Event::interrupted
   std::uint64_t disconnect_timeout_us = 5'000'000;  ///< silence before Event::disconnected
-  std::vector<RemotePlayer> remotes;                ///< every other player, each exactly once
+  /// The longest a peer that keeps talking may hold the match back (docs/NET.md, "Progress"),
+  /// and the longest its hash check of a frame this machine confirmed may take to arrive
+  /// (Event::check_missing):
+  /// over a window of this length in which this machine's game wanted to advance but ran less
+  /// than a third of the time, the peers it waited on are disconnected ("no progress"). Must
+  /// exceed disconnect_timeout_us (a silent peer is the disconnect timeout's to handle).
+  std::uint64_t progress_timeout_us = 10'000'000;
+  std::vector<RemotePlayer> remotes;  ///< every other player, each exactly once
   /// Spectators this machine serves (at most 16; ids distinct from the remotes'): each receives
   /// every confirmed frame's inputs from here (SpectatorSession). Events about spectator k use
   /// player = players + k.
@@ -89,10 +93,15 @@ enum class EventType : std::uint8_t {
   running,         ///< every peer is synchronized: frames can advance
   interrupted,     ///< `player` has been silent for disconnect_warning_us
   resumed,         ///< `player` was heard from again after an interruption
-  disconnected,    ///< `player` was silent for disconnect_timeout_us: its inputs are zero from
-                   ///< `frame` on (InputStatus::disconnected)
+  disconnected,    ///< `player` is gone (`reason`: "silent", "no progress" or "reported gone"):
+                   ///< its inputs are zero from `frame` on (InputStatus::disconnected)
   desync,          ///< `player` hashed confirmed frame `frame` differently
   hello_rejected,  ///< a hello from `player`'s peer did not match this session (`reason`)
+  /// `player`'s hash check of confirmed frame `frame` did not arrive within progress_timeout_us
+  /// of this machine confirming it (or can no longer be compared): that frame, and every later
+  /// one, is unverified with that peer. Raised once per peer. A relay that strips checks, or a
+  /// peer that does not send them, ends here instead of passing unchecked.
+  check_missing,
 };
 
 struct Event {
@@ -101,7 +110,8 @@ struct Event {
   std::uint64_t frame = 0;
   std::uint64_t local_hash = 0;   ///< desync: this machine's hash of `frame`
   std::uint64_t remote_hash = 0;  ///< desync: the peer's
-  std::string_view reason;  ///< hello_rejected: what differed (a string literal: never dangles)
+  /// hello_rejected: what differed; disconnected: why (string literals: never dangle)
+  std::string_view reason;
 };
 
 /// A frame whose inputs are all final, in frame order, each once: what a replay records.
@@ -136,6 +146,8 @@ struct PeerStats {
   std::uint64_t remote_frame = 0;  ///< the peer's frame as last reported
   /// The peer holds every local input before this frame (spectators: every confirmed frame).
   std::uint64_t acknowledged_frame = 0;
+  /// Every hash check of the peer up to this frame has arrived (players only; 0: none yet).
+  std::uint64_t checks_received_through = 0;
   std::uint64_t packets_sent = 0;
   std::uint64_t packets_received = 0;
   std::uint64_t packets_lost = 0;  ///< gaps in the peer's sequence numbers
@@ -157,6 +169,15 @@ struct SessionStats {
   std::array<std::uint64_t, protocol::decode_error_count> dropped_malformed{};
   std::uint64_t dropped_wrong_session = 0;  ///< a nonce or peer this session does not know
   std::uint64_t dropped_out_of_window = 0;  ///< frames outside what the session can hold
+  /// Input datagrams dropped whole for a field no honest peer sends: a held frame beyond the
+  /// inputs it acknowledges, a current frame outside what its inputs and ours allow.
+  std::uint64_t dropped_implausible = 0;
+  /// Pongs that answer no ping this session has outstanding (replayed or forged).
+  std::uint64_t dropped_stale_pongs = 0;
+  /// Gone reports ignored: about this machine's own player, or about a player it still hears.
+  std::uint64_t ignored_gone_reports = 0;
+  /// Peers whose hash check of some confirmed frame never arrived (Event::check_missing).
+  std::uint64_t checks_missing = 0;
 };
 
 /// Predicts a remote player's input for a frame not received yet: writes the prediction to `out`

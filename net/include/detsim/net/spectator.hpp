@@ -24,7 +24,6 @@ struct SpectatorConfig {
   std::uint32_t players = 2;      ///< of the match: 1 .. 8
   std::uint32_t input_size = 4;   ///< of the match: 1 .. protocol::max_input_size
   std::uint64_t fingerprint = 0;  ///< the match's (SessionConfig::fingerprint)
-  std::uint64_t random_seed = 0;  ///< nonce and challenge; fresh per session in a real game
   PeerId host = 0;                ///< the player session that serves this spectator
   /// More frames than this waiting: advance() simulates up to catch_up_frames at once.
   std::uint32_t catch_up_threshold = 2;
