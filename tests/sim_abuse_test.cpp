@@ -110,6 +110,29 @@ TEST_P(LargeForce, MovesAFreeBodyForwardAndNoFasterThanTheLimit) {
 INSTANTIATE_TEST_SUITE_P(Newtons, LargeForce,
                          testing::Values(1000, 100000, 1000000, 100000000, 1000000000));
 
+// --- The speed limits hold at any limit the definition allows, down to one ulp ---------------
+
+// A velocity a few ulp long clamped to a limit of an ulp: the factor's ulp steps no longer move
+// the rounded result, and the clamp once took ~2^31 of them (the API fuzzer's timeout). It must
+// end, and end within the limit.
+TEST(SpeedLimit, HoldsAtALimitOfOneUlp) {
+  WorldDef def = no_gravity();
+  def.max_linear_speed = Fixed::from_raw(1);
+  def.max_angular_speed = Fixed::from_raw(1);
+  World w = make_world(def);
+  BodyDef d = box({}, 0.25_fx, 1_fx);
+  d.linear_velocity = {Fixed::from_raw(3), Fixed::from_raw(2), Fixed::from_raw(-2)};
+  d.angular_velocity = {Fixed::from_raw(2), Fixed::from_raw(-2), Fixed::from_raw(2)};
+  const BodyId id = add(w, d);
+  for (int f = 0; f < 3; ++f) {
+    ASSERT_TRUE(w.apply_force(id, {1_fx, 1_fx, 1_fx}).ok());
+    w.step();
+    const BodyState s = state(w, id);
+    EXPECT_FALSE(length_exceeds(s.linear_velocity, def.max_linear_speed)) << "frame " << f;
+    EXPECT_FALSE(length_exceeds(s.angular_velocity, def.max_angular_speed)) << "frame " << f;
+  }
+}
+
 // --- A bullet flagged CCD stops at the body it hits -----------------------------------------
 
 struct Bullet {

@@ -12,13 +12,32 @@ Vec3 halve(Vec3 v) {
 
 // The result's length never exceeds the limit: v * (limit / |v|) can round a few ulp above it, so
 // the factor steps down by one ulp until it does not (one or two steps; each shortens the result
-// by |v| ulp, more than the rounding it makes up for). Out of line: it is the rare path.
+// by |v| ulp, more than the rounding it makes up for). A v whose length would saturate (beyond
+// about 2^31, which a solve that saturated can leave) is first halved until it is within 2^30:
+// with |v| saturated the factor came out too large and the loop took ~10^5 steps (found by the
+// API fuzzer). Halving keeps the direction to an ulp, and the result is scaled to the limit
+// anyway. Out of line: it is the rare path.
 [[gnu::noinline]] Vec3 scale_to_limit(Vec3 v, Fixed limit) {
+  const Fixed within = Fixed::from_int(1 << 30);
+  while (length_exceeds(v, within))
+    v = {Fixed::from_raw(v.x.raw() >> 1), Fixed::from_raw(v.y.raw() >> 1),
+         Fixed::from_raw(v.z.raw() >> 1)};
   Fixed factor = limit / length(v);
   Vec3 r = v * factor;
+  int steps = 0;
   while (length_exceeds(r, limit)) {
-    factor -= Fixed::from_raw(1);
-    r = v * factor;
+    if (++steps <= 4) {
+      factor -= Fixed::from_raw(1);
+      r = v * factor;
+      continue;
+    }
+    // A v of a few ulp (a limit of a few ulp): an ulp of the factor no longer moves the rounded
+    // result (it took ~2^31 steps). Each component then goes one ulp towards zero per step,
+    // which ends within a few steps of the limit (or at zero, within any limit).
+    const auto toward_zero = [](Fixed c) {
+      return Fixed::from_raw(c.raw() > 0 ? c.raw() - 1 : c.raw() < 0 ? c.raw() + 1 : 0);
+    };
+    r = {toward_zero(r.x), toward_zero(r.y), toward_zero(r.z)};
   }
   return r;
 }
