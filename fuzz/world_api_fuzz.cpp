@@ -1,6 +1,8 @@
 // libFuzzer target for the World's API: the input is a hostile WorldDef and a sequence of calls
 // (create_body with any shape, size, mass, density, velocity and orientation, destroy_body,
-// set_type, set_transform, set_*_velocity, the forces and impulses, wake, step, save, restore).
+// set_type, set_transform, set_*_velocity, the forces and impulses, wake, step, save, restore,
+// create_joint with any type, bodies, anchor, axis, limits, motor, lengths, spring and break
+// thresholds, destroy_joint, set_joint_motor).
 //
 // Properties checked beyond the sanitizers' (no crash, no undefined behaviour, no leak):
 // - a refused call changes nothing: the world's saved bytes are those from before the call;
@@ -9,8 +11,8 @@
 // - a saved state restores exactly (the restored world saves the same bytes), and a world
 //   restored from it into a second World steps to the same bytes as the original (rule 5 of
 //   docs/DETERMINISM.md).
-// Work is bounded per input (at most 64 bodies, 16 steps, and a budget of solver passes) so that
-// one input runs in milliseconds even under the sanitizers.
+// Work is bounded per input (at most 64 bodies, 64 joints, 16 steps, and a budget of solver passes)
+// so that one input runs in milliseconds even under the sanitizers.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -21,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include <detsim/sim/joint.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace {
@@ -37,10 +40,12 @@ using detsim::World;
 using detsim::WorldDef;
 
 constexpr std::size_t kMaxBodies = 64;
+constexpr std::size_t kMaxJoints = 64;
 constexpr int kMaxSteps = 16;
 constexpr int kMaxCalls = 256;
-// Sub-steps x iterations x (bodies + 1), summed over the steps: what the steps of one input may
-// cost in total.
+constexpr int kOps = 20;  // the calls' opcodes, op % kOps
+// Sub-steps x iterations x (bodies + joints + 1), summed over the steps: what the steps of one
+// input may cost in total.
 constexpr std::uint64_t kStepBudget = 40000;
 
 /// A finding: says which property broke, then aborts (libFuzzer saves the input).
@@ -228,6 +233,59 @@ BodyId body_id(Input& in, const World& world) {
   return BodyId{pick % 0x80U};
 }
 
+detsim::JointDef joint_def(Input& in, const World& world) {
+  detsim::JointDef def;
+  def.type = static_cast<detsim::JointType>(in.byte() % 7);  // 6 names no type
+  def.body_a = body_id(in, world);
+  def.body_b = body_id(in, world);
+  const std::uint8_t fields = in.byte();
+  // Mostly the anchor at one body's centre or between the two, sometimes anywhere.
+  const auto centre = [&](BodyId id) {
+    auto b = world.body(id);
+    return b ? b.value().position : Vec3{};
+  };
+  def.anchor = (fields & 1U) != 0 ? in.vec3()
+                                  : (centre(def.body_a) + centre(def.body_b)) / Fixed::from_int(2);
+  if ((fields & 2U) != 0) {
+    const Vec3 axis = in.vec3();
+    def.axis = (fields & 4U) != 0 ? axis : detsim::normalize_or(axis, Vec3::unit_y());
+  }
+  if ((fields & 8U) != 0) {
+    def.limit_enabled = (in.byte() & 1U) != 0;
+    def.limit_lower = in.fixed();
+    def.limit_upper = in.fixed();
+    def.swing_limit = in.fixed();
+  }
+  if ((fields & 16U) != 0) {
+    def.motor_enabled = (in.byte() & 1U) != 0;
+    def.motor_speed = in.fixed();
+    def.motor_max_force = in.fixed();
+  }
+  if ((fields & 32U) != 0) {
+    def.min_length = in.fixed();
+    def.max_length = in.fixed();
+    def.spring_frequency = in.fixed();
+    def.spring_damping_ratio = in.fixed();
+  }
+  if ((fields & 64U) != 0) {
+    def.break_force = in.fixed();
+    def.break_torque = in.fixed();
+  }
+  if ((fields & 128U) != 0) {
+    def.collide_connected = (in.byte() & 1U) != 0;
+    def.user_data = in.u64();
+  }
+  return def;
+}
+
+/// An existing joint most of the time (by index), else any ID (usually unknown).
+detsim::JointId joint_id(Input& in, const World& world) {
+  const std::uint8_t pick = in.byte();
+  const std::vector<detsim::JointId> ids = world.joint_ids();
+  if ((pick & 0x80U) == 0 && !ids.empty()) return ids[pick % ids.size()];
+  return detsim::JointId{pick % 0x80U};
+}
+
 /// With DETSIM_FUZZ_TRACE set, each call's opcode, result and the bodies after it go to stderr:
 /// a finding's input read as the calls it makes.
 void trace(int op, const detsim::Status& status, const World& world) {
@@ -296,7 +354,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::vector<std::uint8_t> before = world.save();
     detsim::Status status = detsim::Status::success();
     const std::uint8_t op = in.byte();
-    switch (op % 17) {
+    switch (op % kOps) {
       case 0: {
         const BodyDef body = body_def(in);
         if (world.body_count() >= kMaxBodies) break;
@@ -365,22 +423,38 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       case 13:
       case 14: {
-        const std::uint64_t cost = step_cost * (world.body_count() + 1);
+        const std::uint64_t cost = step_cost * (world.body_count() + world.joint_ids().size() + 1);
         if (steps >= kMaxSteps || spent + cost > kStepBudget) break;
         ++steps;
         spent += cost;
-        if (op % 17 == 14) {
+        if (op % kOps == 14) {
           check_restore_steps_alike(world);
         } else {
           world.step();
         }
         check_valid(world, true);
-        trace(op % 17, status, world);
+        trace(op % kOps, status, world);
         continue;  // a step changes the world: nothing to compare with `before`
       }
       case 15:
         slots[in.byte() % 2] = before;
         break;
+      case 17: {
+        const detsim::JointDef joint = joint_def(in, world);
+        if (world.joint_ids().size() >= kMaxJoints) break;
+        auto id = world.create_joint(joint);
+        if (!id) status = id.status();
+        break;
+      }
+      case 18:
+        status = world.destroy_joint(joint_id(in, world));
+        break;
+      case 19: {
+        const detsim::JointId id = joint_id(in, world);
+        const Fixed speed = in.fixed();
+        status = world.set_joint_motor(id, speed, in.fixed());
+        break;
+      }
       default: {
         const std::vector<std::uint8_t>& slot = slots[in.byte() % 2];
         if (slot.empty()) break;
@@ -390,7 +464,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         continue;
       }
     }
-    trace(op % 17, status, world);
+    trace(op % kOps, status, world);
     if (!status.ok()) {
       if (world.save() != before) fail("a refused call changed the world");
     } else {
