@@ -1,12 +1,14 @@
 // Writes the packet fuzzer's seed corpus: one valid datagram of every packet type, and input
-// datagrams of every input size the fuzzer decodes with, each twice (a leading 0 byte: read as is;
-// a leading 1: checksum recomputed; see net_packet_fuzz.cpp).
+// datagrams of every input size the fuzzer decodes with, each four times (net_packet_fuzz.cpp
+// has the modes): a leading 0 byte, the plain datagram read as is; 1, its checksum recomputed;
+// 2, the packet sealed with the fuzzer's key; 3, its type byte and plaintext body, to be sealed.
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include <detsim/net/protection.hpp>
 #include <detsim/net/protocol.hpp>
 
 namespace protocol = detsim::net::protocol;
@@ -30,6 +32,38 @@ std::vector<std::uint8_t> sample_deltas(std::size_t size, std::size_t count) {
   std::vector<std::uint8_t> deltas;
   protocol::delta_encode(std::vector<std::uint8_t>(size, 0), inputs, deltas);
   return deltas;
+}
+
+// net_packet_fuzz.cpp's key and sessions.
+constexpr std::uint64_t sender_session = 0x5E'4D'E7ULL;
+constexpr std::uint64_t receiver_session = 0x7EC'E1E7ULL;
+detsim::net::MatchKey match_key() {
+  detsim::net::MatchKey key{};
+  for (std::size_t i = 0; i < key.size(); ++i)
+    key[i] = static_cast<std::uint8_t>(i * 7 + 1);
+  return key;
+}
+
+/// `p` sealed as a session with the fuzzer's key sends it (sequence 7); empty without libsodium.
+std::vector<std::uint8_t> sealed(protocol::Packet p, std::size_t input_size) {
+  namespace protection = detsim::net::protection;
+  std::vector<std::uint8_t> out;
+  const bool handshake = p.header.type == protocol::PacketType::hello ||
+                         p.header.type == protocol::PacketType::hello_reply;
+  p.header.session = sender_session;
+  if (!protocol::encode_sealed_plaintext(p, 7, input_size, out)) return {};
+  const protection::Key key =
+      handshake ? protection::handshake_key(match_key(), sender_session)
+                : protection::data_key(match_key(), sender_session, receiver_session);
+  if (!protection::seal(key, 7, protocol::sealed_header_size(p.header.type), out)) return {};
+  return out;
+}
+
+void write(const std::string& path, char mode, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.put(mode);
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
 }
 
 }  // namespace
@@ -91,12 +125,17 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "make_packet_seeds: %s does not encode\n", s.name.c_str());
       return 1;
     }
-    for (const char mode : {'\0', '\1'}) {
-      std::ofstream out(dir + "/" + s.name + (mode == 0 ? ".raw" : ".resealed"), std::ios::binary);
-      out.put(mode);
-      out.write(reinterpret_cast<const char*>(bytes.data()),
-                static_cast<std::streamsize>(bytes.size()));
-    }
+    write(dir + "/" + s.name + ".raw", '\0', bytes);
+    write(dir + "/" + s.name + ".resealed", '\1', bytes);
+    const std::vector<std::uint8_t> sealed_bytes = sealed(s.packet, s.input_size);
+    if (sealed_bytes.empty()) continue;  // no libsodium: the plain seeds only
+    write(dir + "/" + s.name + ".sealed", '\2', sealed_bytes);
+    // The type byte and the plain framing's body (between its header and its checksum).
+    std::vector<std::uint8_t> body(
+        bytes.begin() + static_cast<std::ptrdiff_t>(protocol::header_size - 1),
+        bytes.end() - static_cast<std::ptrdiff_t>(protocol::trailer_size));
+    body[0] = bytes[3];
+    write(dir + "/" + s.name + ".body", '\3', body);
   }
   return 0;
 }

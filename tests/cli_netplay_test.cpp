@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <string>
@@ -18,6 +19,7 @@
 
 #include <gtest/gtest.h>
 
+#include <detsim/net/protection.hpp>
 #include <detsim/net/protocol.hpp>
 #include <detsim/net/udp.hpp>
 
@@ -348,6 +350,47 @@ TEST(CliNetplay, AnInjectedPeerDesyncsAndBisectNamesTheFrameBodyAndField) {
   EXPECT_EQ(fields, 1U) << r.out;
 }
 
+/// A match key for --key: 64 hex digits.
+constexpr const char* test_key = "8f2c0d41b6e97a3355c1e0f4a9d27b6803e5c19a7f4d2b60e1a8c3f5970b2d4e";
+
+TEST(CliNetplay, WithAKeyThePeersPlaySealedAndAnotherKeyIsRefusedByName) {
+  // The same key given two ways (--key, --key-file): the match completes with equal hashes and
+  // says it was protected. Another key: neither side connects, both name the key as the reason.
+  if (!net::protection::available()) GTEST_SKIP() << "built without libsodium: no --key";
+  TempFile key_file("netplay.key");
+  {
+    std::ofstream out(key_file.path());
+    out << test_key << "\n";
+  }
+  const std::vector<std::string> common = {"--frames", "600", "--fps", "1000", "--json"};
+  std::vector<std::string> a = {"--bot", "11", "--key", test_key};
+  std::vector<std::string> b = {"--bot", "12", "--key-file", key_file.path()};
+  a.insert(a.end(), common.begin(), common.end());
+  b.insert(b.end(), common.begin(), common.end());
+  const Pair pair = run_pair(a, b, std::chrono::seconds(60));
+  ASSERT_FALSE(pair.timed_out) << pair.a->err() << pair.b->err();
+  for (const Process* p : {pair.a.get(), pair.b.get()}) {
+    EXPECT_EQ(p->exit_code(), 0) << p->out() << p->err();
+    EXPECT_EQ(json_value(p->out(), "protected"), "true") << p->out();
+    EXPECT_EQ(json_value(p->out(), "dropped_unauthenticated"), "0") << p->out();
+  }
+  EXPECT_EQ(json_value(pair.a->out(), "final_hash"), json_value(pair.b->out(), "final_hash"));
+
+  std::string other = test_key;
+  other[0] = '0';
+  const Pair refused = run_pair({"--timeout", "1", "--key", test_key},
+                                {"--timeout", "1", "--key", other}, std::chrono::seconds(60));
+  ASSERT_FALSE(refused.timed_out);
+  for (const Process* p : {refused.a.get(), refused.b.get()}) {
+    EXPECT_EQ(p->exit_code(), 2) << p->err();
+    EXPECT_TRUE(has(p->err(), "handshake timed out waiting for player")) << p->err();
+    EXPECT_TRUE(has(p->err(),
+                    "its packets fail authentication: every peer and spectator needs "
+                    "the same --key"))
+        << p->err();
+  }
+}
+
 TEST(CliNetplay, ASpectatorReachesThePlayersHashAndRecordsTheSameReplay) {
   TempFile replay_a("netplay_a.dsr");
   TempFile replay_b("netplay_b.dsr");
@@ -364,8 +407,12 @@ TEST(CliNetplay, ASpectatorReachesThePlayersHashAndRecordsTheSameReplay) {
         {"netplay", "--me", "1", "--bind", b, "--peer", "0=" + a, "--bot", "12", "--record",
          replay_b.path(), "--desync-report", report_b.path()},
         {"netplay", "--spectate", "--bind", s, "--peer", "0=" + a, "--record", replay_s.path()}};
-    for (std::vector<std::string>& one : args)
+    // Sealed, as a real match: the spectator's datagrams too (a build without libsodium has
+    // no keys).
+    for (std::vector<std::string>& one : args) {
       one.insert(one.end(), {"--frames", "2000", "--fps", "1000", "--json"});
+      if (net::protection::available()) one.insert(one.end(), {"--key", test_key});
+    }
     return args;
   };
   const Group group = run_group(commands, std::chrono::seconds(120));
@@ -529,6 +576,16 @@ TEST(CliNetplay, BadUsageExitsWithTwoAndNamesTheProblem) {
        "--spectator \"127.0.0.1:7002\" is given twice"},
       {"netplay" + bind + " --peer 1=127.0.0.1:7001" + seventeen_spectators,
        "at most 16 --spectator addresses, got 17"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --key 0123",
+       "--key: a match key is 64 hex digits (32 bytes), got 4 characters"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --key " + std::string(63, 'a') + "g",
+       "character 64 is not one"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --key " + std::string(64, '0'),
+       "--key: all zero is not a key"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --key-file /nonexistent/key",
+       "--key-file /nonexistent/key: cannot be read"},
+      {"netplay" + bind + " --peer 1=127.0.0.1:7001 --key-file k --key " + std::string(64, '1'),
+       "excludes"},
   };
   for (const Case& c : cases) {
     const test::CliResult r = detsim_cli(c.args);
@@ -544,9 +601,12 @@ TEST(CliNetplay, HelpDescribesEveryOption) {
   const test::CliResult help = detsim_cli("netplay --help");
   EXPECT_EQ(help.exit_code, 0);
   for (const char* option :
-       {"--players", "--me", "--bind", "--peer", "--seed", "--mode", "--input-delay", "--frames",
-        "--bot", "--fps", "--timeout", "--record", "--json", "--spectator", "--spectate",
-        "--desync-report", "detsim netplay --spectate", "Exit status: 0"}) {
+       {"--players",     "--me",        "--bind",        "--peer",
+        "--seed",        "--mode",      "--input-delay", "--frames",
+        "--bot",         "--fps",       "--timeout",     "--record",
+        "--json",        "--spectator", "--spectate",    "--desync-report",
+        "--key",         "--key-file",  "NOT protected", "detsim netplay --spectate",
+        "Exit status: 0"}) {
     EXPECT_TRUE(has(help.out, option)) << option;
   }
 }

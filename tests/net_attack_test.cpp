@@ -125,6 +125,7 @@ TEST(NetAttack, ASpoofedHelloCannotTakeASeat) {
   // player 1's session only from the reply to its own challenge, so it plays the whole match
   // with the genuine peer: the honest hashes, every forged datagram dropped.
   MatchOptions o;
+  o.match_key.reset();  // the plain framing: what a peer with the key could send sealed
   o.frames = 900;
   o.link = net::internet_link();
   o.wrap = [](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
@@ -144,6 +145,7 @@ TEST(NetAttack, AHelloFloodCannotStopTheMatchFromStarting) {
   // peer's address) and changes nothing, so the genuine hellos' answers still get through.
   std::vector<std::uint64_t> running_at(2, 0);
   MatchOptions o;
+  o.match_key.reset();  // the plain framing: what a peer with the key could send sealed
   o.frames = 600;
   o.link.latency_us = 30'000;
   o.wrap = [](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
@@ -168,6 +170,7 @@ TEST(NetAttack, AGoneReportAboutTheReceiverOrAPlayerItStillHearsIsIgnored) {
   // Peer 2 tells everyone, in every input datagram, that players 0 and 1 are gone from frame 5,
   // and that it is gone itself. Without corroboration one such packet ends the match for all.
   MatchOptions o;
+  o.match_key.reset();  // the plain framing: what a peer with the key could send sealed
   o.players = 3;
   o.frames = 900;
   o.link = net::internet_link();
@@ -194,6 +197,7 @@ TEST(NetAttack, ImplausibleFramesAreDroppedWholeAndTheMatchEndsHonest) {
   // Every third input datagram of peer 1 claims a held frame beyond what it acknowledges, or a
   // current frame far ahead of (or far behind) the inputs it carries.
   MatchOptions o;
+  o.match_key.reset();  // the plain framing: what a peer with the key could send sealed
   o.frames = 1200;
   o.link = net::internet_link();
   o.wrap = tamper(1, [](net::PeerId, Packet& p, std::uint64_t n) {
@@ -228,6 +232,7 @@ TEST(NetAttack, ALyingFrameAdvantageCannotSlowTheMatch) {
   // asks peer 0 to wait ~63 frames. Peer 0 trusts it only as far as its own measurement agrees.
   std::uint32_t most_wait = 0;
   MatchOptions o;
+  o.match_key.reset();  // the plain framing: what a peer with the key could send sealed
   o.frames = 1200;
   o.link.latency_us = 30'000;
   o.wrap = tamper(1, [](net::PeerId, Packet& p, std::uint64_t) {
@@ -276,6 +281,7 @@ TEST(NetAttack, ReplayedPongsAndOldDatagramsChangeNoTimeSync) {
   std::uint64_t remote_frame_went_back = 0;
   std::uint64_t last_remote_frame = 0;
   MatchOptions o;
+  o.match_key.reset();  // the plain framing: what a peer with the key could send sealed
   o.frames = 1200;
   o.link.latency_us = 30'000;
   o.wrap = [](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
@@ -307,6 +313,7 @@ TEST(NetAttack, ARelayThatRewritesInputsAndStripsChecksIsCaughtNotASilentSplit) 
   // guard both ended "fine" with different final hashes. Now each raises check_missing for the
   // other, about the first check (frame 30), once the deadline passes.
   MatchOptions o;
+  o.match_key.reset();  // the plain framing: what a peer with the key could send sealed
   o.frames = 1200;
   o.link.latency_us = 20'000;
   o.wrap = [](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
@@ -335,6 +342,7 @@ TEST(NetAttack, ChecksStrippedOneWayAreMissingOnTheSideThatLacksThem) {
   // Only peer 1's checks are removed: peer 0 cannot verify anything and says so; peer 1 compares
   // peer 0's checks as usual and raises nothing.
   MatchOptions o;
+  o.match_key.reset();  // the plain framing: what a peer with the key could send sealed
   o.frames = 1200;
   o.link = net::internet_link();
   o.wrap = tamper(1, [](net::PeerId, Packet& p, std::uint64_t) {
@@ -369,6 +377,7 @@ TEST(NetAttack, AHeldFrameOfZeroCannotStallTheMatch) {
   // player 1 within two windows, naming why, and peer 0 plays on.
   auto watch = std::make_shared<DisconnectWatch>();
   MatchOptions o;
+  o.match_key.reset();  // the plain framing: what a peer with the key could send sealed
   o.frames = 2400;
   o.max_ticks = 6000;
   o.link.latency_us = 20'000;

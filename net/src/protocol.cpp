@@ -184,15 +184,10 @@ std::string_view to_string(DecodeError error) noexcept {
   return "unknown";
 }
 
-bool encode(const Packet& packet, std::size_t input_size, std::vector<std::uint8_t>& out) {
-  out.clear();
-  if (input_size == 0 || input_size > max_unit_size || !body_ok(packet, input_size)) return false;
-  out.push_back(magic0);
-  out.push_back(magic1);
-  out.push_back(version);
-  out.push_back(static_cast<std::uint8_t>(packet.header.type));
-  put(out, packet.header.session, 8);
-  put(out, packet.header.sequence, 2);
+namespace {
+
+// The body of `packet` (its header.type's fields), appended to `out`.
+void put_body(const Packet& packet, std::vector<std::uint8_t>& out) {
   switch (packet.header.type) {
     case PacketType::hello:
       put(out, packet.hello.fingerprint, 8);
@@ -230,37 +225,21 @@ bool encode(const Packet& packet, std::size_t input_size, std::vector<std::uint8
     case PacketType::pong:
       put(out, packet.ping.time_us, 8);
       break;
-    default:
-      out.clear();
-      return false;
   }
-  if (out.size() + trailer_size > max_datagram) {
-    out.clear();
-    return false;
-  }
-  put(out, checksum(out), 4);
-  return true;
 }
 
-DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, Packet& out) {
-  if (bytes.size() > max_datagram) return DecodeError::too_long;
-  if (bytes.size() < header_size + trailer_size) return DecodeError::too_short;
-  if (bytes[0] != magic0 || bytes[1] != magic1) return DecodeError::bad_magic;
-  if (bytes[2] != version) return DecodeError::bad_version;
-  if (bytes[3] < static_cast<std::uint8_t>(PacketType::hello) ||
-      bytes[3] > static_cast<std::uint8_t>(PacketType::pong))
-    return DecodeError::bad_type;
-  const std::span<const std::uint8_t> signed_part = bytes.first(bytes.size() - trailer_size);
-  Reader trailer(bytes.last(trailer_size));
-  if (trailer.u32() != checksum(signed_part)) return DecodeError::bad_checksum;
-  if (input_size == 0 || input_size > max_unit_size) return DecodeError::bad_field;
+bool known_type(std::uint8_t type) noexcept {
+  return type >= static_cast<std::uint8_t>(PacketType::hello) &&
+         type <= static_cast<std::uint8_t>(PacketType::pong);
+}
 
-  Reader in(signed_part);
-  in.get(4);  // magic, version, type: checked above
-  out.header.type = static_cast<PacketType>(bytes[3]);
-  out.header.session = in.u64();
-  out.header.sequence = in.u16();
-  switch (out.header.type) {
+bool handshake(PacketType type) noexcept {
+  return type == PacketType::hello || type == PacketType::hello_reply;
+}
+
+// The body's fields, from a reader positioned at its start; the reader must end exactly there.
+DecodeError get_body(Reader& in, PacketType type, std::size_t input_size, Packet& out) {
+  switch (type) {
     case PacketType::hello:
       out.hello.fingerprint = in.u64();
       out.hello.players = in.u8();
@@ -316,6 +295,96 @@ DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, 
   }
   if (!in.ok() || !in.at_end()) return DecodeError::bad_length;
   return DecodeError::none;
+}
+
+}  // namespace
+
+bool encode(const Packet& packet, std::size_t input_size, std::vector<std::uint8_t>& out) {
+  out.clear();
+  if (input_size == 0 || input_size > max_unit_size || !body_ok(packet, input_size) ||
+      !known_type(static_cast<std::uint8_t>(packet.header.type)))
+    return false;
+  out.push_back(magic0);
+  out.push_back(magic1);
+  out.push_back(version);
+  out.push_back(static_cast<std::uint8_t>(packet.header.type));
+  put(out, packet.header.session, 8);
+  put(out, packet.header.sequence, 2);
+  put_body(packet, out);
+  if (out.size() + trailer_size > max_datagram) {
+    out.clear();
+    return false;
+  }
+  put(out, checksum(out), 4);
+  return true;
+}
+
+DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, Packet& out) {
+  if (bytes.size() > max_datagram) return DecodeError::too_long;
+  if (bytes.size() < header_size + trailer_size) return DecodeError::too_short;
+  if (bytes[0] != magic0 || bytes[1] != magic1) return DecodeError::bad_magic;
+  if (bytes[2] != version) return DecodeError::bad_version;
+  if (!known_type(bytes[3])) return DecodeError::bad_type;
+  const std::span<const std::uint8_t> signed_part = bytes.first(bytes.size() - trailer_size);
+  Reader trailer(bytes.last(trailer_size));
+  if (trailer.u32() != checksum(signed_part)) return DecodeError::bad_checksum;
+  if (input_size == 0 || input_size > max_unit_size) return DecodeError::bad_field;
+
+  Reader in(signed_part);
+  in.get(4);  // magic, version, type: checked above
+  out.header.type = static_cast<PacketType>(bytes[3]);
+  out.header.session = in.u64();
+  out.header.sequence = in.u16();
+  return get_body(in, out.header.type, input_size, out);
+}
+
+std::size_t sealed_header_size(PacketType type) noexcept {
+  return handshake(type) ? sealed_handshake_header_size : sealed_data_header_size;
+}
+
+bool encode_sealed_plaintext(const Packet& packet, std::uint32_t sequence, std::size_t input_size,
+                             std::vector<std::uint8_t>& out) {
+  out.clear();
+  if (input_size == 0 || input_size > max_unit_size || !body_ok(packet, input_size) ||
+      !known_type(static_cast<std::uint8_t>(packet.header.type)))
+    return false;
+  out.push_back(magic0);
+  out.push_back(sealed_magic1);
+  out.push_back(version);
+  out.push_back(static_cast<std::uint8_t>(packet.header.type));
+  put(out, sequence, 4);
+  if (handshake(packet.header.type)) put(out, packet.header.session, 8);
+  put_body(packet, out);
+  if (out.size() + sealed_tag_size > max_datagram) {
+    out.clear();
+    return false;
+  }
+  return true;
+}
+
+DecodeError decode_sealed_header(std::span<const std::uint8_t> bytes, SealedHeader& out) {
+  if (bytes.size() > max_datagram) return DecodeError::too_long;
+  if (bytes.size() < sealed_data_header_size + sealed_tag_size) return DecodeError::too_short;
+  if (bytes[0] != magic0 || bytes[1] != sealed_magic1) return DecodeError::bad_magic;
+  if (bytes[2] != version) return DecodeError::bad_version;
+  if (!known_type(bytes[3])) return DecodeError::bad_type;
+  out.type = static_cast<PacketType>(bytes[3]);
+  out.size = sealed_header_size(out.type);
+  if (bytes.size() < out.size + sealed_tag_size) return DecodeError::too_short;
+  Reader in(bytes.first(out.size));
+  in.get(4);
+  out.sequence = in.u32();
+  out.session = handshake(out.type) ? in.u64() : 0;
+  return DecodeError::none;
+}
+
+DecodeError decode_body(PacketType type, std::span<const std::uint8_t> body, std::size_t input_size,
+                        Packet& out) {
+  if (!known_type(static_cast<std::uint8_t>(type))) return DecodeError::bad_type;
+  if (input_size == 0 || input_size > max_unit_size) return DecodeError::bad_field;
+  out.header.type = type;
+  Reader in(body);
+  return get_body(in, type, input_size, out);
 }
 
 void delta_encode(std::span<const std::uint8_t> reference, std::span<const std::uint8_t> inputs,

@@ -74,6 +74,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
       transport(&t),
       max_prediction(c.mode == SessionMode::lockstep ? 0 : c.max_prediction),
       session_id(detail::secure_random_u64()) {
+  if (c.match_key) protection.emplace(*c.match_key, session_id);
   for (std::uint32_t p = 0; p < c.players; ++p)
     queues.emplace_back(c.input_size, detail::input_capacity);
   disconnect_frame.assign(c.players, never);
@@ -393,6 +394,8 @@ void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame,
 
 Expected<Session> Session::create(const SessionConfig& config, Game& game, Transport& transport) {
   if (Status s = validate(config); !s) return s;
+  if (Status s = detail::check_match_key(config.match_key, "session config: match_key"); !s)
+    return s;
   if (Status s = detail::secure_random_ready(); !s) return s;
   return Session(std::make_unique<Impl>(config, game, transport));
 }

@@ -10,6 +10,7 @@
 
 #include <detsim/net/session.hpp>
 
+#include "channel.hpp"
 #include "input_queue.hpp"
 
 namespace detsim::net::detail {
@@ -55,6 +56,7 @@ struct Peer {
   std::uint64_t last_hello_us = 0;
   bool hello_sent = false;
   bool hello_rejected = false;  ///< reported once
+  Channel channel;              ///< packet protection (a match key only)
   // What the peer holds: every player's input before reported_held (from its latest packet), and
   // the frame from which it takes each player as gone (never: connected; only ever lowered).
   std::uint64_t reported_held = 0;
@@ -147,6 +149,10 @@ struct Session::Impl {
 
   // session_wire.cpp: the network.
   void receive_all();
+  /// Opens a sealed datagram from `peer` into `packet` (match key only); false when dropped.
+  bool open(detail::Peer& peer, std::span<const std::uint8_t> bytes);
+  /// Raises hello_rejected for `peer` once, with `reason`.
+  void reject(detail::Peer& peer, std::string_view reason);
   void handle(detail::Peer& peer, const protocol::Packet& packet);
   /// Answers a hello that matches this session with a reply echoing its challenge. Changes no
   /// handshake state: a hello, forged or not, can neither set nor reset the peer's session id.
@@ -171,6 +177,7 @@ struct Session::Impl {
   Transport* transport;
   std::uint32_t max_prediction = 0;  ///< 0 in lockstep
   std::uint64_t session_id = 0;      ///< this session's id: 64 random bits from a CSPRNG
+  std::optional<detail::Protection> protection;  ///< with a match key
   std::uint64_t now_us = 0;
   bool running = false;
 
@@ -216,6 +223,7 @@ struct Session::Impl {
   std::vector<std::uint8_t> outbuf;
   std::vector<std::uint8_t> scratch_deltas;
   std::vector<std::uint8_t> scratch_inputs;
+  std::vector<std::uint8_t> scratch_body;
   protocol::Packet packet;
 };
 

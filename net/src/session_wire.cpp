@@ -47,15 +47,65 @@ void Session::Impl::receive_all() {
       ++stats.dropped_wrong_session;
       continue;
     }
-    const protocol::DecodeError error = protocol::decode(d.bytes, config.input_size, packet);
-    if (error != protocol::DecodeError::none) {
-      ++stats.dropped_malformed[static_cast<std::size_t>(error)];
-      continue;
+    if (protection) {
+      if (!open(*peer, d.bytes)) continue;
+    } else {
+      const protocol::DecodeError error = protocol::decode(d.bytes, config.input_size, packet);
+      if (error != protocol::DecodeError::none) {
+        if (detail::looks_sealed(d.bytes) && detail::looks_like_handshake(d.bytes) &&
+            !peer->synchronized)
+          reject(*peer, "sealed");  // the peer has a match key, this session none
+        ++stats.dropped_malformed[static_cast<std::size_t>(error)];
+        continue;
+      }
     }
     peer->stats.bytes_received += d.bytes.size();
     handle(*peer, packet);
   }
   inbox.clear();
+}
+
+bool Session::Impl::open(detail::Peer& peer, std::span<const std::uint8_t> bytes) {
+  // Header, replay window, tag (channel.hpp): a datagram that fails any of them changes nothing
+  // but a counter. Before the handshake completes, a hello that fails authentication is the
+  // usual sign of a peer with another key, so it is reported (once).
+  protocol::DecodeError error = protocol::DecodeError::none;
+  switch (protection->open(peer.channel, bytes, packet.header, error, scratch_body)) {
+    case detail::Opened::ok:
+      break;
+    case detail::Opened::malformed:
+      if (error == protocol::DecodeError::bad_magic && !detail::looks_sealed(bytes)) {
+        ++stats.dropped_unauthenticated;  // the plain framing: no protection at all
+        if (!peer.synchronized && detail::looks_like_handshake(bytes)) reject(peer, "not sealed");
+      } else {
+        ++stats.dropped_malformed[static_cast<std::size_t>(error)];
+      }
+      return false;
+    case detail::Opened::no_key:
+      ++stats.dropped_wrong_session;
+      return false;
+    case detail::Opened::replayed:
+      ++stats.dropped_replayed;
+      return false;
+    case detail::Opened::unauthenticated:
+      ++stats.dropped_unauthenticated;
+      if (!peer.synchronized && detail::looks_like_handshake(bytes))
+        reject(peer, "not authenticated");
+      return false;
+  }
+  // A peer that holds the key may still send any body: it is decoded as strictly as ever.
+  error = protocol::decode_body(packet.header.type, scratch_body, config.input_size, packet);
+  if (error != protocol::DecodeError::none) {
+    ++stats.dropped_malformed[static_cast<std::size_t>(error)];
+    return false;
+  }
+  return true;
+}
+
+void Session::Impl::reject(detail::Peer& peer, std::string_view reason) {
+  if (peer.hello_rejected) return;
+  peer.hello_rejected = true;
+  raise(Event{EventType::hello_rejected, peer.player, current, 0, 0, reason});
 }
 
 void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
@@ -76,6 +126,7 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
     if (peer.answered) return;  // a duplicate: nothing new
     peer.answered = true;
     peer.remote_session = p.header.session;
+    if (protection) protection->bind(peer.channel, peer.remote_session);
   } else {
     if (!peer.synchronized || p.header.session != peer.remote_session) {
       ++stats.dropped_wrong_session;
@@ -154,10 +205,7 @@ void Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) 
     reason = peer.spectator ? "not a spectator" : "player index";
   if (!reason.empty()) {
     ++stats.dropped_wrong_session;
-    if (!peer.hello_rejected) {
-      peer.hello_rejected = true;
-      raise(Event{EventType::hello_rejected, peer.player, current, 0, 0, reason});
-    }
+    reject(peer, reason);
     return;
   }
   if (peer.knows_us) {  // the genuine peer has our id already: this one is stale or forged
@@ -275,7 +323,9 @@ void Session::Impl::send(detail::Peer& peer, protocol::Packet& p) {
   const std::size_t unit = peer.spectator && p.header.type == protocol::PacketType::input
                                ? unit_size
                                : config.input_size;
-  if (!protocol::encode(p, unit, outbuf)) return;
+  const bool encoded = protection ? protection->seal(peer.channel, p, unit, outbuf)
+                                  : protocol::encode(p, unit, outbuf);
+  if (!encoded) return;
   transport->send(peer.id, outbuf);
   ++peer.stats.packets_sent;
   peer.stats.bytes_sent += outbuf.size();

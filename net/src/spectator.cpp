@@ -8,6 +8,7 @@
 
 #include <detsim/net/protocol.hpp>
 
+#include "channel.hpp"
 #include "secure_random.hpp"
 
 namespace detsim::net {
@@ -33,6 +34,9 @@ struct SpectatorSession::Impl {
   bool hello_sent = false;
   bool needs_ack = false;
   std::uint16_t sequence = 0;
+  std::optional<detail::Protection> protection;  ///< with a match key
+  detail::Channel channel;                       ///< to the host
+  std::vector<std::uint8_t> body;
 
   std::uint64_t current = 0;             ///< next frame to simulate
   std::deque<std::uint8_t> received;     ///< frames current .. current + buffered - 1
@@ -54,7 +58,9 @@ struct SpectatorSession::Impl {
   void send(protocol::Packet& p) {
     p.header.session = session_id;
     p.header.sequence = sequence++;
-    if (!protocol::encode(p, config.input_size, out)) return;
+    const bool encoded = protection ? protection->seal(channel, p, config.input_size, out)
+                                    : protocol::encode(p, config.input_size, out);
+    if (!encoded) return;
     transport->send(config.host, out);
     last_send_us = now_us;
   }
@@ -86,6 +92,7 @@ struct SpectatorSession::Impl {
         if (answered) return;  // a duplicate
         answered = true;
         host_session = p.header.session;
+        if (protection) protection->bind(channel, host_session);
         break;
       case PacketType::ping: {
         if (!running || p.header.session != host_session) {
@@ -181,8 +188,10 @@ Expected<SpectatorSession> SpectatorSession::create(const SpectatorConfig& c, Ga
   impl->game = &game;
   impl->transport = &transport;
   impl->unit = 1 + std::size_t{c.players} * c.input_size;
+  if (Status s = detail::check_match_key(c.match_key, "spectator config: match_key"); !s) return s;
   if (Status s = detail::secure_random_ready(); !s) return s;
   impl->session_id = detail::secure_random_u64();
+  if (c.match_key) impl->protection.emplace(*c.match_key, impl->session_id);
   impl->challenge = detail::secure_random_u64();
   impl->last_frame.assign(impl->unit, 0);
   impl->frame_inputs.assign(std::size_t{c.players} * c.input_size, 0);
@@ -209,8 +218,23 @@ void SpectatorSession::poll(std::uint64_t now_us) {
     // The host's frames carry whole-frame units; everything else its players' input size.
     const bool frames =
         d.bytes.size() > 3 && d.bytes[3] == static_cast<std::uint8_t>(protocol::PacketType::input);
-    if (protocol::decode(d.bytes, frames ? s.unit : s.config.input_size, s.packet) !=
-        protocol::DecodeError::none) {
+    const std::size_t size = frames ? s.unit : s.config.input_size;
+    if (s.protection) {
+      // Header, replay window, tag, then the body (channel.hpp), as a player's session does.
+      protocol::DecodeError error = protocol::DecodeError::none;
+      const detail::Opened opened =
+          s.protection->open(s.channel, d.bytes, s.packet.header, error, s.body);
+      if (opened == detail::Opened::replayed) ++s.stats.dropped_replayed;
+      if (opened == detail::Opened::unauthenticated ||
+          (opened == detail::Opened::malformed && !detail::looks_sealed(d.bytes)))
+        ++s.stats.dropped_unauthenticated;
+      if (opened != detail::Opened::ok ||
+          protocol::decode_body(s.packet.header.type, s.body, size, s.packet) !=
+              protocol::DecodeError::none) {
+        ++s.stats.dropped;
+        continue;
+      }
+    } else if (protocol::decode(d.bytes, size, s.packet) != protocol::DecodeError::none) {
       ++s.stats.dropped;
       continue;
     }

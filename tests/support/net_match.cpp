@@ -22,6 +22,7 @@ Match::Match(const MatchOptions& options) : options_(options) {
     config.max_prediction = options.max_prediction;
     config.check_interval = options.check_interval;
     config.fingerprint = 0xD5'1A'77ULL + options.players;
+    config.match_key = options.match_key;
     for (std::uint32_t q = 0; q < options.players; ++q)
       if (q != p) config.remotes.push_back(net::RemotePlayer{q, q});
     if (p == 0)
@@ -68,6 +69,7 @@ void Match::add_spectators() {
     config.input_size = sessions_[0]->config().input_size;
     config.fingerprint = sessions_[0]->config().fingerprint;
     config.host = 0;
+    config.match_key = options_.match_key;
     if (options_.configure_spectator) options_.configure_spectator(k, config);
     auto s = net::SpectatorSession::create(config, *spectator_games_.back(),
                                            network_->endpoint(options_.players + k));

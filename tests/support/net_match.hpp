@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <detsim/net/game.hpp>
+#include <detsim/net/protection.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/net/spectator.hpp>
@@ -78,8 +79,26 @@ struct PeerRecord {
   }
 };
 
+/// A match key for tests (any 32 bytes not all zero), `salt` making another one.
+inline net::MatchKey test_match_key(std::uint8_t salt = 0) {
+  net::MatchKey key{};
+  for (std::size_t i = 0; i < key.size(); ++i)
+    key[i] = static_cast<std::uint8_t>((0xA5 ^ (i * 29)) + salt);
+  return key;
+}
+/// The key test matches play with: test_match_key(), or none in a build without libsodium
+/// (DETSIM_WITH_SODIUM=OFF), which refuses keys.
+inline std::optional<net::MatchKey> default_match_key() {
+  if (!net::protection::available()) return std::nullopt;
+  return test_match_key();
+}
+
 struct MatchOptions {
   std::uint32_t players = 2;
+  /// Every peer's and spectator's SessionConfig::match_key: sealed datagrams by default, as a real
+  /// match plays. Tests that edit datagrams as a malicious peer would (it holds the key) reset it
+  /// and edit the plain framing, which carries the same fields.
+  std::optional<net::MatchKey> match_key = default_match_key();
   net::SessionMode mode = net::SessionMode::rollback;
   net::LinkConditions link{};
   std::uint64_t frames = 600;

@@ -162,6 +162,7 @@ Status Netplay::start() {
   config.input_size = net::ScenarioGame::input_size;
   config.input_delay = args_.input_delay;
   config.fingerprint = session_fingerprint(*scenario_, plan_.mode, args_.frames);
+  config.match_key = plan_.match_key;
   config.frame_us =
       args_.fps == 0 ? 1000 : std::clamp<std::uint32_t>(1'000'000 / args_.fps, 1000, 1'000'000);
   for (const net::UdpPeer& p : plan_.peers)
@@ -208,6 +209,10 @@ bool Netplay::handle_events() {
         break;
       case net::EventType::hello_rejected:
         if (e.player < rejected_.size()) rejected_[e.player] = std::string(e.reason);
+        if (const char* keys = key_mismatch(e.reason)) {
+          std::fprintf(stderr, "detsim netplay: %s: %s\n", who.c_str(), keys);
+          break;
+        }
         std::fprintf(stderr,
                      "detsim netplay: %s %s with other settings (%s): check --players, "
                      "--seed, --mode, --frames and the detsim version on both sides\n",
@@ -346,6 +351,7 @@ int Netplay::run() {
       " players): player " + std::to_string(args_.me) + " on " +
       transport_->local_endpoint().to_string() + ", " + args_.mode + ", input delay " +
       std::to_string(args_.input_delay) + ", " + std::to_string(args_.frames) + " frames");
+  say(protection_line(plan_));
   for (const net::UdpPeer& p : plan_.peers)
     say("waiting for player " + std::to_string(p.id) + " at " + p.endpoint.to_string());
   for (std::size_t k = 0; k < plan_.spectators.size(); ++k)
@@ -370,7 +376,9 @@ int Netplay::run() {
           if (stats && stats->synchronized) continue;
           failure_ = "handshake timed out waiting for player " + std::to_string(p.id) + " at " +
                      p.endpoint.to_string();
-          if (!rejected_[p.id].empty())
+          if (const char* keys = key_mismatch(rejected_[p.id]))
+            failure_ += std::string(" (") + keys + ")";
+          else if (!rejected_[p.id].empty())
             failure_ += " (its settings differ: " + rejected_[p.id] + ")";
           break;
         }
@@ -475,6 +483,7 @@ int Netplay::report(double handshake_seconds, double match_seconds) {
         .num("players", args_.players)
         .num("player", args_.me)
         .boolean("spectator", false)
+        .boolean("protected", plan_.match_key.has_value())
         .str("mode", args_.mode)
         .num("input_delay", args_.input_delay)
         .num("frames", confirmed_);
@@ -489,6 +498,8 @@ int Netplay::report(double handshake_seconds, double match_seconds) {
         .num("skipped_advances", skipped_)
         .num("desyncs", desyncs_.size())
         .num("unverified", unverified_.size())
+        .num("dropped_unauthenticated", st.dropped_unauthenticated)
+        .num("dropped_replayed", st.dropped_replayed)
         .raw("desync_events", Json::array(desyncs))
         .raw("peers", Json::array(peers))
         .raw("spectators", Json::array(spectators));
@@ -517,6 +528,10 @@ void Netplay::print_text_report(double handshake_seconds, double match_seconds) 
               static_cast<unsigned long long>(st.rollbacks),
               static_cast<unsigned long long>(st.resimulated_frames));
   std::printf("desyncs      %zu\n", desyncs_.size());
+  if (plan_.match_key)
+    std::printf("protection   sealed; dropped %llu unauthenticated, %llu replayed\n",
+                static_cast<unsigned long long>(st.dropped_unauthenticated),
+                static_cast<unsigned long long>(st.dropped_replayed));
   for (const std::string& line : unverified_)
     std::printf("UNVERIFIED   %s\n", line.c_str());
   for (const net::UdpPeer& p : plan_.peers) {

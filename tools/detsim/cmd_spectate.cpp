@@ -92,6 +92,7 @@ Status Spectate::start() {
   // The players' own fingerprint: a spectator of another match (or length) is never served.
   config.fingerprint = session_fingerprint(*scenario_, plan_.mode, args_.frames);
   config.host = host_.id;
+  config.match_key = plan_.match_key;
   auto session = net::SpectatorSession::create(config, *game_, *transport_);
   if (!session) return session.status();
   session_.emplace(std::move(session.value()));
@@ -136,8 +137,10 @@ std::string Spectate::handshake_failure() const {
   std::string text = "handshake timed out waiting for " + host_name() +
                      ": it must list this machine (" + transport_->local_endpoint().to_string() +
                      ") with --spectator";
-  // Packets from the host arrive but are refused: most likely a hello for another match.
-  if (session_->stats().dropped > 0)
+  // Packets from the host arrive but are refused: another key, or a hello for another match.
+  if (session_->stats().dropped_unauthenticated > 0)
+    text += std::string("; ") + key_mismatch("not authenticated");
+  else if (session_->stats().dropped > 0)
     text +=
         "; its packets were refused (another match?): check --players, --seed, --mode, "
         "--frames and the detsim version on both sides";
@@ -149,6 +152,7 @@ int Spectate::run() {
   say("arena (seed " + std::to_string(args_.seed) + ", " + std::to_string(args_.players) +
       " players): spectator on " + transport_->local_endpoint().to_string() + ", " + args_.mode +
       ", " + std::to_string(args_.frames) + " frames");
+  say(protection_line(plan_));
   say("waiting for " + host_name());
 
   const auto timeout_us = static_cast<std::uint64_t>(args_.timeout_seconds * 1e6);

@@ -110,6 +110,8 @@ struct NetplayArgs {
   std::string desync_report;            ///< on a desync, write this machine's side here; or empty
   std::vector<std::string> injections;  ///< --inject FRAME:BODY:FIELD:DELTA, each
   bool json = false;
+  std::string key;       ///< --key: the match key, 64 hex digits; or empty
+  std::string key_file;  ///< --key-file: a file holding it (64 hex digits, or 32 raw bytes)
 };
 int netplay_command(const NetplayArgs& args);
 

@@ -222,6 +222,14 @@ and one --peer for each other player, e.g. for two players on one machine:
   detsim netplay --players 2 --me 0 --bind 127.0.0.1:7000 --peer 1=127.0.0.1:7001 --bot 1
   detsim netplay --players 2 --me 1 --bind 127.0.0.1:7001 --peer 0=127.0.0.1:7000 --bot 2
 Peers whose settings differ (players, seed, mode, frames, detsim version) refuse each other.
+
+Packet protection: with --key (or --key-file) every packet is encrypted and authenticated
+(ChaCha20-Poly1305 under per-direction keys derived from the match key; a replay window drops
+duplicates and old packets). Whoever lacks the key can drop packets, and nothing more: no reading,
+forging, rewriting or replaying. Peers with different keys (or one without) never connect, and
+say so. Without a key packets are NOT protected: anyone on the path can read every input and
+rewrite it, and a relay that also rewrites the hash checks can split the match unnoticed. Play
+without a key only on a network you trust (a LAN, tests).
 After the last frame the command keeps answering until every frame is confirmed and every peer
 has reached the end. With --record every peer writes the same replay, byte for byte; detsim
 verify checks it. The bot plays by frame number, so the final hash depends only on the
@@ -307,6 +315,18 @@ void add_netplay(CLI::App& app, int& exit_code) {
                 "Record the confirmed frames to a replay file (the same bytes on every peer and "
                 "spectator)")
       ->type_name("FILE");
+  auto* key = c->add_option("--key", netplay.key,
+                            "The match key, 64 hex digits (e.g. from `head -c 32 /dev/urandom | "
+                            "xxd -p -c 64`), the same on every peer and spectator: every packet "
+                            "is encrypted and authenticated, replays are dropped. Visible to "
+                            "other users in the process list: prefer --key-file. Without a key "
+                            "packets are NOT protected (see below)")
+                  ->type_name("HEX");
+  c->add_option("--key-file", netplay.key_file,
+                "Read the match key from FILE: 64 hex digits (whitespace around them ignored) or "
+                "exactly 32 raw bytes")
+      ->type_name("FILE")
+      ->excludes(key);
   add_inject_option(c, netplay.injections);
   c->add_option("--desync-report", netplay.desync_report,
                 "On a desync, write this machine's side to FILE: the inputs up to the divergent "

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <optional>
 
 namespace detsim::cli {
@@ -93,7 +94,70 @@ Status add_spectators(const NetplayArgs& a, NetplayPlan& plan) {
   return Status::success();
 }
 
+/// --key or --key-file into plan.match_key.
+Status read_key(const NetplayArgs& a, NetplayPlan& plan) {
+  if (!a.key.empty() && !a.key_file.empty())
+    return Status::error("--key and --key-file: give one of them, not both");
+  if (!a.key.empty()) {
+    auto key = parse_match_key(a.key);
+    if (!key) return Status::error("--key: " + key.message());
+    plan.match_key = key.value();
+  } else if (!a.key_file.empty()) {
+    std::ifstream in(a.key_file, std::ios::binary);
+    if (!in) return Status::error("--key-file " + a.key_file + ": cannot be read");
+    std::string text(128, '\0');  // a key file is short: read a little more than the longest
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<std::size_t>(in.gcount()));
+    if (text.size() == net::MatchKey{}.size()) {  // 32 raw bytes
+      net::MatchKey key{};
+      std::copy(text.begin(), text.end(), key.begin());
+      plan.match_key = key;
+    } else {
+      auto key = parse_match_key(text);
+      if (!key)
+        return Status::error("--key-file " + a.key_file + ": " + key.message() +
+                             " (or exactly 32 raw bytes)");
+      plan.match_key = key.value();
+    }
+  }
+  if (plan.match_key && !net::protection::available())
+    return Status::error(
+        "--key: this detsim was built without libsodium (DETSIM_WITH_SODIUM=OFF) and cannot "
+        "protect packets");
+  if (plan.match_key &&
+      std::all_of(plan.match_key->begin(), plan.match_key->end(), [](auto b) { return b == 0; }))
+    return Status::error("--key: all zero is not a key");
+  return Status::success();
+}
+
 }  // namespace
+
+Expected<net::MatchKey> parse_match_key(std::string_view text) {
+  const auto space = [](char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t'; };
+  while (!text.empty() && space(text.front()))
+    text.remove_prefix(1);
+  while (!text.empty() && space(text.back()))
+    text.remove_suffix(1);
+  net::MatchKey key{};
+  if (text.size() != 2 * key.size())
+    return Status::error("a match key is 64 hex digits (32 bytes), got " +
+                         std::to_string(text.size()) + " characters");
+  const auto digit = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  };
+  for (std::size_t i = 0; i < key.size(); ++i) {
+    const int hi = digit(text[2 * i]);
+    const int lo = digit(text[2 * i + 1]);
+    if (hi < 0 || lo < 0)
+      return Status::error("a match key is 64 hex digits; character " +
+                           std::to_string(hi < 0 ? 2 * i + 1 : 2 * i + 2) + " is not one");
+    key[i] = static_cast<std::uint8_t>(hi * 16 + lo);
+  }
+  return key;
+}
 
 Expected<NetplayPlan> netplay_plan(const NetplayArgs& a) {
   if (a.players < 2 || a.players > 8)
@@ -134,7 +198,27 @@ Expected<NetplayPlan> netplay_plan(const NetplayArgs& a) {
     plan.peers.push_back(*by_player[p]);
   }
   if (Status s = add_spectators(a, plan); !s) return s;
+  if (Status s = read_key(a, plan); !s) return s;
   return plan;
+}
+
+const char* key_mismatch(std::string_view reason) {
+  if (reason == "not authenticated")
+    return "its packets fail authentication: every peer and spectator needs the same --key";
+  if (reason == "sealed")
+    return "it seals its packets with a --key and this machine has none: give every peer the "
+           "same --key";
+  if (reason == "not sealed")
+    return "it sends unprotected packets (no --key) and this machine has one: give every peer "
+           "the same --key";
+  return nullptr;
+}
+
+std::string protection_line(const NetplayPlan& plan) {
+  return plan.match_key
+             ? "packets sealed with the match key (ChaCha20-Poly1305, per-direction keys)"
+             : "packets NOT protected (no --key): anyone on the path can read and rewrite them; "
+               "for a trusted network only";
 }
 
 std::string milliseconds(std::uint64_t us) {

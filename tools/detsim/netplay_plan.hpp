@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -36,10 +37,23 @@ struct NetplayPlan {
   /// The spectators this player serves (--spectator), PeerId first_spectator_peer + k.
   std::vector<net::UdpPeer> spectators;
   net::SessionMode mode = net::SessionMode::rollback;
+  /// --key or --key-file: every datagram sealed (docs/NET.md, "Packet protection"); absent: the
+  /// plain framing, unauthenticated (a trusted network only).
+  std::optional<net::MatchKey> match_key;
 };
+
+/// A match key from 64 hex digits (either case; surrounding whitespace ignored); errors say why.
+Expected<net::MatchKey> parse_match_key(std::string_view text);
 
 /// Checks `args` (player or --spectate) into a plan; errors name the option and the problem.
 Expected<NetplayPlan> netplay_plan(const NetplayArgs& args);
+
+/// What a hello_rejected reason about keys means for the user ("--key differs ..."), or nullptr
+/// for the other reasons (settings).
+const char* key_mismatch(std::string_view reason);
+
+/// The line netplay prints about packet protection.
+std::string protection_line(const NetplayPlan& plan);
 
 /// "12.3 ms"
 std::string milliseconds(std::uint64_t us);

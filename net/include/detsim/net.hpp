@@ -2,6 +2,7 @@
 #pragma once
 
 #include <detsim/net/game.hpp>
+#include <detsim/net/protection.hpp>
 #include <detsim/net/protocol.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>

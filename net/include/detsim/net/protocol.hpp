@@ -8,11 +8,24 @@
 // the handshake's challenges) and the frame windows in the session are what keep stale and foreign
 // datagrams out.
 //
-// Layout (all integers little-endian):
+// Two framings of the same bodies. Plain (no match key: LAN tests and the simulated network;
+// docs/NET.md says what it gives up), all integers little-endian:
 //
 //     header   magic "DN" | version u8 | type u8 | sender session u64 | sequence u16  (14 bytes)
 //     body     by type (below)
 //     trailer  low 32 bits of XXH3-64 over header and body                             (4 bytes)
+//
+// Sealed (SessionConfig::match_key; <detsim/net/protection.hpp> has the keys and the AEAD):
+//
+//     header   magic "DS" | version u8 | type u8 | sequence u32                        (8 bytes)
+//              hello and hello_reply only: + sender session u64                         (16 bytes)
+//     body     by type (below), encrypted with ChaCha20-Poly1305-IETF
+//     tag      Poly1305 over header (associated data) and ciphertext                   (16 bytes)
+//
+// A sealed datagram's sequence is the low 32 bits of the sender's 64-bit sequence under that key
+// (the nonce); the receiver rebuilds the rest from the highest it accepted. Its data datagrams
+// carry no session id: their key is bound to both sessions' ids (protection.hpp), so the tag
+// proves the sender's session. The header is in the clear, and authenticated.
 //
 //     hello        fingerprint u64 | players u8 | player u8 | input_size u8 | challenge u64
 //     hello_reply  challenge u64 (the hello's, echoed; the header carries the replier's session)
@@ -45,12 +58,17 @@
 namespace detsim::net::protocol {
 
 /// Changes whenever the layout above changes; peers of different versions drop each other's
-/// datagrams (counted as bad_version) and never synchronise.
-inline constexpr std::uint8_t version = 4;
+/// datagrams (counted as bad_version) and never synchronise. Version 5 added the sealed framing.
+inline constexpr std::uint8_t version = 5;
 inline constexpr std::uint8_t magic0 = 'D';
 inline constexpr std::uint8_t magic1 = 'N';
 inline constexpr std::size_t header_size = 14;
 inline constexpr std::size_t trailer_size = 4;
+/// The sealed framing's second magic byte ("DS"), headers and tag.
+inline constexpr std::uint8_t sealed_magic1 = 'S';
+inline constexpr std::size_t sealed_data_header_size = 8;
+inline constexpr std::size_t sealed_handshake_header_size = 16;
+inline constexpr std::size_t sealed_tag_size = 16;
 /// The largest input a player sends, in bytes.
 inline constexpr std::size_t max_input_size = 64;
 /// The largest unit an input packet carries: players send their input; a host sends spectators
@@ -159,6 +177,35 @@ inline constexpr std::size_t decode_error_count = 9;
 /// (count or deltas inconsistent with input_size, too many checks): a session bug, never input.
 [[nodiscard]] bool encode(const Packet& packet, std::size_t input_size,
                           std::vector<std::uint8_t>& out);
+
+/// The cleartext header of a sealed datagram, readable without a key (and not to be trusted
+/// before the tag verified).
+struct SealedHeader {
+  PacketType type = PacketType::hello;
+  std::uint32_t sequence = 0;  ///< the low 32 bits of the sender's sequence under the key
+  std::uint64_t session = 0;   ///< hello and hello_reply: the sender's session id; else 0
+  std::size_t size = 0;        ///< of the header: sealed_data_header_size or ..._handshake_...
+};
+
+/// The size of a sealed header of this type.
+[[nodiscard]] std::size_t sealed_header_size(PacketType type) noexcept;
+
+/// Checks a sealed datagram's length, magic, version and type and reads its header. Says nothing
+/// about the rest: protection::open() checks the tag, decode_body() the body.
+[[nodiscard]] DecodeError decode_sealed_header(std::span<const std::uint8_t> bytes,
+                                               SealedHeader& out);
+
+/// Writes a sealed datagram before sealing: its header (`sequence`, and packet.header.session for
+/// a handshake type) and the plaintext body; protection::seal() then encrypts the body in place
+/// and appends the tag. False, `out` empty, as encode().
+[[nodiscard]] bool encode_sealed_plaintext(const Packet& packet, std::uint32_t sequence,
+                                           std::size_t input_size, std::vector<std::uint8_t>& out);
+
+/// Decodes an opened sealed datagram's body (every field checked, as decode() does: a peer that
+/// holds the key may still send anything) into `out`; out.header's session and sequence are the
+/// caller's to fill.
+[[nodiscard]] DecodeError decode_body(PacketType type, std::span<const std::uint8_t> body,
+                                      std::size_t input_size, Packet& out);
 
 /// The XOR deltas of `inputs` (whole inputs of input_size bytes) against `reference` (one input,
 /// the receiver's input before the first) and each input against the one before it.

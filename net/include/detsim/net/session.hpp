@@ -35,6 +35,7 @@
 
 #include <detsim/core/status.hpp>
 #include <detsim/net/game.hpp>
+#include <detsim/net/protection.hpp>
 #include <detsim/net/protocol.hpp>
 #include <detsim/net/transport.hpp>
 
@@ -73,6 +74,12 @@ struct SessionConfig {
   /// than a third of the time, the peers it waited on are disconnected ("no progress"). Must
   /// exceed disconnect_timeout_us (a silent peer is the disconnect timeout's to handle).
   std::uint64_t progress_timeout_us = 10'000'000;
+  /// The match's secret (docs/NET.md, "Packet protection"): every datagram is then sealed with
+  /// ChaCha20-Poly1305 under per-direction keys derived from it, and replays are dropped; a peer
+  /// with another key (or none) never synchronises. Absent: the plain framing, which anyone on
+  /// the path can read, forge and rewrite — for LAN tests and the simulated network only. A
+  /// build without libsodium refuses a key (create() fails) rather than play unprotected.
+  std::optional<MatchKey> match_key;
   std::vector<RemotePlayer> remotes;  ///< every other player, each exactly once
   /// Spectators this machine serves (at most 16; ids distinct from the remotes'): each receives
   /// every confirmed frame's inputs from here (SpectatorSession). Events about spectator k use
@@ -89,14 +96,16 @@ enum class Advance : std::uint8_t {
 };
 
 enum class EventType : std::uint8_t {
-  synchronized,    ///< the handshake with `player` completed
-  running,         ///< every peer is synchronized: frames can advance
-  interrupted,     ///< `player` has been silent for disconnect_warning_us
-  resumed,         ///< `player` was heard from again after an interruption
-  disconnected,    ///< `player` is gone (`reason`: "silent", "no progress" or "reported gone"):
-                   ///< its inputs are zero from `frame` on (InputStatus::disconnected)
-  desync,          ///< `player` hashed confirmed frame `frame` differently
-  hello_rejected,  ///< a hello from `player`'s peer did not match this session (`reason`)
+  synchronized,  ///< the handshake with `player` completed
+  running,       ///< every peer is synchronized: frames can advance
+  interrupted,   ///< `player` has been silent for disconnect_warning_us
+  resumed,       ///< `player` was heard from again after an interruption
+  disconnected,  ///< `player` is gone (`reason`: "silent", "no progress" or "reported gone"):
+                 ///< its inputs are zero from `frame` on (InputStatus::disconnected)
+  desync,        ///< `player` hashed confirmed frame `frame` differently
+  /// a hello from `player`'s peer did not match this session (`reason`: what differed, or "not
+  /// authenticated" / "sealed" / "not sealed" when the peers' match keys differ or one has none)
+  hello_rejected,
   /// `player`'s hash check of confirmed frame `frame` did not arrive within progress_timeout_us
   /// of this machine confirming it (or can no longer be compared): that frame, and every later
   /// one, is unverified with that peer. Raised once per peer. A relay that strips checks, or a
@@ -178,6 +187,11 @@ struct SessionStats {
   std::uint64_t ignored_gone_reports = 0;
   /// Peers whose hash check of some confirmed frame never arrived (Event::check_missing).
   std::uint64_t checks_missing = 0;
+  /// With a match key: datagrams whose tag did not verify (forged, altered on the way, another
+  /// key) or that came in the plain framing; and datagrams dropped by the replay window (a
+  /// duplicate, or older than the 64 before the newest), before decryption.
+  std::uint64_t dropped_unauthenticated = 0;
+  std::uint64_t dropped_replayed = 0;
 };
 
 /// Predicts a remote player's input for a frame not received yet: writes the prediction to `out`

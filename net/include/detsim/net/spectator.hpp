@@ -11,10 +11,12 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <detsim/core/status.hpp>
 #include <detsim/net/game.hpp>
+#include <detsim/net/protection.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/transport.hpp>
 
@@ -25,6 +27,8 @@ struct SpectatorConfig {
   std::uint32_t input_size = 4;   ///< of the match: 1 .. protocol::max_input_size
   std::uint64_t fingerprint = 0;  ///< the match's (SessionConfig::fingerprint)
   PeerId host = 0;                ///< the player session that serves this spectator
+  /// The match's key (SessionConfig::match_key): the host must have the same, or none if absent.
+  std::optional<MatchKey> match_key;
   /// More frames than this waiting: advance() simulates up to catch_up_frames at once.
   std::uint32_t catch_up_threshold = 2;
   std::uint32_t catch_up_frames = 8;  ///< 1 .. 1000
@@ -38,7 +42,9 @@ struct SpectatorStats {
   std::uint64_t catch_up_calls = 0;  ///< advance() calls that simulated more than one frame
   std::uint64_t packets_received = 0;
   std::uint64_t bytes_received = 0;
-  std::uint64_t dropped = 0;  ///< malformed, foreign, or out of the window
+  std::uint64_t dropped = 0;  ///< malformed, foreign, or out of the window (all of them)
+  std::uint64_t dropped_unauthenticated = 0;  ///< of those: a tag that failed (a match key)
+  std::uint64_t dropped_replayed = 0;         ///< of those: a duplicate or an old datagram
 };
 
 class SpectatorSession {
