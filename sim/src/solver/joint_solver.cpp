@@ -516,24 +516,33 @@ void JointSolver::apply_twist(JointConstraint& k, Fixed impulse) {
   apply_held(k, k.twist_row, k.twist_coupling, impulse);
 }
 
+// One end of a range (a limit's end, a distance joint's), with c >= 0 held and cdot the speed
+// away from the end: speculative while apart (c > 0), soft at the end while biased, rigid in relax;
+// the accumulated impulse pushes only. Returns the impulse to apply now.
+Fixed JointSolver::one_sided_impulse(Fixed c, Fixed cdot, Fixed mass, bool use_bias,
+                                     Fixed& accumulated) const {
+  Fixed impulse;
+  if (c > Fixed::zero()) {
+    impulse = -mass * (cdot + c * bodies_.inv_h);
+  } else if (use_bias) {
+    impulse =
+        -mass * soft_.mass_scale * (cdot + soft_.bias_rate * c) - soft_.impulse_scale * accumulated;
+  } else {
+    impulse = -mass * cdot;
+  }
+  const Fixed next = max(accumulated + impulse, Fixed::zero());
+  impulse = next - accumulated;
+  accumulated = next;
+  return impulse;
+}
+
 // Swing-twist's cone: the angle between the axes at most swing_limit, one-sided like the hinge
 // limit's ends, about the direction the axes part in.
 inline void JointSolver::solve_swing_limit(JointConstraint& k, bool use_bias) {
   const JointDef& def = s_.joints[k.joint].def;
   const Fixed c = def.swing_limit - k.swing_angle;
   const Fixed cdot = -row_speed(bodies_.velocities, k.bodies, no_direction, k.swing_row);
-  Fixed impulse;
-  if (c > Fixed::zero()) {
-    impulse = -k.swing_mass * (cdot + c * bodies_.inv_h);
-  } else if (use_bias) {
-    impulse = -k.swing_mass * soft_.mass_scale * (cdot + soft_.bias_rate * c) -
-              soft_.impulse_scale * k.swing_impulse;
-  } else {
-    impulse = -k.swing_mass * cdot;
-  }
-  const Fixed next = max(k.swing_impulse + impulse, Fixed::zero());
-  impulse = next - k.swing_impulse;
-  k.swing_impulse = next;
+  const Fixed impulse = one_sided_impulse(c, cdot, k.swing_mass, use_bias, k.swing_impulse);
   apply_held(k, k.swing_row, k.swing_coupling, -impulse);
 }
 
@@ -559,18 +568,7 @@ inline void JointSolver::solve_hinge_limit(JointConstraint& k, bool use_bias) {
   const Fixed mass = k.twist_mass;
   const auto one_sided = [&](Fixed c, Fixed sign, Fixed& accumulated) {
     const Fixed cdot = sign * row_speed(bodies_.velocities, k.bodies, no_direction, row);
-    Fixed impulse;
-    if (c > Fixed::zero()) {
-      impulse = -mass * (cdot + c * bodies_.inv_h);
-    } else if (use_bias) {
-      impulse = -mass * soft_.mass_scale * (cdot + soft_.bias_rate * c) -
-                soft_.impulse_scale * accumulated;
-    } else {
-      impulse = -mass * cdot;
-    }
-    const Fixed next = max(accumulated + impulse, Fixed::zero());
-    impulse = next - accumulated;
-    accumulated = next;
+    const Fixed impulse = one_sided_impulse(c, cdot, mass, use_bias, accumulated);
     apply_twist(k, sign * impulse);
   };
   one_sided(k.angle - def.limit_lower, Fixed::one(), k.lower_limit_impulse);
@@ -628,18 +626,7 @@ inline void JointSolver::solve_slide_limit(JointConstraint& k, bool use_bias) {
   const Row& row = k.axial_row;
   const auto one_sided = [&](Fixed c, Fixed sign, Fixed& accumulated) {
     const Fixed cdot = sign * row_speed(bodies_.velocities, k.bodies, k.axial, row);
-    Fixed impulse;
-    if (c > Fixed::zero()) {
-      impulse = -row.mass * (cdot + c * bodies_.inv_h);
-    } else if (use_bias) {
-      impulse = -row.mass * soft_.mass_scale * (cdot + soft_.bias_rate * c) -
-                soft_.impulse_scale * accumulated;
-    } else {
-      impulse = -row.mass * cdot;
-    }
-    const Fixed next = max(accumulated + impulse, Fixed::zero());
-    impulse = next - accumulated;
-    accumulated = next;
+    const Fixed impulse = one_sided_impulse(c, cdot, row.mass, use_bias, accumulated);
     apply_impulse(bodies_.velocities, k.bodies, k.axial, row, sign * impulse);
   };
   one_sided(k.translation - def.limit_lower, Fixed::one(), k.lower_limit_impulse);
@@ -668,18 +655,7 @@ inline void JointSolver::solve_distance(JointConstraint& k, bool use_bias) {
   // (c > 0) the row is speculative, else soft while biased, rigid in relax.
   const auto one_sided = [&](Fixed c, Fixed sign, Fixed& accumulated) {
     const Fixed cdot = sign * row_speed(bodies_.velocities, k.bodies, k.axial, row);
-    Fixed impulse;
-    if (c > Fixed::zero()) {
-      impulse = -mass * (cdot + c * bodies_.inv_h);
-    } else if (use_bias) {
-      impulse = -mass * soft_.mass_scale * (cdot + soft_.bias_rate * c) -
-                soft_.impulse_scale * accumulated;
-    } else {
-      impulse = -mass * cdot;
-    }
-    const Fixed next = max(accumulated + impulse, Fixed::zero());
-    impulse = next - accumulated;
-    accumulated = next;
+    const Fixed impulse = one_sided_impulse(c, cdot, mass, use_bias, accumulated);
     apply_impulse(bodies_.velocities, k.bodies, k.axial, row, sign * impulse);
   };
   if (k.min_length > Fixed::zero())

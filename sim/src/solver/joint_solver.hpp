@@ -124,6 +124,8 @@ class JointSolver final : public ConstraintKind {
   void solve_hinge_axes(JointConstraint& k, bool use_bias);
   void solve_hinge_motor(JointConstraint& k);
   void solve_hinge_limit(JointConstraint& k, bool use_bias);
+  /// The impulse of one end of a range this pass (accumulated updated, clamped to push only).
+  Fixed one_sided_impulse(Fixed c, Fixed cdot, Fixed mass, bool use_bias, Fixed& accumulated) const;
   void apply_twist(JointConstraint& k, Fixed impulse);
   void apply_held(JointConstraint& k, const Row& row, Vec3 coupling, Fixed impulse);
   void solve_swing_limit(JointConstraint& k, bool use_bias);
