@@ -501,6 +501,7 @@ Shape random_shape(Lcg& rng, ShapeType type) {
     case ShapeType::capsule:
       return Shape::capsule(rng.in(small, 0.5_fx), rng.in(0_fx, 1_fx));
     case ShapeType::plane:
+    default:  // the primitives of this test only
       return Shape::plane();
   }
   return Shape::plane();
@@ -531,6 +532,8 @@ Fixed outside(const Shape& s, const Pose& p, Vec3 x) {
       if (q != l) return length(l - q);
       return max(abs(l.x) - h.x, max(abs(l.y) - h.y, abs(l.z) - h.z));
     }
+    default:  // the primitives of this test only
+      break;
   }
   return 0_fx;
 }
@@ -548,6 +551,8 @@ Fixed support(const Shape& s, const Pose& p, Vec3 n) {
     case ShapeType::box:
       return c + s.half_extents.x * along(0) + s.half_extents.y * along(1) +
              s.half_extents.z * along(2);
+    default:  // the primitives of this test only
+      break;
   }
   return 0_fx;
 }
@@ -657,6 +662,7 @@ Vec3 support_point(const Shape& s, const Pose& p, Vec3 n) {
       return p.position + side(0, s.half_extents.x) + side(1, s.half_extents.y) +
              side(2, s.half_extents.z);
     case ShapeType::plane:
+    default:  // the primitives of this test only
       break;
   }
   return p.position;

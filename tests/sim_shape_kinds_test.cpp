@@ -2,7 +2,9 @@
 // kind keeps. A new shape type gets these checks by adding its examples to `examples` below; the
 // contract tests then hold it to the same geometry as the others (derived from what each function
 // promises, never from a recorded run).
+#include <memory>
 #include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -19,17 +21,59 @@ using sim_detail::find_shape_kind;
 using sim_detail::shape_kinds;
 using sim_detail::ShapeKind;
 
+// A shape and the geometry it refers to (none for a primitive).
+struct Example {
+  Shape shape;
+  std::shared_ptr<const sim_detail::Geometry> geometry;
+};
+
+std::shared_ptr<const sim_detail::Geometry> hull_of(std::span<const Vec3> points) {
+  auto hull = sim_detail::build_hull(points);
+  EXPECT_TRUE(hull.ok()) << hull.message();
+  if (!hull.ok()) return nullptr;
+  return sim_detail::make_hull_geometry(std::move(*hull));
+}
+
+// Convex hulls about the origin (the contract's "centre"): a cube's corners, and a rock of 12
+// points from the RNG on an ellipsoid.
+std::vector<Example> hull_examples() {
+  std::vector<Vec3> cube;
+  for (const int i : {0, 1, 2, 3, 4, 5, 6, 7})
+    cube.push_back({(i & 1) != 0 ? 0.5_fx : -0.5_fx, (i & 2) != 0 ? 0.5_fx : -0.5_fx,
+                    (i & 4) != 0 ? 0.5_fx : -0.5_fx});
+  Rng rng(5);
+  std::vector<Vec3> rock;
+  for (int i = 0; i < 12; ++i) {
+    const Vec3 u = rng.unit_vector();
+    rock.push_back({u.x * 2_fx, u.y, u.z * 0.75_fx});
+  }
+  std::vector<Example> out;
+  for (const auto& points : {cube, rock}) {
+    auto g = hull_of(points);
+    if (g) out.push_back({Shape::convex(GeometryId{1}), g});
+  }
+  return out;
+}
+
 // Shapes of each type that a body may have, from small and flat to long.
-std::vector<Shape> examples(ShapeType type) {
+std::vector<Example> examples(ShapeType type) {
+  const auto plain = [](std::initializer_list<Shape> shapes) {
+    std::vector<Example> out;
+    for (const Shape& s : shapes)
+      out.push_back({s, nullptr});
+    return out;
+  };
   switch (type) {
     case ShapeType::sphere:
-      return {Shape::sphere(0.5_fx), Shape::sphere(0.01_fx), Shape::sphere(7_fx)};
+      return plain({Shape::sphere(0.5_fx), Shape::sphere(0.01_fx), Shape::sphere(7_fx)});
     case ShapeType::box:
-      return {Shape::box({0.5_fx, 0.5_fx, 0.5_fx}), Shape::box({2_fx, 0.1_fx, 0.7_fx})};
+      return plain({Shape::box({0.5_fx, 0.5_fx, 0.5_fx}), Shape::box({2_fx, 0.1_fx, 0.7_fx})});
     case ShapeType::capsule:
-      return {Shape::capsule(0.3_fx, 1_fx), Shape::capsule(0.5_fx, 0_fx)};
+      return plain({Shape::capsule(0.3_fx, 1_fx), Shape::capsule(0.5_fx, 0_fx)});
     case ShapeType::plane:
-      return {Shape::plane()};
+      return plain({Shape::plane()});
+    case ShapeType::convex:
+      return hull_examples();
   }
   ADD_FAILURE() << "no examples of shape type " << static_cast<unsigned>(type)
                 << ": add them to examples() in this file";
@@ -62,22 +106,31 @@ TEST(ShapeKinds, EveryShapeTypeHasExactlyOneKind) {
 
 TEST(ShapeKinds, MassPropertiesHaveTheGivenMassAndPositiveMoments) {
   for (const ShapeKind* kind : shape_kinds()) {
-    for (const Shape& s : examples(kind->type)) {
+    for (const Example& e : examples(kind->type)) {
+      const Shape& s = e.shape;
+      const sim_detail::Geometry* g = e.geometry.get();
       ASSERT_EQ(kind->check(s), "");
       if (!kind->bounded) {
         EXPECT_EQ(volume(s), Fixed::zero()) << kind->name;
         EXPECT_EQ(mass_properties(s, 3_fx), MassProperties{}) << kind->name;
         continue;
       }
-      EXPECT_GT(volume(s), Fixed::zero()) << kind->name;
-      const MassProperties m = mass_properties(s, 3_fx);
+      EXPECT_GT(kind->volume(s, g), Fixed::zero()) << kind->name;
+      const MassProperties m = kind->mass_properties(s, g, 3_fx);
+      // The primitives' free functions are the kinds' (geometry needs its world: zero there).
+      if (g == nullptr) {
+        EXPECT_EQ(volume(s), kind->volume(s, g)) << kind->name;
+        EXPECT_EQ(mass_properties(s, 3_fx), m) << kind->name;
+      } else {
+        EXPECT_EQ(volume(s), Fixed::zero()) << kind->name;
+      }
       EXPECT_EQ(m.mass, 3_fx) << kind->name;
       EXPECT_GT(m.inertia.x, Fixed::zero()) << kind->name;
       EXPECT_GT(m.inertia.y, Fixed::zero()) << kind->name;
       EXPECT_GT(m.inertia.z, Fixed::zero()) << kind->name;
       // No point of a solid is farther than the bounding radius R from the origin, so no moment
       // exceeds m R^2 (and each pair of moments obeys the triangle inequality of a real body).
-      const Fixed r = kind->bounding_radius(s);
+      const Fixed r = kind->bounding_radius(s, g);
       const Fixed bound = 3_fx * r * r;
       EXPECT_LE(m.inertia.x, bound) << kind->name;
       EXPECT_LE(m.inertia.x, m.inertia.y + m.inertia.z + Fixed::from_raw(4)) << kind->name;
@@ -94,14 +147,16 @@ TEST(ShapeKinds, ContainedPointsLieWithinTheBoundsAndTheSmallestDimensionIsInsid
   Rng rng(7);
   for (const ShapeKind* kind : shape_kinds()) {
     if (!kind->bounded) continue;
-    for (const Shape& s : examples(kind->type)) {
-      const Fixed r = kind->bounding_radius(s);
-      const Vec3 box = kind->aabb_extent(s, Mat3::identity());
+    for (const Example& e : examples(kind->type)) {
+      const Shape& s = e.shape;
+      const sim_detail::Geometry* g = e.geometry.get();
+      const Fixed r = kind->bounding_radius(s, g);
+      const Vec3 box = kind->aabb_extent(s, g, Mat3::identity());
       int inside = 0;
       for (int i = 0; i < 4000; ++i) {
         const Vec3 p{rng.uniform(-2_fx * r, 2_fx * r), rng.uniform(-2_fx * r, 2_fx * r),
                      rng.uniform(-2_fx * r, 2_fx * r)};
-        if (!kind->contains(s, p)) continue;
+        if (!kind->contains(s, g, p)) continue;
         ++inside;
         ASSERT_LE(length(p), r + Fixed::from_raw(16)) << kind->name;
         ASSERT_LE(abs(p.x), box.x) << kind->name;
@@ -109,10 +164,10 @@ TEST(ShapeKinds, ContainedPointsLieWithinTheBoundsAndTheSmallestDimensionIsInsid
         ASSERT_LE(abs(p.z), box.z) << kind->name;
       }
       EXPECT_GT(inside, 0) << kind->name << ": no sample fell inside";
-      const Fixed d = kind->smallest_dimension(s);
+      const Fixed d = kind->smallest_dimension(s, g);
       for (const Vec3 axis : {Vec3::unit_x(), Vec3::unit_y(), Vec3::unit_z()}) {
-        EXPECT_TRUE(kind->contains(s, axis * d)) << kind->name;
-        EXPECT_TRUE(kind->contains(s, -axis * d)) << kind->name;
+        EXPECT_TRUE(kind->contains(s, g, axis * d)) << kind->name;
+        EXPECT_TRUE(kind->contains(s, g, -axis * d)) << kind->name;
       }
     }
   }
@@ -126,19 +181,21 @@ TEST(ShapeKinds, RaysAtTheCentreHitTheSurfaceAndRaysAwayMiss) {
   const Fixed step_back = Fixed::from_raw(Fixed::one_raw >> 16);
   for (const ShapeKind* kind : shape_kinds()) {
     if (!kind->bounded) continue;
-    for (const Shape& s : examples(kind->type)) {
-      const Fixed r = kind->bounding_radius(s);
+    for (const Example& e : examples(kind->type)) {
+      const Shape& s = e.shape;
+      const sim_detail::Geometry* g = e.geometry.get();
+      const Fixed r = kind->bounding_radius(s, g);
       for (int i = 0; i < 200; ++i) {
         const Vec3 v = rng.unit_vector();
         const Vec3 p = -v * (r * 2_fx + 1_fx);
-        const auto hit = kind->ray(s, p, v);
+        const auto hit = kind->ray(s, g, p, v);
         ASSERT_TRUE(hit.has_value()) << kind->name;
         EXPECT_LE(length(hit->point - (p + v * hit->t)), Fixed::from_raw(1 << 12)) << kind->name;
         EXPECT_LE(length(hit->point), r + Fixed::from_raw(1 << 12)) << kind->name;
-        EXPECT_TRUE(kind->contains(s, hit->point + v * step_back)) << kind->name;
-        EXPECT_FALSE(kind->contains(s, hit->point - v * step_back)) << kind->name;
+        EXPECT_TRUE(kind->contains(s, g, hit->point + v * step_back)) << kind->name;
+        EXPECT_FALSE(kind->contains(s, g, hit->point - v * step_back)) << kind->name;
         EXPECT_NEAR(length(hit->normal).to_double(), 1.0, 1e-6) << kind->name;
-        EXPECT_FALSE(kind->ray(s, p, -v).has_value()) << kind->name;
+        EXPECT_FALSE(kind->ray(s, g, p, -v).has_value()) << kind->name;
       }
     }
   }
@@ -148,13 +205,16 @@ TEST(ShapeKinds, TheBoundingBoxHoldsTheRotatedShape) {
   Rng rng(13);
   for (const ShapeKind* kind : shape_kinds()) {
     if (!kind->bounded) continue;
-    for (const Shape& s : examples(kind->type)) {
+    for (const Example& e : examples(kind->type)) {
+      const Shape& s = e.shape;
+      const sim_detail::Geometry* g = e.geometry.get();
       for (int i = 0; i < 50; ++i) {
         const Quat q = from_axis_angle(rng.unit_vector(), rng.uniform(0_fx, 3_fx));
         const Mat3 rotation = to_mat3(q);
-        const Vec3 box = kind->aabb_extent(s, rotation);
+        const Vec3 box = kind->aabb_extent(s, g, rotation);
         // The outline's points grown by its radius are the extreme points of a convex shape.
-        const ShapeOutline outline = shape_outline(s, Vec3{}, q);
+        ShapeOutline outline;
+        kind->outline(s, g, Vec3{}, q, outline);
         for (const Vec3 p : outline.points) {
           EXPECT_LE(abs(p.x) + outline.radius, box.x + Fixed::from_raw(64)) << kind->name;
           EXPECT_LE(abs(p.y) + outline.radius, box.y + Fixed::from_raw(64)) << kind->name;
@@ -167,7 +227,8 @@ TEST(ShapeKinds, TheBoundingBoxHoldsTheRotatedShape) {
 
 TEST(ShapeKinds, TheEncodingReadsBackTheSameShapeAndNothingMore) {
   for (const ShapeKind* kind : shape_kinds()) {
-    for (const Shape& s : examples(kind->type)) {
+    for (const Example& e : examples(kind->type)) {
+      const Shape& s = e.shape;
       ByteWriter w;
       kind->write(s, w);
       w.u8(0xAB);  // what follows the shape is not read

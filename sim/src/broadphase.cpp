@@ -184,7 +184,7 @@ void keep_within_budget(const WorldState& s, std::vector<std::uint64_t>& pairs) 
         used.assign(s.bodies.size(), 0);
         radius.resize(s.bodies.size());
         for (std::size_t b = 0; b < s.bodies.size(); ++b)
-          radius[b] = bounding_radius(s.bodies[b].shape);
+          radius[b] = bounding_radius(s.bodies[b].shape, s.geometry(s.bodies[b].shape));
       }
       // Each counts the other if the other is at least half its size.
       const bool i_counts = (radius[j] << 1) >= radius[i];

@@ -42,10 +42,25 @@ struct Manifold {
   std::array<ContactPoint, 4> points{};
 };
 
-/// The contact manifold of shape `a` at `pose_a` against shape `b` at `pose_b`, with every point
-/// whose separation is at most `margin` (>= 0). `count` is 0 when the shapes are farther apart than
-/// `margin`, and always 0 for a plane against a plane.
-[[nodiscard]] Manifold collide(const Shape& a, const Pose& pose_a, const Shape& b,
-                               const Pose& pose_b, Fixed margin) noexcept;
+struct Geometry;
+
+/// A shape placed for the narrowphase: the shape, the geometry it refers to (nullptr for a
+/// primitive; see geometry/geometry.hpp) and its pose.
+struct PosedShape {
+  const Shape& shape;
+  const Geometry* geometry;
+  const Pose& pose;
+};
+
+/// The contact manifold of shape `a` against shape `b`, with every point whose separation is at
+/// most `margin` (>= 0). `count` is 0 when the shapes are farther apart than `margin`, and always
+/// 0 for a plane against a plane.
+[[nodiscard]] Manifold collide(const PosedShape& a, const PosedShape& b, Fixed margin) noexcept;
+
+/// collide() for two primitives (shapes without geometry).
+[[nodiscard]] inline Manifold collide(const Shape& a, const Pose& pose_a, const Shape& b,
+                                      const Pose& pose_b, Fixed margin) noexcept {
+  return collide(PosedShape{a, nullptr, pose_a}, PosedShape{b, nullptr, pose_b}, margin);
+}
 
 }  // namespace detsim::sim_detail

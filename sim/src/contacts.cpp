@@ -42,7 +42,8 @@ void collide_one(WorldState& s, Contact& c, std::size_t ia, std::size_t ib) {
   const BodyState& a = s.bodies[ia];
   const BodyState& b = s.bodies[ib];
   c.manifold =
-      collide(a.shape, s.derived[ia].pose, b.shape, s.derived[ib].pose, contact_margin(s, ia, ib));
+      collide({a.shape, s.geometry(a.shape), s.derived[ia].pose},
+              {b.shape, s.geometry(b.shape), s.derived[ib].pose}, contact_margin(s, ia, ib));
   std::array<CachedPoint, 4> next{};
   for (std::size_t k = 0; k < c.manifold.count; ++k) {
     next[k].feature = c.manifold.points[k].feature;

@@ -240,9 +240,9 @@ struct WorldSection {
 /// The World's sections, in the order a state lists them: a new kind of state (joints, particle
 /// groups, controllers) is a row here, after the bodies it refers to.
 constexpr WorldSection kSections[] = {
-    {"globals", 1, write_globals, read_globals}, {"rng", 1, write_rng_section, read_rng},
-    {"bodies", 1, write_bodies, read_bodies},    {"contacts", 1, write_contacts, read_contacts},
-    {"joints", 1, write_joints, read_joints},
+    {"globals", 1, write_globals, read_globals},    {"rng", 1, write_rng_section, read_rng},
+    {"geometry", 1, write_geometry, read_geometry}, {"bodies", 2, write_bodies, read_bodies},
+    {"contacts", 1, write_contacts, read_contacts}, {"joints", 1, write_joints, read_joints},
 };
 constexpr std::size_t kSectionCount = std::size(kSections);
 
@@ -417,6 +417,9 @@ std::vector<std::uint8_t> World::save() const {
 
 Status World::restore(std::span<const std::uint8_t> bytes) {
   auto scratch = std::make_unique<sim_detail::WorldState>();
+  // The geometry is the world's definition, not the state's: the state names it by hash, and
+  // read_geometry checks it against this world's.
+  scratch->geometries = s_->geometries;
   std::string error;
   if (!sim_detail::read_state(bytes, *scratch, error)) return Status::error(error);
   s_ = std::move(scratch);

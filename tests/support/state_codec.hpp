@@ -1,24 +1,26 @@
-// An independent codec of the v4 world-state layout (docs/STATE.md), for the world-state tests
+// An independent codec of the v5 world-state layout (docs/STATE.md), for the world-state tests
 // (support/state_helpers.hpp includes it).
 //
 // Written from docs/STATE.md, not from state_io.cpp, so that the two can disagree. In brief:
-//   "DSIM" u32 version=4 | var section count (5) | five sections, each: var name length, name,
-//   var section version (1), u32 payload length, payload. The payloads, in this order:
-//   globals: u64 frame | u32 next ID | definition (fixed width);  rng: 4 x u64;
+//   "DSIM" u32 version=5 | var section count (6) | six sections, each: var name length, name,
+//   var section version (bodies 2, the others 1), u32 payload length, payload. The payloads, in
+//   this order: globals: u64 frame | u32 next ID | definition (fixed width);  rng: 4 x u64;
+//   geometry: var count, then per geometry u8 type (1 convex hull), u64 content hash;
 //   bodies: u32 property-set count, sets in first-use order | u32 body count, bodies ascending by
 //   ID;  contacts: u32 contact count, contacts ascending by (a, b);  joints: u32 next joint ID,
 //   u32 joint count, joints ascending by ID.
 // `var` is canonical LEB128 (at most 5 bytes for a 32-bit field, 10 for a 64-bit one); `vfixed` a
-// var of the zigzag raw value. A set: type u8, shape (type u8, then its vfixed sizes), mass,
-// inertia, friction, restitution, linear and angular damping (vfixed), layer u32, mask u32, flags
-// u8 (sensor, CCD). A body: ID step var, set index var, flags u8 (awake, user data, force, torque
-// follow), position, orientation, velocities, sleep time (vfixed), then the flagged values. A
-// contact: a step var, b - a var, point byte (count in bits 0-2, reported in bit 3), then per
-// point: feature on a, feature on b (var: index * 4 + kind), three impulses (vfixed). A joint: ID
-// step var, type u8 (0-5), body a var, body b var, flags u8 (limit enabled, motor enabled, collide
-// connected, broken, user data follows), anchor, axis (vec3), eleven definition numbers (vfixed),
-// local anchors a and b, local axes a and b (vec3), relative orientation (quat), length (vfixed),
-// linear and angular impulse (vec3), axial, motor and limit impulse (vfixed), then the user data.
+// var of the zigzag raw value. A set: type u8, shape (type u8, then its vfixed sizes, or a convex
+// hull's geometry ID var), mass, inertia, centre of mass (vec3), inertia axes (quat), friction,
+// restitution, linear and angular damping (vfixed), layer u32, mask u32, flags u8 (sensor, CCD). A
+// body: ID step var, set index var, flags u8 (awake, user data, force, torque follow), position,
+// orientation, velocities, sleep time (vfixed), then the flagged values. A contact: a step var, b -
+// a var, point byte (count in bits 0-2, reported in bit 3), then per point: feature on a, feature
+// on b (var: index * 4 + kind), three impulses (vfixed). A joint: ID step var, type u8 (0-5), body
+// a var, body b var, flags u8 (limit enabled, motor enabled, collide connected, broken, user data
+// follows), anchor, axis (vec3), eleven definition numbers (vfixed), local anchors a and b, local
+// axes a and b (vec3), relative orientation (quat), length (vfixed), linear and angular impulse
+// (vec3), axial, motor and limit impulse (vfixed), then the user data.
 //
 // decode() is strict about what the layout itself says (canonical vars, enum values, flag bits,
 // zero values flagged present, set order and use, ID and pair order, point bytes, features) and
@@ -47,11 +49,19 @@ namespace detsim::state_test {
 using Bytes = std::vector<std::uint8_t>;
 
 inline constexpr std::uint32_t kStateMagic = 0x4D495344U;
-inline constexpr std::uint32_t kStateVersion = 4;
-/// A World's sections, in their order, each at version 1.
-inline constexpr const char* kSectionNames[] = {"globals", "rng", "bodies", "contacts", "joints"};
-inline constexpr std::size_t kSectionCount = 5;
-inline constexpr std::uint32_t kSectionVersion = 1;
+inline constexpr std::uint32_t kStateVersion = 5;
+/// A World's sections, in their order, and their versions.
+inline constexpr const char* kSectionNames[] = {"globals", "rng",      "geometry",
+                                                "bodies",  "contacts", "joints"};
+inline constexpr std::size_t kSectionCount = 6;
+inline constexpr std::uint32_t kSectionVersions[] = {1, 1, 1, 2, 1, 1};
+// Each section's index in the lists above.
+inline constexpr std::size_t kGlobals = 0;
+inline constexpr std::size_t kRngSection = 1;
+inline constexpr std::size_t kGeometry = 2;
+inline constexpr std::size_t kBodies = 3;
+inline constexpr std::size_t kContacts = 4;
+inline constexpr std::size_t kJoints = 5;
 
 // Body flags.
 inline constexpr std::uint8_t kAwake = 1;
@@ -158,6 +168,8 @@ struct DecodedSet {
   Shape shape{};
   Fixed mass{};
   Vec3 inertia{};
+  Vec3 center_of_mass{};
+  Quat inertia_axes{};
   Fixed friction{};
   Fixed restitution{};
   Fixed linear_damping{};
@@ -173,6 +185,7 @@ struct DecodedSet {
 
 inline bool same_properties(const DecodedSet& a, const DecodedSet& b) {
   return a.type == b.type && a.shape == b.shape && a.mass == b.mass && a.inertia == b.inertia &&
+         a.center_of_mass == b.center_of_mass && a.inertia_axes == b.inertia_axes &&
          a.friction == b.friction && a.restitution == b.restitution &&
          a.linear_damping == b.linear_damping && a.angular_damping == b.angular_damping &&
          a.layer == b.layer && a.mask == b.mask && a.flags == b.flags;
@@ -268,6 +281,13 @@ struct DecodedJoint {
   std::size_t end = 0;
 };
 
+/// A geometry entry: its type byte and content hash.
+struct DecodedGeometry {
+  std::uint8_t type = 1;
+  std::uint64_t hash = 0;
+  std::size_t at = 0;  // filled by decode()
+};
+
 struct Decoded {
   bool ok = false;
   std::string error;  // "byte N: what", the first error
@@ -277,6 +297,7 @@ struct Decoded {
   std::uint32_t next_id = 1;
   WorldDef def;
   Rng::State rng{};
+  std::vector<DecodedGeometry> geometries;
   std::vector<DecodedSet> sets;
   std::vector<DecodedBody> bodies;
   std::vector<DecodedContact> contacts;
@@ -291,6 +312,7 @@ struct Decoded {
   std::size_t next_id_at = 0;
   std::size_t def_at = 0;
   std::size_t rng_at = 0;
+  std::size_t geometry_count_at = 0;
   std::size_t property_count_at = 0;
   std::size_t body_count_at = 0;
   std::size_t contact_count_at = 0;
@@ -437,12 +459,17 @@ inline DecodedSet read_set(StateReader& r) {
       break;
     case ShapeType::plane:
       break;
+    case ShapeType::convex:
+      s.shape.geometry = GeometryId{static_cast<std::uint32_t>(r.var("geometry ID", 32))};
+      break;
     default:
-      r.fail(shape_at, "shape type: not 1 to 4");
+      r.fail(shape_at, "shape type: not 1 to 4 or 6");
   }
   s.mass_at = r.at();
   s.mass = r.vfixed("mass");
   s.inertia = r.vvec3("inertia");
+  s.center_of_mass = r.vvec3("centre of mass");
+  s.inertia_axes = r.vquat("inertia axes");
   s.friction = r.vfixed("friction");
   s.restitution = r.vfixed("restitution");
   s.linear_damping = r.vfixed("linear damping");
@@ -600,7 +627,7 @@ inline void read_joint(StateReader& r, Decoded& d, std::uint64_t& previous_id) {
   d.joints.push_back(j);
 }
 
-/// Decodes a whole v4 state; `ok` is false and `error` names the first problem otherwise (what was
+/// Decodes a whole v5 state; `ok` is false and `error` names the first problem otherwise (what was
 /// decoded up to there is kept).
 inline Decoded decode(std::span<const std::uint8_t> bytes) {
   Decoded d;
@@ -611,7 +638,7 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
   if (r.ok() && d.version != kStateVersion) r.fail(4, "version");
   const std::size_t count_at = r.at();
   const std::uint64_t sections = r.var("section count", 64);
-  if (r.ok() && sections != kSectionCount) r.fail(count_at, "section count: not 5");
+  if (r.ok() && sections != kSectionCount) r.fail(count_at, "section count: not 6");
   for (std::size_t i = 0; i < kSectionCount && r.ok(); ++i) {
     // The section's record: its name, its version, its payload's length; the payload must end
     // exactly where the length says.
@@ -623,7 +650,7 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
     if (r.ok() && name != kSectionNames[i])
       r.fail(d.section_at[i], std::string("section name: not ") + kSectionNames[i]);
     const std::size_t version_at = r.at();
-    if (r.var("section version", 32) != kSectionVersion && r.ok())
+    if (r.var("section version", 32) != kSectionVersions[i] && r.ok())
       r.fail(version_at, "section version");
     d.section_length_at[i] = r.at();
     const std::uint32_t length = r.u32("section length");
@@ -643,7 +670,20 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
         for (std::uint64_t& word : d.rng)
           word = r.u64("rng");
         break;
-      case 2: {
+      case kGeometry: {
+        d.geometry_count_at = r.at();
+        const std::uint64_t count = r.var("geometry count", 64);
+        for (std::uint64_t k = 0; k < count && r.ok(); ++k) {
+          DecodedGeometry g;
+          g.at = r.at();
+          g.type = r.u8("geometry type");
+          if (r.ok() && g.type != 1) r.fail(g.at, "geometry type: not 1");
+          g.hash = r.u64("geometry hash");
+          d.geometries.push_back(g);
+        }
+        break;
+      }
+      case kBodies: {
         d.property_count_at = r.at();
         const std::uint32_t set_count = r.u32("property-set count");
         for (std::uint32_t k = 0; k < set_count && r.ok(); ++k) {
@@ -662,7 +702,7 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
         if (r.ok() && used != d.sets.size()) r.fail(d.property_count_at, "property set: unused");
         break;
       }
-      case 4: {
+      case kJoints: {
         d.next_joint_id_at = r.at();
         d.next_joint_id = r.u32("next joint ID");
         if (r.ok() && d.next_joint_id == 0) r.fail(d.next_joint_id_at, "next joint ID: zero");
@@ -742,11 +782,16 @@ inline void write_set(StateWriter& w, const DecodedSet& s) {
       w.vfixed(s.shape.radius);
       w.vfixed(s.shape.half_height);
       break;
+    case ShapeType::convex:
+      w.var(s.shape.geometry.value);
+      break;
     default:
       break;
   }
   w.vfixed(s.mass);
   w.vvec3(s.inertia);
+  w.vvec3(s.center_of_mass);
+  w.vquat(s.inertia_axes);
   w.vfixed(s.friction);
   w.vfixed(s.restitution);
   w.vfixed(s.linear_damping);
@@ -807,7 +852,7 @@ inline void write_joint(StateWriter& w, const DecodedJoint& j) {
   if ((j.flags & kJointHasUserData) != 0) w.var(j.user_data);
 }
 
-/// The v4 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
+/// The v5 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
 /// sizes of the vectors, the section lengths those of the payloads written).
 inline Bytes encode(const Decoded& d) {
   StateWriter payloads[kSectionCount];
@@ -831,20 +876,25 @@ inline Bytes encode(const Decoded& d) {
   globals.fixed(def.sleep_angular_speed);
   globals.fixed(def.time_to_sleep);
   for (const std::uint64_t word : d.rng)
-    payloads[1].u64(word);
-  payloads[2].u32(static_cast<std::uint32_t>(d.sets.size()));
+    payloads[kRngSection].u64(word);
+  payloads[kGeometry].var(d.geometries.size());
+  for (const DecodedGeometry& g : d.geometries) {
+    payloads[kGeometry].u8(g.type);
+    payloads[kGeometry].u64(g.hash);
+  }
+  payloads[kBodies].u32(static_cast<std::uint32_t>(d.sets.size()));
   for (const DecodedSet& s : d.sets)
-    write_set(payloads[2], s);
-  payloads[2].u32(static_cast<std::uint32_t>(d.bodies.size()));
+    write_set(payloads[kBodies], s);
+  payloads[kBodies].u32(static_cast<std::uint32_t>(d.bodies.size()));
   for (const DecodedBody& b : d.bodies)
-    write_body(payloads[2], b);
-  payloads[3].u32(static_cast<std::uint32_t>(d.contacts.size()));
+    write_body(payloads[kBodies], b);
+  payloads[kContacts].u32(static_cast<std::uint32_t>(d.contacts.size()));
   for (const DecodedContact& c : d.contacts)
-    write_contact(payloads[3], c);
-  payloads[4].u32(d.next_joint_id);
-  payloads[4].u32(static_cast<std::uint32_t>(d.joints.size()));
+    write_contact(payloads[kContacts], c);
+  payloads[kJoints].u32(d.next_joint_id);
+  payloads[kJoints].u32(static_cast<std::uint32_t>(d.joints.size()));
   for (const DecodedJoint& j : d.joints)
-    write_joint(payloads[4], j);
+    write_joint(payloads[kJoints], j);
 
   StateWriter w;
   w.u32(d.magic);
@@ -855,7 +905,7 @@ inline Bytes encode(const Decoded& d) {
     w.var(name.size());
     for (const char c : name)
       w.u8(static_cast<std::uint8_t>(c));
-    w.var(kSectionVersion);
+    w.var(kSectionVersions[i]);
     const Bytes payload = payloads[i].take();
     w.u32(static_cast<std::uint32_t>(payload.size()));
     for (const std::uint8_t b : payload)

@@ -4,12 +4,23 @@
 // snapshots field by field and compared bitwise, and the narrowphase dispatches on `type`.
 #pragma once
 
+#include <compare>
 #include <cstdint>
 
 #include <detsim/fixed/fixed.hpp>
 #include <detsim/fixed/vec3.hpp>
 
 namespace detsim {
+
+/// Geometry registered with a World (World::create_convex_hull, ...): immutable, referred to by
+/// shapes through this ID. IDs are assigned in creation order (1, 2, 3, ...) and never reused;
+/// zero is the null ID. A geometry ID means something only in the world that made it.
+struct GeometryId {
+  std::uint32_t value = 0;
+
+  [[nodiscard]] constexpr bool is_null() const noexcept { return value == 0; }
+  friend constexpr auto operator<=>(GeometryId, GeometryId) noexcept = default;
+};
 
 /// The kinds of shape. The numeric values are part of the canonical state encoding: never
 /// renumber, only append.
@@ -18,6 +29,7 @@ enum class ShapeType : std::uint8_t {
   box = 2,      ///< oriented box centred on the body's origin
   capsule = 3,  ///< segment along the body's local y axis, swept by a sphere
   plane = 4,    ///< half-space below the body's local y = 0 plane; static bodies only
+  convex = 6,   ///< a convex hull registered with the world (World::create_convex_hull)
 };
 
 /// A shape in the body's local frame (lengths in metres).
@@ -27,23 +39,31 @@ enum class ShapeType : std::uint8_t {
 ///   (0, +half_height, 0).
 /// - plane: no parameters. Solid below the plane through the body's position whose outward normal
 ///   is the body's local +y axis, rotated by its orientation. Only a static body can have one.
+/// - convex: `geometry`, a convex hull of the body's world (its points are in the body's frame;
+///   its centre of mass need not be the body's origin).
 /// Fields that a type does not use are zero. Build shapes with the named constructors.
 struct Shape {
   ShapeType type = ShapeType::sphere;
   Fixed radius{};
   Fixed half_height{};
   Vec3 half_extents{};
+  GeometryId geometry{};
 
   [[nodiscard]] static constexpr Shape sphere(Fixed radius) noexcept {
-    return {ShapeType::sphere, radius, {}, {}};
+    return {ShapeType::sphere, radius, {}, {}, {}};
   }
   [[nodiscard]] static constexpr Shape box(Vec3 half_extents) noexcept {
-    return {ShapeType::box, {}, {}, half_extents};
+    return {ShapeType::box, {}, {}, half_extents, {}};
   }
   [[nodiscard]] static constexpr Shape capsule(Fixed radius, Fixed half_height) noexcept {
-    return {ShapeType::capsule, radius, half_height, {}};
+    return {ShapeType::capsule, radius, half_height, {}, {}};
   }
-  [[nodiscard]] static constexpr Shape plane() noexcept { return {ShapeType::plane, {}, {}, {}}; }
+  [[nodiscard]] static constexpr Shape plane() noexcept {
+    return {ShapeType::plane, {}, {}, {}, {}};
+  }
+  [[nodiscard]] static constexpr Shape convex(GeometryId hull) noexcept {
+    return {ShapeType::convex, {}, {}, {}, hull};
+  }
 
   friend constexpr bool operator==(const Shape&, const Shape&) noexcept = default;
 };

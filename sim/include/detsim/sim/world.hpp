@@ -16,8 +16,10 @@
 
 #include <detsim/core/rng.hpp>
 #include <detsim/core/status.hpp>
+#include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
 #include <detsim/sim/joint.hpp>
+#include <detsim/sim/mass.hpp>
 #include <detsim/sim/state_sections.hpp>
 #include <detsim/sim/world_def.hpp>
 
@@ -35,10 +37,15 @@ struct BodyState {
   Shape shape{};
   Vec3 position{};
   Quat orientation{};
-  Vec3 linear_velocity{};
+  Vec3 linear_velocity{};   ///< of the centre of mass (the origin, for the primitives)
   Vec3 angular_velocity{};  ///< world space
   Fixed mass{};    ///< kg: what the body weighs while dynamic (kept while kinematic or static)
-  Vec3 inertia{};  ///< principal moments in the body frame, kg m^2, like mass
+  Vec3 inertia{};  ///< principal moments, kg m^2, like mass (about inertia_axes)
+  /// The centre of mass in the body frame (m): what the body rotates about. Zero for the
+  /// primitives; world_center() gives it in world space. Set from the shape, like mass.
+  Vec3 center_of_mass{};
+  /// The principal axes of inertia in the body frame (MassProperties::inertia_axes).
+  Quat inertia_axes{};
   Fixed friction{};
   Fixed restitution{};
   Fixed linear_damping{};
@@ -52,6 +59,10 @@ struct BodyState {
   Fixed sleep_time{};  ///< seconds the body has been slow enough to sleep
   Vec3 force{};        ///< accumulated for the next step, then cleared
   Vec3 torque{};
+
+  /// The centre of mass in world space: position + orientation * center_of_mass. linear_velocity
+  /// is this point's velocity.
+  [[nodiscard]] Vec3 world_center() const noexcept;
 
   friend constexpr bool operator==(const BodyState&, const BodyState&) noexcept = default;
 };
@@ -149,6 +160,22 @@ class World {
   [[nodiscard]] const WorldDef& def() const noexcept;
   /// Steps taken since creation (restored by restore()).
   [[nodiscard]] std::uint64_t frame() const noexcept;
+
+  // ---- Geometry: immutable, registered once, referred to by ID (docs/SIM.md, "Shapes") ----
+
+  /// Registers the convex hull of `points` (body frame, metres): duplicate, coplanar and interior
+  /// points are fine, and their order does not matter. Refused, with a message naming what is
+  /// wrong: more than 4096 points, a component beyond +-10^4 m, fewer than 4 points that are not
+  /// coplanar (a flat or degenerate cloud), or a hull of more than 256 corners.
+  Expected<GeometryId> create_convex_hull(std::span<const Vec3> points);
+  /// Registered geometries, 0 .. n-1 being IDs 1 .. n (geometry is never removed).
+  [[nodiscard]] std::size_t geometry_count() const noexcept;
+  /// The content hash of a geometry (XXH3-64 of its canonical encoding, docs/STATE.md): equal
+  /// for equal geometry in any world, on any machine. An error for an unknown ID.
+  [[nodiscard]] Expected<std::uint64_t> geometry_hash(GeometryId id) const;
+  /// The mass properties that a dynamic body of `shape` and the given mass would have (mass > 0;
+  /// the same as detsim::mass_properties for a primitive); an error for an invalid shape.
+  [[nodiscard]] Expected<MassProperties> mass_properties(const Shape& shape, Fixed mass) const;
 
   // ---- Bodies ----
 

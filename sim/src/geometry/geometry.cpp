@@ -1,0 +1,88 @@
+// The world's geometry: registration (World::create_convex_hull, ...), content hashes, and the
+// queries on it (geometry/geometry.hpp).
+#include "geometry.hpp"
+
+#include <detsim/core/hash.hpp>
+#include <detsim/sim/world.hpp>
+
+#include "../shapes.hpp"
+#include "../world_state.hpp"
+
+namespace detsim {
+
+namespace sim_detail {
+
+const char* geometry_type_name(GeometryType type) noexcept {
+  switch (type) {
+    case GeometryType::convex_hull:
+      return "convex hull";
+  }
+  return "unknown geometry";
+}
+
+// The corners define the hull: build_hull of them gives it back, bit for bit (every corner of a
+// hull is a corner of the hull of its corners, and the build depends on the set of points only).
+void write_hull_content(const Hull& hull, ByteWriter& w) {
+  w.var(hull.vertices.size());
+  for (const Vec3 v : hull.vertices)
+    w.var_vec3(v);
+}
+
+std::shared_ptr<const Geometry> make_hull_geometry(Hull hull) {
+  auto g = std::make_shared<Geometry>();
+  g->type = GeometryType::convex_hull;
+  ByteWriter w;
+  w.u8(static_cast<std::uint8_t>(g->type));
+  write_hull_content(hull, w);
+  g->hash = hash64(w.bytes());
+  g->hull = std::move(hull);
+  return g;
+}
+
+namespace {
+
+// Geometry IDs are 32-bit like body IDs; a world that registered this many has bigger problems.
+constexpr std::size_t kMaxGeometries = 0xFFFFFFFEU;
+
+Expected<GeometryId> add(WorldState& s, std::shared_ptr<const Geometry> g) {
+  if (s.geometries.size() >= kMaxGeometries)
+    return Status::error("geometry IDs exhausted (2^32 - 2 registered)");
+  s.geometries.push_back(std::move(g));
+  return GeometryId{static_cast<std::uint32_t>(s.geometries.size())};
+}
+
+}  // namespace
+
+}  // namespace sim_detail
+
+Vec3 BodyState::world_center() const noexcept {
+  // rotate(q, 0) is exactly zero, so a primitive's centre is its position, bit for bit.
+  return position + rotate(orientation, center_of_mass);
+}
+
+Expected<GeometryId> World::create_convex_hull(std::span<const Vec3> points) {
+  auto hull = sim_detail::build_hull(points);
+  if (!hull) return Status::error("invalid convex hull: " + hull.message());
+  return sim_detail::add(*s_, sim_detail::make_hull_geometry(std::move(*hull)));
+}
+
+std::size_t World::geometry_count() const noexcept {
+  return s_->geometries.size();
+}
+
+Expected<std::uint64_t> World::geometry_hash(GeometryId id) const {
+  const sim_detail::Geometry* g = sim_detail::find_geometry(s_->geometries, id);
+  if (g == nullptr)
+    return Status::error("no geometry with ID " + std::to_string(id.value) + " (" +
+                         std::to_string(s_->geometries.size()) + " registered)");
+  return g->hash;
+}
+
+Expected<MassProperties> World::mass_properties(const Shape& shape, Fixed mass) const {
+  if (auto e = sim_detail::check_shape(s_->geometries, shape, BodyType::dynamic); !e.empty())
+    return Status::error("invalid shape: " + e);
+  if (mass <= Fixed::zero()) return Status::error("mass must be > 0, got " + to_string(mass));
+  return sim_detail::shape_kind(shape.type).mass_properties(shape, s_->geometry(shape), mass);
+}
+
+}  // namespace detsim

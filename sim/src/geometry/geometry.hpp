@@ -1,0 +1,60 @@
+// The world's table of registered geometry. Internal to detsim::sim.
+//
+// Geometry (convex hulls today; meshes, heightfields and compounds next) is immutable once built:
+// a World copy shares it (shared_ptr to const), which keeps the copies a rollback session makes
+// cheap. It is part of the world's definition, not of its per-frame state: the "geometry" state
+// section lists each geometry's ID, type and content hash (not its data), so a snapshot stays
+// small however large a level's mesh is, and restore refuses a state naming geometry that the
+// world does not have (state_geometry.cpp).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <detsim/core/bytes.hpp>
+#include <detsim/sim/shape.hpp>
+
+#include "hull.hpp"
+
+namespace detsim::sim_detail {
+
+/// The kinds of geometry. The numeric values are part of the canonical encoding: never renumber.
+enum class GeometryType : std::uint8_t { convex_hull = 1 };
+
+/// "convex hull": in messages.
+[[nodiscard]] const char* geometry_type_name(GeometryType type) noexcept;
+
+/// One registered geometry: its type, its content hash (XXH3-64 of its canonical encoding) and
+/// its data (the member of its type).
+struct Geometry {
+  GeometryType type = GeometryType::convex_hull;
+  std::uint64_t hash = 0;
+  Hull hull;
+};
+
+/// Registered geometry in ID order: entry i has ID i + 1.
+using GeometryTable = std::vector<std::shared_ptr<const Geometry>>;
+
+/// The geometry of `id`, or nullptr when the table has no such ID.
+[[nodiscard]] inline const Geometry* find_geometry(const GeometryTable& table,
+                                                   GeometryId id) noexcept {
+  if (id.value == 0 || id.value > table.size()) return nullptr;
+  return table[id.value - 1].get();
+}
+
+/// The geometry a shape refers to: nullptr for the primitives (and for an ID the table lacks,
+/// which a checked shape never has).
+[[nodiscard]] inline const Geometry* shape_geometry(const GeometryTable& table,
+                                                    const Shape& shape) noexcept {
+  return shape.geometry.is_null() ? nullptr : find_geometry(table, shape.geometry);
+}
+
+/// The canonical encoding of a hull's content (its corners, in order), which its hash covers and
+/// from which build_hull rebuilds the same hull.
+void write_hull_content(const Hull& hull, ByteWriter& w);
+
+/// A geometry of hull `hull`, its hash computed.
+[[nodiscard]] std::shared_ptr<const Geometry> make_hull_geometry(Hull hull);
+
+}  // namespace detsim::sim_detail
