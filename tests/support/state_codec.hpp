@@ -432,13 +432,14 @@ inline DecodedSet read_set(StateReader& r) {
       s.shape.half_extents = r.vvec3("half extents");
       break;
     case ShapeType::capsule:
+    case ShapeType::cylinder:
       s.shape.radius = r.vfixed("radius");
       s.shape.half_height = r.vfixed("half height");
       break;
     case ShapeType::plane:
       break;
     default:
-      r.fail(shape_at, "shape type: not 1 to 4");
+      r.fail(shape_at, "shape type: not 1 to 5");
   }
   s.mass_at = r.at();
   s.mass = r.vfixed("mass");
@@ -739,6 +740,7 @@ inline void write_set(StateWriter& w, const DecodedSet& s) {
       w.vvec3(s.shape.half_extents);
       break;
     case ShapeType::capsule:
+    case ShapeType::cylinder:
       w.vfixed(s.shape.radius);
       w.vfixed(s.shape.half_height);
       break;
