@@ -299,7 +299,10 @@ TEST(Hull, RotatedBoxHasTheBoxPrincipalMomentsAndAxesThatReproduceTheTensor) {
   const Vec3 h{0.5_fx, 1_fx, 1.5_fx};
   Rng rng(5);
   for (int trial = 0; trial < 5; ++trial) {
-    const Quat q = from_axis_angle(rng.unit_vector(), rng.uniform(0_fx, 3_fx));
+    // Drawn one statement at a time: the order of a call's arguments is unspecified, and the
+    // test must draw the same numbers with every compiler.
+    const Vec3 axis = rng.unit_vector();
+    const Quat q = from_axis_angle(axis, rng.uniform(0_fx, 3_fx));
     const Vec3 at{rng.uniform(-5_fx, 5_fx), rng.uniform(-5_fx, 5_fx), rng.uniform(-5_fx, 5_fx)};
     std::vector<Vec3> points;
     for (const Vec3 c : box_corners(h))
@@ -351,8 +354,9 @@ TEST(Hull, RandomCloudsGiveValidHulls) {
     for (int i = 0; i < n; ++i) {
       const Vec3 p = trial % 2 == 0 ? Vec3{rng.uniform(-size, size), rng.uniform(-size, size),
                                            rng.uniform(-size, size)}
-                                    : rng.unit_vector() * (size * rng.uniform(0.9_fx, 1_fx));
-      points.push_back(p + Vec3{7_fx, -3_fx, 1_fx});
+                                    : rng.unit_vector() * size;
+      const Fixed shell = rng.uniform(0.9_fx, 1_fx);  // round clouds: in a shell, not on a sphere
+      points.push_back((trial % 2 == 0 ? p : p * shell) + Vec3{7_fx, -3_fx, 1_fx});
     }
     const auto built = build_hull(points);
     if (!built.ok()) {
@@ -446,7 +450,10 @@ TEST(Inertia, RandomSymmetricTensorsAreReconstructed) {
   Rng rng(21);
   double worst = 0;
   for (int trial = 0; trial < 200; ++trial) {
-    const Quat q = from_axis_angle(rng.unit_vector(), rng.uniform(0_fx, 3_fx));
+    // Drawn one statement at a time: the order of a call's arguments is unspecified, and the
+    // test must draw the same numbers with every compiler.
+    const Vec3 axis = rng.unit_vector();
+    const Quat q = from_axis_angle(axis, rng.uniform(0_fx, 3_fx));
     const Fixed scale = trial % 3 == 0 ? 0.001_fx : (trial % 3 == 1 ? 1_fx : 1000_fx);
     const Vec3 m{rng.uniform(0.1_fx, 10_fx) * scale, rng.uniform(0.1_fx, 10_fx) * scale,
                  rng.uniform(0.1_fx, 10_fx) * scale};

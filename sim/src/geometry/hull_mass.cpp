@@ -13,9 +13,10 @@
 //
 // Precision: o is the bounding box's centre, so no coordinate exceeds half the extent and the
 // centroid is near o (no cancellation in "second moment - centroid centroid^T"). The coordinates
-// are then scaled by a power of two so that the largest lies in [1, 2): every product of up to
-// five of them stays below 2^8 and keeps 32 fraction bits whatever the hull's size (a 1 mm hull
-// and a 1 km hull are computed alike), and the results are scaled back exactly by shifts. Each
+// are then scaled by a power of two so that the largest lies in [1, 2): a determinant is below
+// (2 sqrt 3)^3 < 2^6, a factor of the second moment below 48 and their product below 2^11, far
+// inside the range, and every term keeps 32 fraction bits whatever the hull's size (a 1 mm hull
+// and a 1 km hull are computed alike); the results are scaled back by shifts (exact upwards). Each
 // determinant is an exact sum rounded once; each tetrahedron's moments are det times an exactly
 // summed factor, and all of them are summed exactly (ProductSum) and rounded once per entry. So
 // the volume, centroid and tensor are within a few 2^-32 of the largest term, relative to the
