@@ -351,7 +351,7 @@ Status Builder::add_eye(std::uint32_t start) {
     std::vector<std::uint16_t>().swap(face.outside);
     face.alive = false;
   }
-  // Freed in reverse so that the next faces reuse the lowest of them first.
+  // Freed in reverse, so that later faces reuse the slots in the order the faces were found.
   for (auto it = visible.rbegin(); it != visible.rend(); ++it)
     free_.push_back(*it);
   std::vector<std::uint32_t> all;
