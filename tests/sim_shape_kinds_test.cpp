@@ -34,8 +34,9 @@ std::shared_ptr<const sim_detail::Geometry> hull_of(std::span<const Vec3> points
   return sim_detail::make_hull_geometry(std::move(*hull));
 }
 
-// Convex hulls about the origin (the contract's "centre"): a cube's corners, and a rock of 12
-// points from the RNG on an ellipsoid.
+// Convex hulls about the origin (the contract's "centre", which for a hull is its centroid): a
+// cube's corners, and a rock of 12 points from the RNG on an ellipsoid, in opposite pairs so that
+// its centroid is the origin.
 std::vector<Example> hull_examples() {
   std::vector<Vec3> cube;
   for (const int i : {0, 1, 2, 3, 4, 5, 6, 7})
@@ -43,9 +44,10 @@ std::vector<Example> hull_examples() {
                     (i & 4) != 0 ? 0.5_fx : -0.5_fx});
   Rng rng(5);
   std::vector<Vec3> rock;
-  for (int i = 0; i < 12; ++i) {
+  for (int i = 0; i < 6; ++i) {
     const Vec3 u = rng.unit_vector();
     rock.push_back({u.x * 2_fx, u.y, u.z * 0.75_fx});
+    rock.push_back(-rock.back());
   }
   std::vector<Example> out;
   for (const auto& points : {cube, rock}) {
@@ -72,6 +74,9 @@ std::vector<Example> examples(ShapeType type) {
       return plain({Shape::capsule(0.3_fx, 1_fx), Shape::capsule(0.5_fx, 0_fx)});
     case ShapeType::plane:
       return plain({Shape::plane()});
+    case ShapeType::cylinder:
+      return plain({Shape::cylinder(0.5_fx, 1_fx), Shape::cylinder(2_fx, 0.05_fx),
+                    Shape::cylinder(0.25_fx, 1.5_fx)});
     case ShapeType::convex:
       return hull_examples();
   }
@@ -238,6 +243,70 @@ TEST(ShapeKinds, TheEncodingReadsBackTheSameShapeAndNothingMore) {
       EXPECT_EQ(r.remaining(), 1U) << kind->name;
     }
   }
+}
+
+// The cylinder's mass properties against its closed forms: V = pi r^2 H, I_axis = m r^2 / 2,
+// I_across = m (3 r^2 + H^2) / 12 with the full height H = 2 h. (1e-6 relative needs moments
+// well above the Fixed resolution, 2^-32: a 1 cm radius's m r^2 / 2 is only ~10^6 ulp.)
+TEST(ShapeKinds, CylinderMassPropertiesAreTheClosedForms) {
+  double worst = 0;
+  for (const Example& example : examples(ShapeType::cylinder)) {
+    const Shape& s = example.shape;
+    const double r = s.radius.to_double();
+    const double big_h = 2 * s.half_height.to_double();
+    const double pi = 3.14159265358979323846;
+    const double m = 3.5;
+    const double want_volume = pi * r * r * big_h;
+    const double want_axis = m * r * r / 2;
+    const double want_across = m * (3 * r * r + big_h * big_h) / 12;
+    const MassProperties p = mass_properties(s, 3.5_fx);
+    const auto rel = [](Fixed got, double want) { return std::abs(got.to_double() - want) / want; };
+    for (const double e : {rel(volume(s), want_volume), rel(p.inertia.y, want_axis),
+                           rel(p.inertia.x, want_across), rel(p.inertia.z, want_across)}) {
+      EXPECT_LT(e, 1e-6) << s.radius.to_double() << " " << s.half_height.to_double();
+      worst = std::max(worst, e);
+    }
+  }
+  std::printf("cylinder mass properties: worst relative error %.3g\n", worst);
+}
+
+TEST(ShapeKinds, CylinderChecksEncodingAndBounds) {
+  const ShapeKind& kind = *find_shape_kind(ShapeType::cylinder);
+  EXPECT_EQ(kind.check(Shape::cylinder(0_fx, 1_fx)), "cylinder radius must be > 0, got 0");
+  EXPECT_EQ(kind.check(Shape::cylinder(1_fx, 0_fx)), "cylinder half height must be > 0, got 0");
+  EXPECT_EQ(kind.check(Shape::cylinder(1_fx, 10001_fx)),
+            "cylinder half height must be <= 10000, got 10001");
+  EXPECT_EQ(kind.check(Shape::cylinder(10001_fx, 1_fx)),
+            "cylinder radius must be <= 10000, got 10001");
+  // The encoding: radius then half height, as var_fixed each (docs/STATE.md).
+  ByteWriter w;
+  kind.write(Shape::cylinder(0.5_fx, 2_fx), w);
+  ByteWriter want;
+  want.var_fixed(0.5_fx);
+  want.var_fixed(2_fx);
+  EXPECT_EQ(w.bytes(), want.bytes());
+  // Exact bounds: upright, the box is (r, h, r); lying along x, (h, r, r); tilted 45 degrees
+  // about z, h / sqrt 2 + r / sqrt 2 across x and y.
+  const Shape s = Shape::cylinder(0.5_fx, 2_fx);
+  EXPECT_EQ(kind.aabb_extent(s, nullptr, Mat3::identity()), (Vec3{0.5_fx, 2_fx, 0.5_fx}));
+  EXPECT_NEAR(kind.bounding_radius(s, nullptr).to_double(), std::sqrt(4.25), 1e-9);
+  EXPECT_EQ(kind.smallest_dimension(s, nullptr), 0.5_fx);
+  const Mat3 tilt = to_mat3(from_axis_angle(Vec3::unit_z(), Fixed::pi() / 4_fx));
+  const Vec3 e = kind.aabb_extent(s, nullptr, tilt);
+  EXPECT_NEAR(e.x.to_double(), 2.5 / std::sqrt(2.0), 1e-8);
+  EXPECT_NEAR(e.y.to_double(), 2.5 / std::sqrt(2.0), 1e-8);
+  EXPECT_NEAR(e.z.to_double(), 0.5, 1e-8);
+  // Rays onto an end and onto the side.
+  const auto top = kind.ray(s, nullptr, {0.1_fx, 5_fx, 0.2_fx}, {0_fx, -1_fx, 0_fx});
+  ASSERT_TRUE(top.has_value());
+  EXPECT_EQ(top->t, 3_fx);
+  EXPECT_EQ(top->normal, Vec3::unit_y());
+  const auto side = kind.ray(s, nullptr, {-3_fx, 1.5_fx, 0_fx}, {1_fx, 0_fx, 0_fx});
+  ASSERT_TRUE(side.has_value());
+  EXPECT_EQ(side->t, 2.5_fx);
+  EXPECT_EQ(side->normal, -Vec3::unit_x());
+  EXPECT_FALSE(kind.ray(s, nullptr, {-3_fx, 2.5_fx, 0_fx}, {1_fx, 0_fx, 0_fx}).has_value());  // above it
+  EXPECT_FALSE(kind.ray(s, nullptr, {0.6_fx, 5_fx, 0_fx}, {0_fx, -1_fx, 0_fx}).has_value());  // beside it
 }
 
 // The outlines a viewer draws, from each shape's definition.

@@ -244,7 +244,7 @@ TEST_F(RejectedRestore, UnknownShapeOrBodyType) {
   const auto sphere_set = static_cast<std::size_t>(decoded_.bodies[1].set);
   ASSERT_EQ(decoded_.sets[sphere_set].shape.type, ShapeType::sphere);
   for (const std::uint8_t type :
-       {std::uint8_t{0}, std::uint8_t{5}, std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
+       {std::uint8_t{0}, std::uint8_t{7}, std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
     Decoded d = decoded_;
     d.sets[sphere_set].shape.type = static_cast<ShapeType>(type);
     d.sets[sphere_set].shape.radius = Fixed{};

@@ -512,7 +512,8 @@ Manifold primitive(const PosedShape& a, const PosedShape& b, Fixed margin) noexc
 
 /// One row per pair of shape types that can touch, with a.type <= b.type: a new shape type adds
 /// its rows here (and its pair functions). Pairs without a row have no manifold: two planes, which
-/// are static and unbounded.
+/// are static and unbounded, and for now any pair with a cylinder (the generic convex narrowphase
+/// will add those rows).
 struct PairRow {
   ShapeType a;
   ShapeType b;

@@ -1,12 +1,12 @@
 // One home per shape type. Internal to detsim::sim.
 //
 // Everything the library does with a shape that depends on its type lives in that type's file
-// (shape_sphere.cpp, shape_box.cpp, shape_capsule.cpp, shape_plane.cpp) as one ShapeKind: its
-// checks, mass properties, bounds, ray and containment tests, canonical encoding and outline. The
-// rest of the library asks the kind (shape_kind(type)) and never switches on ShapeType, so a new
-// type is its file, a row in shapes.cpp's table and its rows in the collision pair table
-// (collide.cpp) — docs/ARCHITECTURE.md has the checklist. Pair functions, which belong to two
-// types, stay in the narrowphase files.
+// (shape_sphere.cpp, shape_box.cpp, shape_capsule.cpp, shape_plane.cpp, shape_cylinder.cpp) as one
+// ShapeKind: its checks, mass properties, bounds, ray and containment tests, canonical encoding and
+// outline. The rest of the library asks the kind (shape_kind(type)) and never switches on
+// ShapeType, so a new type is its file, a row in shapes.cpp's table and its rows in the collision
+// pair table (collide.cpp) — docs/ARCHITECTURE.md has the checklist. Pair functions, which belong
+// to two types, stay in the narrowphase files.
 //
 // Precision rules shared by every kind: sizes are at most 10^4 m (check), so squares and products
 // of sizes stay far inside the Fixed range; each function keeps its own precision argument.
@@ -111,6 +111,7 @@ extern const ShapeKind sphere_kind;
 extern const ShapeKind box_kind;
 extern const ShapeKind capsule_kind;
 extern const ShapeKind plane_kind;
+extern const ShapeKind cylinder_kind;
 extern const ShapeKind convex_kind;
 
 /// Every kind, ascending by type.

@@ -454,6 +454,7 @@ inline DecodedSet read_set(StateReader& r) {
       s.shape.half_extents = r.vvec3("half extents");
       break;
     case ShapeType::capsule:
+    case ShapeType::cylinder:
       s.shape.radius = r.vfixed("radius");
       s.shape.half_height = r.vfixed("half height");
       break;
@@ -463,7 +464,7 @@ inline DecodedSet read_set(StateReader& r) {
       s.shape.geometry = GeometryId{static_cast<std::uint32_t>(r.var("geometry ID", 32))};
       break;
     default:
-      r.fail(shape_at, "shape type: not 1 to 4 or 6");
+      r.fail(shape_at, "shape type: not 1 to 6");
   }
   s.mass_at = r.at();
   s.mass = r.vfixed("mass");
@@ -779,6 +780,7 @@ inline void write_set(StateWriter& w, const DecodedSet& s) {
       w.vvec3(s.shape.half_extents);
       break;
     case ShapeType::capsule:
+    case ShapeType::cylinder:
       w.vfixed(s.shape.radius);
       w.vfixed(s.shape.half_height);
       break;

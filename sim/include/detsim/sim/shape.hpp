@@ -25,11 +25,12 @@ struct GeometryId {
 /// The kinds of shape. The numeric values are part of the canonical state encoding: never
 /// renumber, only append.
 enum class ShapeType : std::uint8_t {
-  sphere = 1,   ///< centred on the body's origin
-  box = 2,      ///< oriented box centred on the body's origin
-  capsule = 3,  ///< segment along the body's local y axis, swept by a sphere
-  plane = 4,    ///< half-space below the body's local y = 0 plane; static bodies only
-  convex = 6,   ///< a convex hull registered with the world (World::create_convex_hull)
+  sphere = 1,    ///< centred on the body's origin
+  box = 2,       ///< oriented box centred on the body's origin
+  capsule = 3,   ///< segment along the body's local y axis, swept by a sphere
+  plane = 4,     ///< half-space below the body's local y = 0 plane; static bodies only
+  cylinder = 5,  ///< flat-ended cylinder along the body's local y axis
+  convex = 6,    ///< a convex hull registered with the world (World::create_convex_hull)
 };
 
 /// A shape in the body's local frame (lengths in metres).
@@ -37,6 +38,9 @@ enum class ShapeType : std::uint8_t {
 /// - box: every component of `half_extents` > 0.
 /// - capsule: `radius` > 0, `half_height` >= 0: the core segment runs from (0, -half_height, 0) to
 ///   (0, +half_height, 0).
+/// - cylinder: `radius` > 0, `half_height` > 0: the axis runs from (0, -half_height, 0) to
+///   (0, +half_height, 0), with flat ends. (No collision pairs yet: it collides with nothing until
+///   the convex narrowphase handles it.)
 /// - plane: no parameters. Solid below the plane through the body's position whose outward normal
 ///   is the body's local +y axis, rotated by its orientation. Only a static body can have one.
 /// - convex: `geometry`, a convex hull of the body's world (its points are in the body's frame;
@@ -63,6 +67,9 @@ struct Shape {
   }
   [[nodiscard]] static constexpr Shape convex(GeometryId hull) noexcept {
     return {ShapeType::convex, {}, {}, {}, hull};
+  }
+  [[nodiscard]] static constexpr Shape cylinder(Fixed radius, Fixed half_height) noexcept {
+    return {ShapeType::cylinder, radius, half_height, {}, {}};
   }
 
   friend constexpr bool operator==(const Shape&, const Shape&) noexcept = default;

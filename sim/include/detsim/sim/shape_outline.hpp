@@ -12,9 +12,9 @@ namespace detsim {
 
 /// A shape placed in the world, as a viewer draws it: the convex hull of `points` grown by
 /// `radius` (a sphere: its centre and radius; a capsule: the two ends of its core and its radius;
-/// a box: its eight corners, radius 0), or, for a plane (`half_space`), the solid below the plane
-/// through `points[0]` with outward unit normal `normal`. For display only: nothing the
-/// simulation computes depends on it.
+/// a box: its eight corners, radius 0; a cylinder: 16 points on each end circle, radius 0), or, for
+/// a plane (`half_space`), the solid below the plane through `points[0]` with outward unit normal
+/// `normal`. For display only: nothing the simulation computes depends on it.
 struct ShapeOutline {
   bool half_space = false;
   std::vector<Vec3> points;
