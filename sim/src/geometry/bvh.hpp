@@ -1,0 +1,130 @@
+// A bounding volume hierarchy over the triangles of static geometry (mesh.hpp), and the ray-box
+// test that every hierarchical query of triangles (the BVH, the heightfield's height pyramid)
+// uses. Internal to detsim::sim.
+//
+// Why our own code rather than a library's BVH: determinism demands that the tree be a function of
+// the data only. Library builders (Bullet's quantized BVH, Embree, Jolt's) split with floating
+// point SAH costs, sort with unstable sorts or build in parallel, so the same triangles give
+// different trees on different compilers, flags or thread counts — and although a tree's shape
+// should not change a query's answer, the content hash, the order of overlap results, the
+// traversal's cost and any tie left open would. This one splits at the median along the longest
+// axis of the centroids, ties broken by triangle index, in integer and Fixed arithmetic only, so
+// the same triangles give the same nodes, bit for bit, everywhere.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <detsim/fixed/fixed.hpp>
+#include <detsim/fixed/vec3.hpp>
+
+#include "triangle.hpp"
+
+namespace detsim::sim_detail {
+
+/// The most items in one leaf.
+inline constexpr std::uint32_t bvh_leaf_size = 4;
+/// The deepest a tree may be: the median split halves the items at every level, so 2^20
+/// triangles need at most 19 levels; the traversal's fixed stack is sized from this.
+inline constexpr std::uint32_t bvh_max_depth = 40;
+
+/// One node: its bounds (exact componentwise min and max of its items' bounds), and either two
+/// children (count == 0: the left child is the next node, the right child is node `first`) or a
+/// leaf's items (count in 1..bvh_leaf_size: Bvh::items[first, first + count)).
+struct BvhNode {
+  Bounds bounds;
+  std::uint32_t first = 0;
+  std::uint32_t count = 0;
+  friend bool operator==(const BvhNode&, const BvhNode&) = default;
+};
+
+/// A flat tree in depth-first order (node 0 is the root); empty for no items.
+struct Bvh {
+  std::vector<BvhNode> nodes;
+  std::vector<std::uint32_t> items;  ///< the leaves' items: indices into the bounds given to build
+  std::uint32_t depth = 0;           ///< levels below the root
+  friend bool operator==(const Bvh&, const Bvh&) = default;
+};
+
+/// The tree over items 0..n-1 with the given bounds (n = bounds.size() <= 2^31). At each node, the
+/// items are ordered by their centroid (min + max, exact) along the longest axis of the centroids'
+/// bounds (ties to the lower axis), ties by index, and split at the middle.
+[[nodiscard]] Bvh build_bvh(std::span<const Bounds> bounds);
+
+/// A ray p + v t prepared for box tests: the reciprocal of each component of v. Boxes are tested
+/// grown by box_margin, so that no rounding of the triangle tests (a few ulps of the geometry's
+/// size, plus t * 2^-32) can put a hit outside the box of its triangle.
+struct RayBox {
+  Vec3 origin;
+  std::array<Fixed, 3> inverse;  ///< 1 / v_i
+  std::array<bool, 3> parallel;  ///< |v_i| <= 2^-31: the ray moves < box_margin along axis i
+  static constexpr Fixed box_margin = Fixed::from_raw(Fixed::one_raw >> 12);  // ~0.24 mm
+
+  RayBox(Vec3 p, Vec3 v) noexcept;
+  /// The t at which the ray enters `b` (grown by the margin), when it meets it for some t in
+  /// [0, max_t]; 0 when p is inside. An underestimate of the true entry, never more.
+  [[nodiscard]] std::optional<Fixed> entry(const Bounds& b, Fixed max_t) const noexcept;
+};
+
+/// Calls test(item) for every item of a leaf the ray p + v t, t in [0, limit], reaches; `limit`
+/// may shrink during the traversal (test lowers it to its best hit's t), which prunes every node
+/// entered beyond it. Nodes at exactly `limit` are still visited, so a tie at the same t can be
+/// resolved by index in `test`. The nearer child is visited first.
+template <class Test>
+void bvh_raycast(const Bvh& bvh, const RayBox& ray, const Fixed& limit, Test&& test) {
+  if (bvh.nodes.empty()) return;
+  std::array<std::uint32_t, 2 * bvh_max_depth + 2> stack;
+  std::size_t size = 0;
+  if (!ray.entry(bvh.nodes[0].bounds, limit)) return;
+  stack[size++] = 0;
+  while (size > 0) {
+    const std::uint32_t index = stack[--size];
+    const BvhNode& node = bvh.nodes[index];
+    if (node.count > 0) {
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
+        test(bvh.items[i]);
+      continue;
+    }
+    const std::uint32_t left = index + 1;
+    const std::uint32_t right = node.first;
+    const auto enter_left = ray.entry(bvh.nodes[left].bounds, limit);
+    const auto enter_right = ray.entry(bvh.nodes[right].bounds, limit);
+    if (enter_left && enter_right) {
+      const bool left_first = *enter_left <= *enter_right;
+      stack[size++] = left_first ? right : left;  // the far one waits
+      stack[size++] = left_first ? left : right;
+    } else if (enter_left) {
+      stack[size++] = left;
+    } else if (enter_right) {
+      stack[size++] = right;
+    }
+  }
+}
+
+/// Calls visit(item) for every item in a leaf whose node bounds overlap the closed box [lo, hi];
+/// the caller tests each item's own bounds.
+template <class Visit>
+void bvh_overlap(const Bvh& bvh, Vec3 lo, Vec3 hi, Visit&& visit) {
+  if (bvh.nodes.empty()) return;
+  std::array<std::uint32_t, 2 * bvh_max_depth + 2> stack;
+  std::size_t size = 0;
+  stack[size++] = 0;
+  while (size > 0) {
+    const std::uint32_t index = stack[--size];
+    const BvhNode& node = bvh.nodes[index];
+    if (!overlaps(node.bounds, lo, hi)) continue;
+    if (node.count > 0) {
+      for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
+        visit(bvh.items[i]);
+      continue;
+    }
+    stack[size++] = node.first;
+    stack[size++] = index + 1;
+  }
+}
+
+}  // namespace detsim::sim_detail
