@@ -338,7 +338,9 @@ void write(const Heightfield& hf, ByteWriter& w) {
 }
 
 Expected<Heightfield> read_heightfield(ByteReader& r) {
-  if (r.u8("heightfield version") != 1 && r.ok()) r.fail("heightfield version", "version 1");
+  const std::size_t start = r.offset();
+  if (r.u8("heightfield version") != 1 && r.ok())
+    r.fail_at(start, "heightfield version", "version 1");
   HeightfieldDef def;
   def.rows = r.var32("heightfield rows");
   def.columns = r.var32("heightfield columns");

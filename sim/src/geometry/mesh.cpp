@@ -212,7 +212,8 @@ void write(const Mesh& mesh, ByteWriter& w) {
 }
 
 Expected<Mesh> read_mesh(ByteReader& r) {
-  if (r.u8("mesh version") != 1 && r.ok()) r.fail("mesh version", "version 1");
+  const std::size_t start = r.offset();
+  if (r.u8("mesh version") != 1 && r.ok()) r.fail_at(start, "mesh version", "version 1");
   // A vertex takes at least 3 bytes and a triangle at least 3: counts beyond what the bytes left
   // can hold are refused before the vectors are sized.
   const std::uint32_t vertex_count = r.var32("mesh vertex count");
