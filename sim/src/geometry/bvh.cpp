@@ -134,42 +134,20 @@ Bvh build_bvh(std::span<const Bounds> bounds) {
   return Builder(bounds).build();
 }
 
-RayBox::RayBox(Vec3 p, Vec3 v) noexcept : origin(p), inverse{}, parallel{} {
+RayBox::RayBox(Vec3 p, Vec3 v) noexcept : origin_plus_{}, origin_minus_{}, inverse_{}, parallel_{} {
   // Below 2^-31 the ray moves less than 2^16 * 2^-31 = 2^-15 m along the axis over the longest
   // distance that can reach geometry (< 2^16 m with p and the geometry in range): well inside the
   // margin, so such an axis is treated as parallel (and its reciprocal, which would saturate, is
   // not used).
   const Fixed tiny = Fixed::from_raw(2);
   for (int i = 0; i < 3; ++i) {
-    const Fixed vi = axis_of(v, i);
-    parallel[static_cast<std::size_t>(i)] = abs(vi) <= tiny;
-    inverse[static_cast<std::size_t>(i)] = abs(vi) <= tiny ? Fixed::zero() : Fixed::one() / vi;
-  }
-}
-
-std::optional<Fixed> RayBox::entry(const Bounds& b, Fixed max_t) const noexcept {
-  Fixed enter = Fixed::zero();
-  Fixed exit = max_t;
-  for (int i = 0; i < 3; ++i) {
     const auto k = static_cast<std::size_t>(i);
-    const Fixed p = axis_of(origin, i);
-    const Fixed lo = axis_of(b.min, i) - box_margin;
-    const Fixed hi = axis_of(b.max, i) + box_margin;
-    if (parallel[k]) {
-      if (p < lo || p > hi) return std::nullopt;
-      continue;
-    }
-    // The reciprocal's relative error (2^-32) and the product's rounding move these by far less
-    // than the margin's box_margin / |v_i| >= box_margin in t; saturated products act as
-    // infinities of the right sign.
-    Fixed near = (lo - p) * inverse[k];
-    Fixed far = (hi - p) * inverse[k];
-    if (inverse[k] < Fixed::zero()) std::swap(near, far);
-    enter = max(enter, near);
-    exit = min(exit, far);
-    if (enter > exit) return std::nullopt;
+    const Fixed vi = axis_of(v, i);
+    origin_plus_[k] = axis_of(p, i) + box_margin;
+    origin_minus_[k] = axis_of(p, i) - box_margin;
+    parallel_[k] = abs(vi) <= tiny;
+    inverse_[k] = parallel_[k] ? Fixed::zero() : Fixed::one() / vi;
   }
-  return enter;
 }
 
 }  // namespace detsim::sim_detail

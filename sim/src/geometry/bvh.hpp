@@ -20,6 +20,7 @@
 #include <vector>
 
 #include <detsim/fixed/fixed.hpp>
+#include <detsim/fixed/math.hpp>
 #include <detsim/fixed/vec3.hpp>
 
 #include "triangle.hpp"
@@ -58,16 +59,46 @@ struct Bvh {
 /// A ray p + v t prepared for box tests: the reciprocal of each component of v. Boxes are tested
 /// grown by box_margin, so that no rounding of the triangle tests (a few ulps of the geometry's
 /// size, plus t * 2^-32) can put a hit outside the box of its triangle.
-struct RayBox {
-  Vec3 origin;
-  std::array<Fixed, 3> inverse;  ///< 1 / v_i
-  std::array<bool, 3> parallel;  ///< |v_i| <= 2^-31: the ray moves < box_margin along axis i
+class RayBox {
+ public:
   static constexpr Fixed box_margin = Fixed::from_raw(Fixed::one_raw >> 12);  // ~0.24 mm
 
   RayBox(Vec3 p, Vec3 v) noexcept;
+
   /// The t at which the ray enters `b` (grown by the margin), when it meets it for some t in
-  /// [0, max_t]; 0 when p is inside. An underestimate of the true entry, never more.
-  [[nodiscard]] std::optional<Fixed> entry(const Bounds& b, Fixed max_t) const noexcept;
+  /// [0, max_t]; 0 when p is inside. An underestimate of the true entry, never more. Inline: the
+  /// traversals call it twice per node, and it is most of their time.
+  [[nodiscard]] std::optional<Fixed> entry(const Bounds& b, Fixed max_t) const noexcept {
+    Fixed enter = Fixed::zero();
+    Fixed exit = max_t;
+    const std::array<Fixed, 3> lo = {b.min.x, b.min.y, b.min.z};
+    const std::array<Fixed, 3> hi = {b.max.x, b.max.y, b.max.z};
+    for (std::size_t i = 0; i < 3; ++i) {
+      // (b.min - margin) - p == b.min - (p + margin), and the same for the upper side.
+      const Fixed below = lo[i] - origin_plus_[i];
+      const Fixed above = hi[i] - origin_minus_[i];
+      if (parallel_[i]) {
+        if (below > Fixed::zero() || above < Fixed::zero()) return std::nullopt;
+        continue;
+      }
+      // The reciprocal's relative error (2^-32) and the product's rounding move these by far
+      // less than the margin's box_margin / |v_i| >= box_margin in t; saturated products act as
+      // infinities of the right sign.
+      const Fixed t_below = below * inverse_[i];
+      const Fixed t_above = above * inverse_[i];
+      const bool backwards = inverse_[i] < Fixed::zero();
+      enter = max(enter, backwards ? t_above : t_below);
+      exit = min(exit, backwards ? t_below : t_above);
+    }
+    if (enter > exit) return std::nullopt;
+    return enter;
+  }
+
+ private:
+  std::array<Fixed, 3> origin_plus_;   ///< p + box_margin
+  std::array<Fixed, 3> origin_minus_;  ///< p - box_margin
+  std::array<Fixed, 3> inverse_;       ///< 1 / v_i, or 0 where parallel
+  std::array<bool, 3> parallel_;       ///< |v_i| <= 2^-31: the ray moves < box_margin along i
 };
 
 /// Calls test(item) for every item of a leaf the ray p + v t, t in [0, limit], reaches; `limit`
