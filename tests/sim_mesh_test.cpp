@@ -373,11 +373,8 @@ TEST(MeshBvh, IsDeterministicBoundedAndCoversEveryTriangleOnce) {
   EXPECT_EQ(a->bvh, b->bvh);
   const Bvh& bvh = a->bvh;
   const std::uint32_t n = triangle_count(*a);
-  // Median splits: depth <= ceil(log2(ceil(n / 4))).
-  std::uint32_t bound = 0;
-  while ((std::uint32_t{4} << bound) < n)
-    ++bound;
-  EXPECT_LE(bvh.depth, bound);
+  EXPECT_LE(bvh.depth, bvh_max_depth);
+  EXPECT_GE(bvh.depth, 9U);  // at least ceil(log2(ceil(n / 4))) levels hold n items by fours
   std::vector<int> seen(n, 0);
   for (std::size_t i = 0; i < bvh.nodes.size(); ++i) {
     const BvhNode& node = bvh.nodes[i];
@@ -398,6 +395,48 @@ TEST(MeshBvh, IsDeterministicBoundedAndCoversEveryTriangleOnce) {
     }
   }
   EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(n));
+}
+
+// Triangles whose gaps shrink geometrically (x_i = 9000 (1 - 0.995^i)): a skewed input still gives
+// a bounded tree, and every ray finds what brute force finds.
+TEST(MeshBvh, DepthIsBoundedOnSkewedInput) {
+  std::vector<Vec3> v;
+  std::vector<std::uint32_t> idx;
+  Fixed x = Fixed::zero();
+  Fixed gap = fx(45);
+  for (std::uint32_t i = 0; i < 3000; ++i) {
+    const auto base = static_cast<std::uint32_t>(v.size());
+    v.insert(v.end(), {{x, {}, {}}, {x, {}, fx(1)}, {x + 0.01_fx, fx(1), {}}});
+    idx.insert(idx.end(), {base, base + 1, base + 2});
+    x += gap;
+    gap = gap * 0.995_fx;
+  }
+  const Mesh m = build_mesh(v, idx).value();
+  EXPECT_LE(m.bvh.depth, bvh_max_depth);
+  const Soup s = soup_of(m);
+  Rng rng(1);
+  for (int i = 0; i < 2000; ++i) {
+    const Ray r = random_ray(rng, m.bounds);
+    ASSERT_TRUE(same_hit(raycast(m, r.p, r.v, r.max_t), brute_force(s, r.p, r.v, r.max_t)))
+        << "ray " << i;
+  }
+}
+
+// The median split (what the build uses below bvh_sah_levels, here from the root): a balanced
+// tree of depth ceil(log2(ceil(n / 4))) = 9 for 1800 triangles, which finds the same hits.
+TEST(MeshBvh, MedianSplitsAreBalancedAndFindTheSameHits) {
+  const Landscape l = landscape(31);
+  Mesh m = build_mesh(l.vertices, l.indices).value();
+  const Soup s = soup_of(m);
+  m.bvh = build_bvh(s.bounds, 0);
+  EXPECT_EQ(m.bvh.depth, 9U);
+  EXPECT_EQ(m.bvh, build_bvh(s.bounds, 0));
+  Rng rng(3);
+  for (int i = 0; i < 5000; ++i) {
+    const Ray r = random_ray(rng, m.bounds);
+    ASSERT_TRUE(same_hit(raycast(m, r.p, r.v, r.max_t), brute_force(s, r.p, r.v, r.max_t)))
+        << "ray " << i;
+  }
 }
 
 // A permutation of the triangles (a deterministic shuffle) builds a different tree but finds the

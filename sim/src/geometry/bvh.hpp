@@ -7,9 +7,10 @@
 // point SAH costs, sort with unstable sorts or build in parallel, so the same triangles give
 // different trees on different compilers, flags or thread counts — and although a tree's shape
 // should not change a query's answer, the content hash, the order of overlap results, the
-// traversal's cost and any tie left open would. This one splits at the median along the longest
-// axis of the centroids, ties broken by triangle index, in integer and Fixed arithmetic only, so
-// the same triangles give the same nodes, bit for bit, everywhere.
+// traversal's cost and any tie left open would. This one splits by the surface area heuristic,
+// swept exactly over the items sorted by centroid along each axis (ties by triangle index), with
+// costs in exact integers and a median split below a fixed depth; so the same triangles give the
+// same nodes, bit for bit, everywhere.
 #pragma once
 
 #include <array>
@@ -29,8 +30,10 @@ namespace detsim::sim_detail {
 
 /// The most items in one leaf.
 inline constexpr std::uint32_t bvh_leaf_size = 4;
-/// The deepest a tree may be: the median split halves the items at every level, so 2^20
-/// triangles need at most 19 levels; the traversal's fixed stack is sized from this.
+/// The levels split by the surface area heuristic; deeper ones split at the median.
+inline constexpr std::uint32_t bvh_sah_levels = 20;
+/// The deepest a tree may be: 20 levels of SAH splits, then median splits, which take any 2^20
+/// items to leaves within 18 more; the traversal's fixed stack is sized from this.
 inline constexpr std::uint32_t bvh_max_depth = 40;
 
 /// One node: its bounds (exact componentwise min and max of its items' bounds), and either two
@@ -51,10 +54,14 @@ struct Bvh {
   friend bool operator==(const Bvh&, const Bvh&) = default;
 };
 
-/// The tree over items 0..n-1 with the given bounds (n = bounds.size() <= 2^31). At each node, the
-/// items are ordered by their centroid (min + max, exact) along the longest axis of the centroids'
-/// bounds (ties to the lower axis), ties by index, and split at the middle.
-[[nodiscard]] Bvh build_bvh(std::span<const Bounds> bounds);
+/// The tree over items 0..n-1 with the given bounds (n = bounds.size() <= 2^20, coordinates
+/// within +-10^4 m). At each node of more than bvh_leaf_size items, the items are ordered by their
+/// centroid (min + max, exact) along each axis, ties by index; the first `sah_levels` (<=
+/// bvh_sah_levels) levels split where the surface area heuristic is least (ties to the lower axis,
+/// then the earlier split), deeper ones at the middle of the axis along which the centroids spread
+/// most.
+[[nodiscard]] Bvh build_bvh(std::span<const Bounds> bounds,
+                            std::uint32_t sah_levels = bvh_sah_levels);
 
 /// A ray p + v t prepared for box tests: the reciprocal of each component of v. Boxes are tested
 /// grown by box_margin, so that no rounding of the triangle tests (a few ulps of the geometry's
