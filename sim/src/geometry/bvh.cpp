@@ -9,6 +9,7 @@
 #include "bvh.hpp"
 
 #include <algorithm>
+#include <cstddef>
 #include <utility>
 
 #include <detsim/core/assert.hpp>
@@ -18,6 +19,11 @@
 namespace detsim::sim_detail {
 
 namespace {
+
+/// An index as an iterator offset (explicit: a 32-bit target's ptrdiff_t is as wide as the index).
+std::ptrdiff_t offset(std::uint32_t i) noexcept {
+  return static_cast<std::ptrdiff_t>(i);
+}
 
 Fixed axis_of(Vec3 v, int axis) noexcept {
   return axis == 0 ? v.x : (axis == 1 ? v.y : v.z);
@@ -63,8 +69,9 @@ class Builder {
     bvh_.nodes.push_back({range_bounds(lo, hi), 0, 0});
     if (hi - lo <= bvh_leaf_size) {
       const auto first = static_cast<std::uint32_t>(bvh_.items.size());
-      bvh_.items.insert(bvh_.items.end(), order_[0].begin() + lo, order_[0].begin() + hi);
-      std::sort(bvh_.items.begin() + first, bvh_.items.end());  // distinct indices: no ties
+      bvh_.items.insert(bvh_.items.end(), order_[0].begin() + offset(lo),
+                        order_[0].begin() + offset(hi));
+      std::sort(bvh_.items.begin() + offset(first), bvh_.items.end());  // distinct: no ties
       bvh_.nodes[index].first = first;
       bvh_.nodes[index].count = hi - lo;
       return index;
@@ -177,7 +184,8 @@ class Builder {
         const std::uint32_t item = order[i];
         scratch_[left_[item] != 0 ? l++ : r++] = item;
       }
-      std::copy(scratch_.begin() + lo, scratch_.begin() + hi, order.begin() + lo);
+      std::copy(scratch_.begin() + offset(lo), scratch_.begin() + offset(hi),
+                order.begin() + offset(lo));
     }
   }
 
