@@ -65,7 +65,8 @@ TEST(Geometry, AHullIsNamedByItsContentWhateverItsPoints) {
   EXPECT_NE(*b.geometry_hash(gc), *b.geometry_hash(gb));
   const auto unknown = b.geometry_hash(GeometryId{3});
   ASSERT_FALSE(unknown.ok());
-  EXPECT_NE(unknown.message().find("no geometry with ID 3"), std::string::npos) << unknown.message();
+  EXPECT_NE(unknown.message().find("no geometry with ID 3"), std::string::npos)
+      << unknown.message();
 }
 
 TEST(Geometry, BadHullsAreRefusedAndRegisterNothing) {
@@ -304,8 +305,8 @@ TEST(Geometry, ImpulsesActAboutTheCentreOfMass) {
   const BodyId through_centre = add(w, hull_body(g, {0_fx, 0_fx, 0_fx}));
   const BodyId through_origin = add(w, hull_body(g, {0_fx, 0_fx, 10_fx}));
   const Vec3 up{0_fx, 1_fx, 0_fx};
-  ASSERT_TRUE(w.apply_impulse_at_point(through_centre, up, state(w, through_centre).world_center())
-                  .ok());
+  ASSERT_TRUE(
+      w.apply_impulse_at_point(through_centre, up, state(w, through_centre).world_center()).ok());
   ASSERT_TRUE(w.apply_impulse_at_point(through_origin, up, state(w, through_origin).position).ok());
   EXPECT_EQ(state(w, through_centre).angular_velocity, Vec3{});
   // Arm from the centre to the origin: (-1, 0, 0); (-1, 0, 0) x (0, 1, 0) = (0, 0, -1): about -z.

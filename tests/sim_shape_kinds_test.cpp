@@ -305,8 +305,10 @@ TEST(ShapeKinds, CylinderChecksEncodingAndBounds) {
   ASSERT_TRUE(side.has_value());
   EXPECT_EQ(side->t, 2.5_fx);
   EXPECT_EQ(side->normal, -Vec3::unit_x());
-  EXPECT_FALSE(kind.ray(s, nullptr, {-3_fx, 2.5_fx, 0_fx}, {1_fx, 0_fx, 0_fx}).has_value());  // above it
-  EXPECT_FALSE(kind.ray(s, nullptr, {0.6_fx, 5_fx, 0_fx}, {0_fx, -1_fx, 0_fx}).has_value());  // beside it
+  EXPECT_FALSE(
+      kind.ray(s, nullptr, {-3_fx, 2.5_fx, 0_fx}, {1_fx, 0_fx, 0_fx}).has_value());  // above it
+  EXPECT_FALSE(
+      kind.ray(s, nullptr, {0.6_fx, 5_fx, 0_fx}, {0_fx, -1_fx, 0_fx}).has_value());  // beside it
 }
 
 // The outlines a viewer draws, from each shape's definition.

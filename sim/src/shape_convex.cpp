@@ -11,7 +11,7 @@ namespace detsim::sim_detail {
 namespace convex_shape {
 
 const Hull& hull_of(const Geometry* g) noexcept {
-  return g->hull;
+  return g->hull();
 }
 
 // The geometry (its type included) is checked by check_shape; the shape has no fields of its own.

@@ -29,9 +29,9 @@ Fixed axis_of(Vec3 v, int axis) noexcept {
   return axis == 0 ? v.x : (axis == 1 ? v.y : v.z);
 }
 
-class Builder {
+class BvhBuilder {
  public:
-  Builder(std::span<const Bounds> bounds, std::uint32_t sah_levels)
+  BvhBuilder(std::span<const Bounds> bounds, std::uint32_t sah_levels)
       : bounds_(bounds), sah_levels_(std::min(sah_levels, bvh_sah_levels)) {
     const auto n = static_cast<std::uint32_t>(bounds.size());
     centroids_.resize(n);
@@ -202,7 +202,7 @@ class Builder {
 }  // namespace
 
 Bvh build_bvh(std::span<const Bounds> bounds, std::uint32_t sah_levels) {
-  return Builder(bounds, sah_levels).build();
+  return BvhBuilder(bounds, sah_levels).build();
 }
 
 RayBox::RayBox(Vec3 p, Vec3 v) noexcept : origin_plus_{}, origin_minus_{}, inverse_{}, parallel_{} {

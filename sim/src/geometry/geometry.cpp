@@ -16,6 +16,12 @@ const char* geometry_type_name(GeometryType type) noexcept {
   switch (type) {
     case GeometryType::convex_hull:
       return "convex hull";
+    case GeometryType::mesh:
+      return "triangle mesh";
+    case GeometryType::heightfield:
+      return "heightfield";
+    case GeometryType::compound:
+      return "compound";
   }
   return "unknown geometry";
 }
@@ -35,7 +41,7 @@ std::shared_ptr<const Geometry> make_hull_geometry(Hull hull) {
   w.u8(static_cast<std::uint8_t>(g->type));
   write_hull_content(hull, w);
   g->hash = hash64(w.bytes());
-  g->hull = std::move(hull);
+  g->data = std::move(hull);
   return g;
 }
 

@@ -1,6 +1,6 @@
 // The world's table of registered geometry. Internal to detsim::sim.
 //
-// Geometry (convex hulls today; meshes, heightfields and compounds next) is immutable once built:
+// Geometry (convex hulls, triangle meshes, heightfields, compounds) is immutable once built:
 // a World copy shares it (shared_ptr to const), which keeps the copies a rollback session makes
 // cheap. It is part of the world's definition, not of its per-frame state: the "geometry" state
 // section lists each geometry's ID, type and content hash (not its data), so a snapshot stays
@@ -10,17 +10,21 @@
 
 #include <cstdint>
 #include <memory>
+#include <variant>
 #include <vector>
 
 #include <detsim/core/bytes.hpp>
 #include <detsim/sim/shape.hpp>
 
+#include "compound.hpp"
+#include "heightfield.hpp"
 #include "hull.hpp"
+#include "mesh.hpp"
 
 namespace detsim::sim_detail {
 
 /// The kinds of geometry. The numeric values are part of the canonical encoding: never renumber.
-enum class GeometryType : std::uint8_t { convex_hull = 1 };
+enum class GeometryType : std::uint8_t { convex_hull = 1, mesh = 2, heightfield = 3, compound = 4 };
 
 /// "convex hull": in messages.
 [[nodiscard]] const char* geometry_type_name(GeometryType type) noexcept;
@@ -30,7 +34,12 @@ enum class GeometryType : std::uint8_t { convex_hull = 1 };
 struct Geometry {
   GeometryType type = GeometryType::convex_hull;
   std::uint64_t hash = 0;
-  Hull hull;
+  std::variant<Hull, Mesh, Heightfield, Compound> data;
+
+  [[nodiscard]] const Hull& hull() const { return std::get<Hull>(data); }
+  [[nodiscard]] const Mesh& mesh() const { return std::get<Mesh>(data); }
+  [[nodiscard]] const Heightfield& heightfield() const { return std::get<Heightfield>(data); }
+  [[nodiscard]] const Compound& compound() const { return std::get<Compound>(data); }
 };
 
 /// Registered geometry in ID order: entry i has ID i + 1.

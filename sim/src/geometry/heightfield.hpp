@@ -22,6 +22,7 @@
 #include <detsim/core/status.hpp>
 #include <detsim/fixed/fixed.hpp>
 #include <detsim/fixed/vec3.hpp>
+#include <detsim/sim/geometry.hpp>
 
 #include "triangle.hpp"
 
@@ -34,14 +35,8 @@ inline constexpr std::uint32_t max_heightfield_side = 4096;
 /// threshold of triangle_normal (2^-24 m^2).
 inline constexpr Fixed min_heightfield_cell = Fixed::from_raw(Fixed::one_raw >> 10);
 
-struct HeightfieldDef {
-  std::uint32_t rows = 0;     ///< samples along z, 2..4096
-  std::uint32_t columns = 0;  ///< samples along x, 2..4096
-  /// The spacing of samples (m), >= 2^-10, with (max(rows, columns) - 1) * cell_size <= 10^4.
-  Fixed cell_size;
-  std::vector<Fixed> heights;  ///< rows * columns, row-major, each within +-10^4 m
-  friend bool operator==(const HeightfieldDef&, const HeightfieldDef&) = default;
-};
+/// The public definition (detsim/sim/geometry.hpp), checked by build_heightfield.
+using detsim::HeightfieldDef;
 
 /// The heights of one level of the pyramid: per block of cells, the least and greatest height of
 /// its samples. Level 0 has blocks of 4 x 4 cells; each level above merges 2 x 2 blocks, up to one.

@@ -134,9 +134,9 @@ Status refuse(std::string message) {
   return Status::error("convex hull: " + std::move(message));
 }
 
-class Builder {
+class HullBuilder {
  public:
-  Builder(std::vector<Vec3> points, Fixed tolerance)
+  HullBuilder(std::vector<Vec3> points, Fixed tolerance)
       : p_(std::move(points)), tolerance_(tolerance), slot_(p_.size(), -1) {}
 
   Status build();
@@ -165,7 +165,7 @@ class Builder {
   std::vector<std::vector<std::uint16_t>> loops_;
 };
 
-std::uint32_t Builder::new_face(std::uint16_t a, std::uint16_t b, std::uint16_t c) {
+std::uint32_t HullBuilder::new_face(std::uint16_t a, std::uint16_t b, std::uint16_t c) {
   std::uint32_t f = 0;
   if (free_.empty()) {
     f = static_cast<std::uint32_t>(faces_.size());
@@ -184,7 +184,7 @@ std::uint32_t Builder::new_face(std::uint16_t a, std::uint16_t b, std::uint16_t 
 }
 
 /// Sets the neighbour of f across its edge from -> to to g.
-void Builder::link(std::uint32_t f, std::uint16_t from, std::uint16_t to, std::uint32_t g) {
+void HullBuilder::link(std::uint32_t f, std::uint16_t from, std::uint16_t to, std::uint32_t g) {
   Face& face = faces_[f];
   for (std::size_t i = 0; i < 3; ++i) {
     if (face.v[i] == from && face.v[(i + 1) % 3] == to) face.adj[i] = g;
@@ -194,7 +194,7 @@ void Builder::link(std::uint32_t f, std::uint16_t from, std::uint16_t to, std::u
 /// Puts the point in the outside set of the first candidate face it is more than the tolerance
 /// above; a point above none is inside (within the tolerance) and dropped. Ties for the farthest
 /// point go to the lowest index. Whether it was placed.
-bool Builder::assign(std::uint16_t point, const std::vector<std::uint32_t>& candidates) {
+bool HullBuilder::assign(std::uint16_t point, const std::vector<std::uint32_t>& candidates) {
   for (const std::uint32_t f : candidates) {
     Face& face = faces_[f];
     if (!face.alive) continue;
@@ -211,7 +211,7 @@ bool Builder::assign(std::uint16_t point, const std::vector<std::uint32_t>& cand
   return false;
 }
 
-Status Builder::initial_simplex() {
+Status HullBuilder::initial_simplex() {
   const auto n = static_cast<std::uint16_t>(p_.size());
   // p0 is the lowest point in (x, y, z) order (a vertex of any hull); p1 the farthest from it;
   // p2 the farthest from the line p0 p1; p3 the farthest from the plane p0 p1 p2. Ties: lowest.
@@ -284,7 +284,7 @@ Status Builder::initial_simplex() {
   return Status::success();
 }
 
-Status Builder::add_eye(std::uint32_t start) {
+Status HullBuilder::add_eye(std::uint32_t start) {
   const std::uint16_t eye = faces_[start].furthest;
   const Vec3 e = p_[eye];
   // The faces the eye sees (exactly above their planes): a connected region around `start`.
@@ -370,9 +370,9 @@ Status Builder::add_eye(std::uint32_t start) {
 
 /// The boundary of a group of triangles, counter-clockwise from outside; false unless it is one
 /// simple loop (the group is a disc).
-bool Builder::boundary_loop(const std::vector<std::uint32_t>& group,
-                            const std::vector<std::int32_t>& id, std::int32_t g,
-                            std::vector<std::uint16_t>& loop) {
+bool HullBuilder::boundary_loop(const std::vector<std::uint32_t>& group,
+                                const std::vector<std::int32_t>& id, std::int32_t g,
+                                std::vector<std::uint16_t>& loop) {
   std::vector<std::array<std::uint16_t, 2>> edges;
   for (const std::uint32_t f : group) {
     for (std::size_t i = 0; i < 3; ++i) {
@@ -399,7 +399,7 @@ bool Builder::boundary_loop(const std::vector<std::uint32_t>& group,
   return simple && loop.size() == edges.size() && loop.size() >= 3;
 }
 
-Status Builder::merge() {
+Status HullBuilder::merge() {
   // Groups of triangles within the tolerance of the plane of the group's first (lowest-numbered)
   // triangle, grown across edges. That plane supports the hull exactly (every vertex is on or
   // below it), so a group lies in a slab of the tolerance's width below it.
@@ -458,7 +458,7 @@ Status Builder::merge() {
   return Status::success();
 }
 
-Status Builder::build() {
+Status HullBuilder::build() {
   if (Status s = initial_simplex(); !s) return s;
   const std::size_t cap = 2 * max_hull_vertices;
   for (std::size_t iteration = 0; iteration <= p_.size(); ++iteration) {
@@ -594,7 +594,7 @@ Expected<Hull> build_hull(std::span<const Vec3> points) {
   const Fixed extent = max(hi.x - lo.x, max(hi.y - lo.y, hi.z - lo.z));
   const Fixed tolerance = hull_tolerance(extent);
 
-  Builder builder(std::move(sorted), tolerance);
+  HullBuilder builder(std::move(sorted), tolerance);
   if (Status s = builder.build(); !s) return s;
   const std::vector<Vec3>& p = builder.points();
   auto& loops = builder.loops();
