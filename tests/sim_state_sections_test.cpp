@@ -85,7 +85,7 @@ TEST(StateSections, AWorldsStateIsItsSixSectionsAndTheirHashes) {
   ASSERT_EQ(found->size(), 6U);
   ASSERT_EQ(h.sections.size(), 6U);
   const char* names[] = {"globals", "rng", "geometry", "bodies", "contacts", "joints"};
-  const std::uint32_t versions[] = {1, 1, 1, 2, 1, 1};
+  const std::uint32_t versions[] = {1, 1, 1, 2, 2, 1};
   std::size_t next = 9;  // magic, version, the count 6 in one byte
   for (std::size_t i = 0; i < 6; ++i) {
     const StateSection& s = (*found)[i];

@@ -75,13 +75,15 @@ struct Sweep {
 
 // The signed distance between two posed shapes, as the narrowphase measures it (a lower bound of
 // the true distance when apart), or `beyond` when they are farther apart than that.
+// Over every pair of sub-shapes (a compound's parts, a surface's triangles).
 Fixed distance(const WorldState& s, const Shape& a, const Pose& pa, const Shape& b, const Pose& pb,
-               Fixed beyond) {
-  const Manifold m = collide({a, s.geometry(a), pa}, {b, s.geometry(b), pb}, beyond);
-  if (m.count == 0) return beyond;
-  Fixed d = m.points[0].separation;
-  for (std::size_t k = 1; k < m.count; ++k)
-    d = min(d, m.points[k].separation);
+               Fixed beyond, std::vector<SubManifold>& scratch) {
+  collide_all({a, s.geometry(a), pa}, {b, s.geometry(b), pb}, beyond, scratch);
+  Fixed d = beyond;
+  for (const SubManifold& sub : scratch) {
+    for (std::size_t k = 0; k < sub.manifold.count; ++k)
+      d = min(d, sub.manifold.points[k].separation);
+  }
   return d;
 }
 
@@ -233,7 +235,8 @@ void continuous(WorldState& s) {
     for (std::size_t m = 0; m < movers_now.size(); ++m)
       mover_of[movers_now[m].index] = static_cast<std::uint32_t>(m);
   }
-  std::vector<std::uint32_t> near;  // the current sweep's candidates, ascending
+  std::vector<std::uint32_t> near;   // the current sweep's candidates, ascending
+  std::vector<SubManifold> scratch;  // the narrowphase's output, reused
   std::size_t next_pair = 0;
   for (const Mover& mover : movers_now) {
     const std::size_t i = mover.index;
@@ -284,13 +287,13 @@ void continuous(WorldState& s) {
       const Fixed pair_beyond = pair_bound + target + r;
       // Already touching at the start: the contact solver has it; a sweep would only stick.
       if (distance(s, body.shape, sweep.at(Fixed::zero()), other.shape,
-                   other_sweep.at(Fixed::zero()), pair_beyond) <= target)
+                   other_sweep.at(Fixed::zero()), pair_beyond, scratch) <= target)
         continue;
       Fixed t = Fixed::zero();
       bool stop = true;  // a touch, or out of iterations: t is then the last safe time
       for (int k = 0; k < max_iterations; ++k) {
-        const Fixed gap =
-            distance(s, body.shape, sweep.at(t), other.shape, other_sweep.at(t), pair_beyond);
+        const Fixed gap = distance(s, body.shape, sweep.at(t), other.shape, other_sweep.at(t),
+                                   pair_beyond, scratch);
         if (gap <= target) break;
         // A safe advance that aims for half the target gap, so the loop ends near the surface.
         t += (gap - target / Fixed::from_int(2)) / pair_bound;

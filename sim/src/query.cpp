@@ -142,6 +142,7 @@ std::vector<BodyId> World::overlap(const Shape& shape, Vec3 position, Quat orien
   const Pose query{position, to_mat3(orientation)};
   const sim_detail::Geometry* shape_geometry = s_->geometry(shape);
   const Fixed reach = bounding_radius(shape, shape_geometry);
+  std::vector<sim_detail::SubManifold> manifolds;
   for (const BodyState& b : s_->bodies) {
     if (!passes(b, filter)) continue;
     if (sim_detail::shape_kind(b.shape.type).bounded) {
@@ -151,8 +152,10 @@ std::vector<BodyId> World::overlap(const Shape& shape, Vec3 position, Quat orien
     // collide() accepts its shapes in either order (it swaps them into its canonical one); the
     // normal's direction, the only thing the order changes, does not matter here.
     const Pose pose = pose_of(b);
-    if (touches(sim_detail::collide({shape, shape_geometry, query},
-                                    {b.shape, s_->geometry(b.shape), pose}, Fixed::zero()))) {
+    sim_detail::collide_all({shape, shape_geometry, query}, {b.shape, s_->geometry(b.shape), pose},
+                            Fixed::zero(), manifolds);
+    if (std::any_of(manifolds.begin(), manifolds.end(),
+                    [](const sim_detail::SubManifold& m) { return touches(m.manifold); })) {
       ids.push_back(b.id);
     }
   }

@@ -144,6 +144,6 @@ const ShapeKind cylinder_kind{ShapeType::cylinder,
                               cylinder_shape::write,
                               cylinder_shape::read,
                               cylinder_shape::outline,
- std::nullopt};
+                              std::nullopt};
 
 }  // namespace detsim::sim_detail

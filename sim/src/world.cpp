@@ -137,8 +137,12 @@ Status World::destroy_body(BodyId id) {
       }
     }
   }
-  for (const sim_detail::Contact& c : s_->contacts) {
-    if (c.a == id.value || c.b == id.value) sim_detail::report_end(*s_, c);
+  // One end event per body pair (its first contact: a pair's contacts share the reported flag).
+  for (std::size_t k = 0; k < s_->contacts.size(); ++k) {
+    const sim_detail::Contact& c = s_->contacts[k];
+    const bool first_of_pair =
+        k == 0 || s_->contacts[k - 1].a != c.a || s_->contacts[k - 1].b != c.b;
+    if (first_of_pair && (c.a == id.value || c.b == id.value)) sim_detail::report_end(*s_, c);
   }
   std::erase_if(s_->contacts,
                 [id](const sim_detail::Contact& c) { return c.a == id.value || c.b == id.value; });
@@ -178,6 +182,8 @@ std::vector<ContactState> World::contacts() const {
     ContactState v;
     v.a = BodyId{c.a};
     v.b = BodyId{c.b};
+    v.sub_a = c.sub_a;
+    v.sub_b = c.sub_b;
     v.touching = c.touching;
     v.reported = c.reported;
     v.point_count = c.point_count;

@@ -34,12 +34,19 @@ struct CachedPoint {
   friend constexpr bool operator==(const CachedPoint&, const CachedPoint&) noexcept = default;
 };
 
-/// A pair of bodies whose bounding boxes overlap, a < b. `manifold` is the current geometry
+/// A pair of bodies whose bounding boxes overlap, a < b, and of their sub-shapes: `sub_a` and
+/// `sub_b` name a compound's part or a surface's triangle (0 for a shape that has none), so that a
+/// body pair may hold several contacts, each with its own normal (a box on a stair's tread and
+/// riser, a chair's four legs). A pair of two whole shapes has exactly one, of sub-shapes (0, 0).
+/// Contacts are ordered by (a, b, sub_a, sub_b); the contacts of one body pair are its *group*,
+/// and share the pair's `reported` flag. `manifold` is the current geometry
 /// (recomputed every step while either body is awake; not saved — a sleeping pair's manifold is
 /// recomputed on waking before it is used); `cached` is saved.
 struct Contact {
   std::uint32_t a = 0;
   std::uint32_t b = 0;
+  std::uint32_t sub_a = 0;
+  std::uint32_t sub_b = 0;
   std::uint8_t point_count = 0;  ///< points in `cached` (and in `manifold` after collide)
   bool touching = false;         ///< had at least one point at the last collide
   /// In touch as contact events report it (docs/SIM.md): some point within the speculative
@@ -56,6 +63,14 @@ struct Contact {
   std::array<CachedPoint, 4> cached{};
   Manifold manifold;
 };
+
+/// Whether contact x comes before contact y: ascending (a, b, sub_a, sub_b).
+[[nodiscard]] constexpr bool contact_before(const Contact& x, const Contact& y) noexcept {
+  if (x.a != y.a) return x.a < y.a;
+  if (x.b != y.b) return x.b < y.b;
+  if (x.sub_a != y.sub_a) return x.sub_a < y.sub_a;
+  return x.sub_b < y.sub_b;
+}
 
 /// Per-body data rebuilt at the start of each step (parallel to WorldState::bodies).
 struct Derived {

@@ -54,7 +54,7 @@ inline constexpr std::uint32_t kStateVersion = 5;
 inline constexpr const char* kSectionNames[] = {"globals", "rng",      "geometry",
                                                 "bodies",  "contacts", "joints"};
 inline constexpr std::size_t kSectionCount = 6;
-inline constexpr std::uint32_t kSectionVersions[] = {1, 1, 1, 2, 1, 1};
+inline constexpr std::uint32_t kSectionVersions[] = {1, 1, 1, 2, 2, 1};
 // Each section's index in the lists above.
 inline constexpr std::size_t kGlobals = 0;
 inline constexpr std::size_t kRngSection = 1;
@@ -74,6 +74,7 @@ inline constexpr std::uint8_t kCcd = 2;
 // A contact's point byte.
 inline constexpr std::uint8_t kPointCountBits = 7;
 inline constexpr std::uint8_t kReported = 8;
+inline constexpr std::uint8_t kSubShapes = 16;  // the contact's sub-shapes follow
 // Joint flags.
 inline constexpr std::uint8_t kLimitEnabled = 1;
 inline constexpr std::uint8_t kMotorEnabled = 2;
@@ -231,6 +232,8 @@ struct DecodedContact {
   std::uint64_t a_step = 0;     // a minus the previous contact's a
   std::uint64_t b_minus_a = 0;  // b minus a, at least 1
   std::uint8_t points_byte = 0;
+  std::uint64_t sub_a = 0;  // written when points_byte has kSubShapes
+  std::uint64_t sub_b = 0;
   std::vector<DecodedPoint> points;  // encode() writes all of them, whatever points_byte says
   // Filled by decode(), ignored by encode():
   std::uint32_t a = 0;
@@ -540,7 +543,8 @@ inline bool has_body(const Decoded& d, std::uint64_t id) {
 }
 
 inline void read_contact(StateReader& r, Decoded& d, std::uint64_t& previous_a,
-                         std::uint64_t& previous_b) {
+                         std::uint64_t& previous_b, std::uint64_t& previous_sub_a,
+                         std::uint64_t& previous_sub_b) {
   DecodedContact c;
   c.at = r.at();
   c.a_step = r.var("contact a step", 32);
@@ -549,17 +553,29 @@ inline void read_contact(StateReader& r, Decoded& d, std::uint64_t& previous_a,
   const std::uint64_t a = previous_a + c.a_step;
   const std::uint64_t b = a + c.b_minus_a;
   if (r.ok() && c.b_minus_a == 0) r.fail(c.b_at, "contact b - a: zero");
-  if (r.ok() && !d.contacts.empty() && a == previous_a && b <= previous_b)
-    r.fail(c.at, "contact: not in ascending (a, b) order");
   if (r.ok() && (!has_body(d, a) || !has_body(d, b))) r.fail(c.at, "contact: no such body");
-  previous_a = a;
-  previous_b = b;
   c.a = static_cast<std::uint32_t>(a);
   c.b = static_cast<std::uint32_t>(b);
   c.points_at = r.at();
   c.points_byte = r.u8("contact points");
-  if ((c.points_byte & ~(kPointCountBits | kReported)) != 0)
+  if ((c.points_byte & ~(kPointCountBits | kReported | kSubShapes)) != 0)
     r.fail(c.points_at, "contact points: an unknown bit");
+  if ((c.points_byte & kSubShapes) != 0) {
+    c.sub_a = r.var("contact sub-shape a", 32);
+    c.sub_b = r.var("contact sub-shape b", 32);
+    if (r.ok() && c.sub_a == 0 && c.sub_b == 0) r.fail(c.points_at, "contact sub-shapes: both 0");
+  }
+  // Ascending (a, b, sub_a, sub_b), each once.
+  const auto key = [](std::uint64_t x, std::uint64_t y, std::uint64_t u, std::uint64_t v) {
+    return std::array<std::uint64_t, 4>{x, y, u, v};
+  };
+  if (r.ok() && !d.contacts.empty() &&
+      key(a, b, c.sub_a, c.sub_b) <= key(previous_a, previous_b, previous_sub_a, previous_sub_b))
+    r.fail(c.at, "contact: not in ascending (a, b, sub_a, sub_b) order");
+  previous_a = a;
+  previous_b = b;
+  previous_sub_a = c.sub_a;
+  previous_sub_b = c.sub_b;
   if (c.point_count() > 4) r.fail(c.points_at, "contact points: more than four");
   if (c.reported() && c.point_count() == 0)
     r.fail(c.points_at, "contact points: reported without points");
@@ -567,10 +583,10 @@ inline void read_contact(StateReader& r, Decoded& d, std::uint64_t& previous_a,
     DecodedPoint point;
     point.at = r.at();
     point.feature_a = r.var("feature on a", 32);
-    if (point.feature_a > 1023) r.fail(point.at, "feature on a: beyond 1023");
+    if (point.feature_a > 65535) r.fail(point.at, "feature on a: beyond 65535");
     point.feature_b_at = r.at();
     point.feature_b = r.var("feature on b", 32);
-    if (point.feature_b > 1023) r.fail(point.feature_b_at, "feature on b: beyond 1023");
+    if (point.feature_b > 65535) r.fail(point.feature_b_at, "feature on b: beyond 65535");
     point.normal_impulse_at = r.at();
     point.normal_impulse = r.vfixed("normal impulse");
     point.tangent_impulse_1 = r.vfixed("tangent impulse 1");
@@ -719,8 +735,10 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
         const std::uint32_t contact_count = r.u32("contact count");
         std::uint64_t previous_a = 0;
         std::uint64_t previous_b = 0;
+        std::uint64_t previous_sub_a = 0;
+        std::uint64_t previous_sub_b = 0;
         for (std::uint32_t k = 0; k < contact_count && r.ok(); ++k)
-          read_contact(r, d, previous_a, previous_b);
+          read_contact(r, d, previous_a, previous_b, previous_sub_a, previous_sub_b);
         break;
       }
     }
@@ -821,6 +839,10 @@ inline void write_contact(StateWriter& w, const DecodedContact& c) {
   w.var(c.a_step);
   w.var(c.b_minus_a);
   w.u8(c.points_byte);
+  if ((c.points_byte & kSubShapes) != 0) {
+    w.var(c.sub_a);
+    w.var(c.sub_b);
+  }
   for (const DecodedPoint& p : c.points) {
     w.var(p.feature_a);
     w.var(p.feature_b);

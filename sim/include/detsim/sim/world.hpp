@@ -105,6 +105,10 @@ struct ContactPointState {
 struct ContactState {
   BodyId a{};  ///< the lower ID
   BodyId b{};
+  /// The sub-shapes in touch: a compound's part or a surface's triangle (0 for a whole shape). A
+  /// body pair has one contact per pair of sub-shapes, ascending (a, b, sub_a, sub_b).
+  std::uint32_t sub_a = 0;
+  std::uint32_t sub_b = 0;
   bool touching = false;  ///< had at least one point at the last narrowphase
   bool reported = false;  ///< in touch as contact events report it
   std::uint8_t point_count = 0;
