@@ -1,0 +1,408 @@
+// ConvexView: the per-kind geometry that the convex narrowphase reads (supports, supporting faces,
+// the faces and edges of the separating axis test). One switch per question, one case per kind.
+#include "convex.hpp"
+
+#include <array>
+#include <cstdint>
+
+#include <detsim/fixed/math.hpp>
+#include <detsim/fixed/vec3.hpp>
+
+#include "../collide_util.hpp"
+
+namespace detsim::sim_detail {
+
+using namespace narrow;
+
+ConvexView ConvexView::of(const Shape& s) noexcept {
+  switch (s.type) {
+    case ShapeType::box:
+      return box(s.half_extents);
+    case ShapeType::capsule:
+      return capsule(s.radius, s.half_height);
+    default:
+      return sphere(s.radius);
+  }
+}
+
+namespace convex {
+
+// Named, not anonymous: unity builds put the convex files in one translation unit.
+namespace view_detail {
+
+constexpr unsigned kRim = cylinder_rim_points;
+constexpr unsigned kVertex = static_cast<unsigned>(Kind::vertex);
+constexpr unsigned kEdge = static_cast<unsigned>(Kind::edge);
+constexpr unsigned kFace = static_cast<unsigned>(Kind::face);
+
+/// Rim directions at 22.5 degree steps, built from exact symmetries so that the four axis
+/// directions are exact and opposite points are exact negatives.
+struct RimTable {
+  std::array<Vec3, kRim> at{};
+  RimTable() noexcept {
+    const Fixed two = Fixed::from_int(2);
+    const Fixed c = sqrt(two + Fixed::sqrt2()) >> 1;  // cos 22.5
+    const Fixed s = sqrt(two - Fixed::sqrt2()) >> 1;  // sin 22.5
+    const Fixed h = Fixed::sqrt2() >> 1;
+    const std::array<std::array<Fixed, 2>, 4> quarter{
+        {{Fixed::one(), Fixed::zero()}, {c, s}, {h, h}, {s, c}}};
+    for (unsigned k = 0; k < kRim; ++k) {
+      const auto& q = quarter[k % 4];
+      Fixed x = q[0];
+      Fixed z = q[1];
+      for (unsigned turn = 0; turn < k / 4; ++turn) {  // +90 degrees: (x, z) -> (-z, x)
+        const Fixed t = x;
+        x = -z;
+        z = t;
+      }
+      at[k] = Vec3{x, Fixed::zero(), z};
+    }
+  }
+};
+
+const RimTable& rim_table() noexcept {
+  static const RimTable table;
+  return table;
+}
+
+std::uint16_t box_corner_feature(unsigned bits) noexcept {
+  return box_vertex({(bits & 1U) != 0, (bits & 2U) != 0, (bits & 4U) != 0});
+}
+
+Vec3 box_corner(Vec3 h, unsigned bits) noexcept {
+  return {signed_value((bits & 1U) != 0, h.x), signed_value((bits & 2U) != 0, h.y),
+          signed_value((bits & 4U) != 0, h.z)};
+}
+
+/// The edge of a box between corners u and w (which differ in one bit).
+std::uint16_t box_edge_between(unsigned u, unsigned w) noexcept {
+  const unsigned diff = u ^ w;
+  const int axis = diff == 1U ? 0 : (diff == 2U ? 1 : 2);
+  return box_edge(axis, {(u & 1U) != 0, (u & 2U) != 0, (u & 4U) != 0});
+}
+
+/// The index of hull edge (u, w) in the (a, b)-sorted edge list (binary search), or 0.
+unsigned hull_edge_index(const Hull& hull, std::uint16_t u, std::uint16_t w) noexcept {
+  const std::uint16_t a = u < w ? u : w;
+  const std::uint16_t b = u < w ? w : u;
+  std::size_t lo = 0;
+  std::size_t hi = hull.edges.size();
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    const HullEdge& e = hull.edges[mid];
+    if (e.a < a || (e.a == a && e.b < b)) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  return static_cast<unsigned>(lo);
+}
+
+void push(Face& f, Vec3 p, std::uint16_t vertex, std::uint16_t edge) noexcept {
+  if (f.count >= max_face_points) return;
+  f.points[f.count] = p;
+  f.vertex[f.count] = vertex;
+  f.edge[f.count] = edge;
+  ++f.count;
+}
+
+Face box_face_toward(Vec3 h, Vec3 d) noexcept {
+  const Vec3 m = abs_components(d);
+  int k = 0;
+  if (m.y > component(m, k)) k = 1;
+  if (m.z > component(m, k)) k = 2;
+  const bool positive = component(d, k) >= Fixed::zero();
+  const unsigned ka = static_cast<unsigned>((k + 1) % 3);
+  const unsigned kb = static_cast<unsigned>((k + 2) % 3);
+  // (+,+), (-,+), (-,-), (+,-) over (k+1, k+2) is counter-clockwise about +k.
+  constexpr std::array<std::array<bool, 2>, 4> order{
+      {{true, true}, {false, true}, {false, false}, {true, false}}};
+  std::array<unsigned, 4> bits{};
+  for (unsigned i = 0; i < 4; ++i) {
+    const unsigned j = positive ? i : 3 - i;
+    bits[i] = (positive ? 1U << static_cast<unsigned>(k) : 0U) | (order[j][0] ? 1U << ka : 0U) |
+              (order[j][1] ? 1U << kb : 0U);
+  }
+  Face f;
+  f.normal = axis_vector(k, positive);
+  f.feature = box_face(k, positive);
+  for (unsigned i = 0; i < 4; ++i) {
+    push(f, box_corner(h, bits[i]), box_corner_feature(bits[i]),
+         box_edge_between(bits[i], bits[(i + 1) % 4]));
+  }
+  return f;
+}
+
+Face hull_face_toward(const Hull& hull, Vec3 d) noexcept {
+  Face f;
+  if (hull.faces.empty()) return f;
+  std::size_t best = 0;
+  Fixed best_dot = dot(hull.faces[0].normal, d);
+  for (std::size_t i = 1; i < hull.faces.size(); ++i) {
+    const Fixed x = dot(hull.faces[i].normal, d);
+    if (x > best_dot) {
+      best_dot = x;
+      best = i;
+    }
+  }
+  const HullFace& face = hull.faces[best];
+  f.normal = face.normal;
+  f.feature = convex_feature(kFace, static_cast<unsigned>(best));
+  for (unsigned i = 0; i < face.count && i < max_face_points; ++i) {
+    const std::uint16_t v = hull.face_vertices[face.first + i];
+    const unsigned next = (i + 1 == face.count || i + 1 == max_face_points) ? 0 : i + 1;
+    const std::uint16_t w = hull.face_vertices[face.first + next];
+    push(f, hull.vertices[v], convex_feature(kVertex, v),
+         convex_feature(kEdge, hull_edge_index(hull, v, w)));
+  }
+  return f;
+}
+
+/// The horizontal unit direction of d (local y is the axis), or zero when d is vertical.
+Vec3 radial(Vec3 d) noexcept {
+  return normalize(Vec3{d.x, Fixed::zero(), d.z});
+}
+
+Face cylinder_face_toward(Fixed r, Fixed h, Vec3 d) noexcept {
+  Face f;
+  const Fixed side2 = d.x * d.x + d.z * d.z;
+  if (d.y * d.y >= side2) {  // nearer the axis than the side: a cap
+    const bool top = d.y >= Fixed::zero();
+    f.normal = axis_vector(1, top);
+    f.feature = convex_feature(kFace, top ? 0U : 1U);
+    const RimTable& rim = rim_table();
+    for (unsigned i = 0; i < kRim; ++i) {
+      const unsigned k = top ? i : kRim - 1 - i;  // listed in one turning order on either cap
+      const unsigned k_next = top ? (k + 1) % kRim : (k + kRim - 1) % kRim;
+      const unsigned chord = top ? k : k_next;  // rim chord c joins points c and c + 1
+      Vec3 p = rim.at[k] * r;
+      p.y = signed_value(top, h);
+      push(f, p, convex_feature(kVertex, top ? k : kRim + k),
+           convex_feature(kEdge, top ? 1 + chord : 1 + kRim + chord));
+    }
+    return f;
+  }
+  const Vec3 u = radial(d) * r;
+  f.feature = convex_feature(kEdge, 0);
+  push(f, Vec3{u.x, -h, u.z}, convex_feature(kVertex, 2 * kRim), f.feature);
+  push(f, Vec3{u.x, h, u.z}, convex_feature(kVertex, 2 * kRim + 1), f.feature);
+  return f;
+}
+
+Face capsule_face_toward(Fixed half, Vec3 d) noexcept {
+  Face f;
+  const Vec3 top{Fixed::zero(), half, Fixed::zero()};
+  if (half > Fixed::zero() && d.y * d.y < flat_sin2) {
+    f.feature = capsule_core;
+    push(f, -top, capsule_end(false), capsule_core);
+    push(f, top, capsule_end(true), capsule_core);
+    return f;
+  }
+  const bool up = d.y >= Fixed::zero();
+  f.feature = capsule_end(up);
+  push(f, up ? top : -top, f.feature, f.feature);
+  return f;
+}
+
+}  // namespace view_detail
+
+using namespace view_detail;
+
+Vec3 rim_direction(unsigned i) noexcept {
+  return rim_table().at[i % kRim];
+}
+
+Fixed core_radius(const ConvexView& v) noexcept {
+  return v.kind == ConvexKind::sphere || v.kind == ConvexKind::capsule ? v.radius : Fixed::zero();
+}
+
+Fixed bounding_radius(const ConvexView& v) noexcept {
+  switch (v.kind) {
+    case ConvexKind::sphere:
+      return v.radius;
+    case ConvexKind::capsule:
+      return v.radius + v.half_height;
+    case ConvexKind::box:
+      return length(v.half_extents);
+    case ConvexKind::cylinder:
+      return length(Vec3{v.radius, v.half_height, Fixed::zero()});
+    case ConvexKind::hull:
+      return v.hull->bounding_radius;
+  }
+  return Fixed::zero();
+}
+
+SupportPoint core_support(const ConvexView& v, Vec3 d) noexcept {
+  switch (v.kind) {
+    case ConvexKind::sphere:
+      return {Vec3{}, whole_shape};
+    case ConvexKind::capsule: {
+      const bool up = d.y >= Fixed::zero();
+      return {Vec3{Fixed::zero(), signed_value(up, v.half_height), Fixed::zero()}, capsule_end(up)};
+    }
+    case ConvexKind::box: {
+      const unsigned bits = (d.x >= Fixed::zero() ? 1U : 0U) | (d.y >= Fixed::zero() ? 2U : 0U) |
+                            (d.z >= Fixed::zero() ? 4U : 0U);
+      return {box_corner(v.half_extents, bits), box_corner_feature(bits)};
+    }
+    case ConvexKind::cylinder: {
+      const bool top = d.y >= Fixed::zero();
+      Vec3 p = radial(d) * v.radius;
+      p.y = signed_value(top, v.half_height);
+      const bool on_axis = p.x == Fixed::zero() && p.z == Fixed::zero();
+      return {p, on_axis ? convex_feature(kFace, top ? 0U : 1U)
+                         : convex_feature(kVertex, 2 * kRim + 2 + (top ? 1U : 0U))};
+    }
+    case ConvexKind::hull: {
+      const std::uint16_t i = hull_support(*v.hull, d);
+      return {v.hull->vertices[i], convex_feature(kVertex, i)};
+    }
+  }
+  return {};
+}
+
+Vec3 support(const ConvexView& v, const Pose& pose, Vec3 direction) noexcept {
+  const SupportPoint s = core_support(v, to_local(pose.rotation, direction));
+  const Vec3 p = pose.position + pose.rotation * s.point;
+  const Fixed r = core_radius(v);
+  return r == Fixed::zero() ? p : p + normalize(direction) * r;
+}
+
+Face supporting_face(const ConvexView& v, Vec3 direction) noexcept {
+  const Vec3 d = normalize(direction);
+  switch (v.kind) {
+    case ConvexKind::sphere: {
+      Face f;
+      f.feature = whole_shape;
+      push(f, Vec3{}, whole_shape, whole_shape);
+      return f;
+    }
+    case ConvexKind::capsule:
+      return capsule_face_toward(v.half_height, d);
+    case ConvexKind::box:
+      return box_face_toward(v.half_extents, d);
+    case ConvexKind::cylinder:
+      return cylinder_face_toward(v.radius, v.half_height, d);
+    case ConvexKind::hull:
+      return hull_face_toward(*v.hull, d);
+  }
+  return {};
+}
+
+Face supporting_face(const ConvexView& v, const Pose& pose, Vec3 direction, Vec3 origin) noexcept {
+  Face f = supporting_face(v, to_local(pose.rotation, direction));
+  const Vec3 offset = pose.position - origin;
+  for (unsigned i = 0; i < f.count; ++i)
+    f.points[i] = offset + pose.rotation * f.points[i];
+  if (f.normal != Vec3{}) f.normal = unit_or(pose.rotation * f.normal, f.normal);
+  return f;
+}
+
+unsigned sat_face_count(const ConvexView& v) noexcept {
+  switch (v.kind) {
+    case ConvexKind::box:
+      return 6;
+    case ConvexKind::cylinder:
+      return 2 + kRim;
+    case ConvexKind::hull:
+      return static_cast<unsigned>(v.hull->faces.size());
+    default:
+      return 0;
+  }
+}
+
+SatFace sat_face(const ConvexView& v, unsigned i) noexcept {
+  switch (v.kind) {
+    case ConvexKind::box:
+      return {axis_vector(static_cast<int>(i / 2), i % 2 == 0), true};
+    case ConvexKind::cylinder:
+      if (i < 2) return {axis_vector(1, i == 0), true};
+      return {normalize(rim_direction(i - 2) + rim_direction(i - 1)), false};
+    case ConvexKind::hull:
+      return {v.hull->faces[i].normal, true};
+    default:
+      return {};
+  }
+}
+
+unsigned sat_edge_count(const ConvexView& v) noexcept {
+  switch (v.kind) {
+    case ConvexKind::capsule:
+      return 1;
+    case ConvexKind::box:
+      return 12;
+    case ConvexKind::cylinder:
+      return 3 * kRim;
+    case ConvexKind::hull:
+      return static_cast<unsigned>(v.hull->edges.size());
+    default:
+      return 0;
+  }
+}
+
+SatEdge sat_edge(const ConvexView& v, unsigned i) noexcept {
+  SatEdge e;
+  switch (v.kind) {
+    case ConvexKind::capsule:
+      e.p0 = Vec3{Fixed::zero(), -v.half_height, Fixed::zero()};
+      e.p1 = -e.p0;
+      e.feature = capsule_core;
+      e.circle = true;
+      return e;
+    case ConvexKind::box: {
+      const int axis = static_cast<int>(i / 4);
+      const bool s1 = (i & 1U) != 0;
+      const bool s2 = (i & 2U) != 0;
+      Signs s{};
+      s[static_cast<unsigned>((axis + 1) % 3)] = s1;
+      s[static_cast<unsigned>((axis + 2) % 3)] = s2;
+      const unsigned lo = (s[0] ? 1U : 0U) | (s[1] ? 2U : 0U) | (s[2] ? 4U : 0U);
+      e.p0 = box_corner(v.half_extents, lo);
+      e.p1 = box_corner(v.half_extents, lo | (1U << static_cast<unsigned>(axis)));
+      e.n0 = axis_vector((axis + 1) % 3, s1);
+      e.n1 = axis_vector((axis + 2) % 3, s2);
+      e.feature = box_edge(axis, s);
+      return e;
+    }
+    case ConvexKind::cylinder: {
+      const unsigned k = i % kRim;
+      const Vec3 p = rim_direction(k) * v.radius;
+      const Vec3 q = rim_direction(k + 1) * v.radius;
+      const Vec3 side_before = sat_face(v, 2 + (k + kRim - 1) % kRim).normal;
+      const Vec3 side_after = sat_face(v, 2 + k).normal;
+      const Vec3 up{Fixed::zero(), v.half_height, Fixed::zero()};
+      e.exact = false;
+      e.feature = convex_feature(kEdge, 1 + i);
+      if (i < 2 * kRim) {  // rim chord k of the +y (i < 16) or -y cap
+        const bool top = i < kRim;
+        e.p0 = top ? p + up : p - up;
+        e.p1 = top ? q + up : q - up;
+        e.n0 = axis_vector(1, top);
+        e.n1 = side_after;
+        return e;
+      }
+      e.p0 = p - up;  // a side line, through rim point k: a true line of the cylinder
+      e.p1 = p + up;
+      e.n0 = side_before;
+      e.n1 = side_after;
+      e.exact = true;
+      return e;
+    }
+    case ConvexKind::hull: {
+      const HullEdge& h = v.hull->edges[i];
+      e.p0 = v.hull->vertices[h.a];
+      e.p1 = v.hull->vertices[h.b];
+      e.n0 = v.hull->faces[h.face_0].normal;
+      e.n1 = v.hull->faces[h.face_1].normal;
+      e.feature = convex_feature(kEdge, i);
+      return e;
+    }
+    default:
+      return e;
+  }
+}
+
+}  // namespace convex
+
+}  // namespace detsim::sim_detail

@@ -1,0 +1,244 @@
+// collide_convex: the separating axis test over face normals and Gauss-map-pruned edge pairs
+// (Gregorius, "The Separating Axis Test between Convex Polyhedra", GDC 2013), with every axis
+// measured by the true support functions of the cores; GJK closest points for cores that are
+// apart; then the supporting faces' clipped manifold (convex_manifold.cpp).
+//
+// Why supports rather than face offsets and edge points: a cylinder's axes come from its 16-gon
+// prism, but its extent along any axis is the true cylinder's, so every separation below is a
+// true lower bound of the distance (an axis beyond the margin proves there is no contact) and the
+// flat contacts (a cap, a box or hull face) are measured exactly.
+//
+// Order of decisions (each deterministic, ties to the lower index):
+// 1. bounding spheres beyond the margin: nothing;
+// 2. a round core (sphere point, capsule segment) apart from the other core: GJK closest points;
+// 3. otherwise SAT: a's faces, b's faces, edge pairs, each replacing the incumbent only when
+//    clearly greater (collide_util's bias, the same rule as box_box);
+// 4. a face axis clips the incident face against the reference face; an edge axis between true
+//    edges gives the closest points of the two edges (one point, as box_box);
+// 5. apart, and the axis made no contact (corners passing each other, a cylinder's prism axis):
+//    GJK closest points and the manifold along their direction.
+#include <cstdint>
+
+#include <detsim/fixed/math.hpp>
+#include <detsim/fixed/vec3.hpp>
+
+#include "../collide_util.hpp"
+#include "convex_internal.hpp"
+
+namespace detsim::sim_detail {
+
+namespace convex::collide_detail {
+
+using namespace narrow;
+
+bool is_round(const ConvexView& v) noexcept {
+  return v.kind == ConvexKind::sphere || v.kind == ConvexKind::capsule;
+}
+
+/// A point inside the core (for orienting edge axes): a hull's bounding-box centre, else the
+/// origin.
+Vec3 interior(const Body& b) noexcept {
+  if (b.view->kind != ConvexKind::hull) return b.position;
+  return b.position + b.rotation * half(b.view->hull->aabb_min + b.view->hull->aabb_max);
+}
+
+/// The gap between the cores' projections on l (a -> b), less the radii: a lower bound of the
+/// distance between the shapes.
+Fixed separation_along(const Body& a, const Body& b, Vec3 l) noexcept {
+  return dot(l, support_at(b, -l).point - support_at(a, l).point) - a.radius - b.radius;
+}
+
+struct Best {
+  Vec3 normal;  ///< a -> b
+  Fixed separation = Fixed::min();
+  bool found = false;
+  bool exact = true;
+  unsigned index_a = 0;
+  unsigned index_b = 0;
+  /// A candidate replaces the best when strictly greater: the first of equals (lowest index) wins.
+  void offer(Vec3 n, Fixed s, bool is_exact, unsigned ia, unsigned ib) noexcept {
+    if (found && s <= separation) return;
+    *this = {n, s, true, is_exact, ia, ib};
+  }
+};
+
+struct Sat {
+  Best face_a;
+  Best face_b;
+  Best edge;
+  bool beyond = false;  ///< an axis separates by more than the margin
+};
+
+struct WorldEdge {
+  Vec3 p0;
+  Vec3 p1;
+  Vec3 direction;
+  Vec3 n0;
+  Vec3 n1;
+  SatEdge local;
+};
+
+WorldEdge world_edge(const Body& b, unsigned i) noexcept {
+  const SatEdge e = sat_edge(*b.view, i);
+  WorldEdge w{b.position + b.rotation * e.p0,
+              b.position + b.rotation * e.p1,
+              {},
+              b.rotation * e.n0,
+              b.rotation * e.n1,
+              e};
+  w.direction = normalize(w.p1 - w.p0);
+  return w;
+}
+
+int sign(Fixed x) noexcept {
+  return x > Fixed::zero() ? 1 : (x < Fixed::zero() ? -1 : 0);
+}
+
+/// Whether the arc (n0, n1) crosses the great circle perpendicular to u.
+bool arc_meets_circle(Vec3 n0, Vec3 n1, Vec3 u) noexcept {
+  return sign(dot(n0, u)) * sign(dot(n1, u)) <= 0;
+}
+
+/// Whether edges ea (of a) and eb (of b) make a face of the Minkowski difference: their Gauss-map
+/// arcs, a's and b's negated, intersect (Gregorius). A segment core's arc is a whole circle.
+bool minkowski_face(const WorldEdge& ea, const WorldEdge& eb) noexcept {
+  if (ea.local.circle && eb.local.circle) return true;
+  if (ea.local.circle) return arc_meets_circle(-eb.n0, -eb.n1, ea.direction);
+  if (eb.local.circle) return arc_meets_circle(ea.n0, ea.n1, eb.direction);
+  const Vec3 a = ea.n0;
+  const Vec3 b = ea.n1;
+  const Vec3 c = -eb.n0;
+  const Vec3 d = -eb.n1;
+  const Vec3 bxa = cross(b, a);
+  const Vec3 dxc = cross(d, c);
+  const int cba = sign(dot(c, bxa));
+  const int dba = sign(dot(d, bxa));
+  const int adc = sign(dot(a, dxc));
+  const int bdc = sign(dot(b, dxc));
+  return cba * dba < 0 && adc * bdc < 0 && cba * bdc > 0;
+}
+
+void face_axes(const Body& owner, const Body& a, const Body& b, bool owner_is_a, Fixed margin,
+               Best& best, bool& beyond) noexcept {
+  const unsigned count = sat_face_count(*owner.view);
+  for (unsigned i = 0; i < count && !beyond; ++i) {
+    const SatFace f = sat_face(*owner.view, i);
+    const Vec3 m = unit_or(owner.rotation * f.normal, f.normal);
+    const Vec3 l = owner_is_a ? m : -m;
+    const Fixed s = separation_along(a, b, l);
+    if (s > margin) beyond = true;
+    best.offer(l, s, f.exact, i, i);
+  }
+}
+
+void edge_axes(const Body& a, const Body& b, Fixed margin, Best& best, bool& beyond) noexcept {
+  const unsigned count_a = sat_edge_count(*a.view);
+  const unsigned count_b = sat_edge_count(*b.view);
+  const Vec3 inside_a = interior(a);
+  const Vec3 inside_b = interior(b);
+  for (unsigned i = 0; i < count_a && !beyond; ++i) {
+    const WorldEdge ea = world_edge(a, i);
+    for (unsigned j = 0; j < count_b && !beyond; ++j) {
+      const WorldEdge eb = world_edge(b, j);
+      if (!minkowski_face(ea, eb)) continue;
+      const Vec3 w = cross(ea.direction, eb.direction);
+      if (length_squared(w) < parallel_sin2) continue;  // parallel edges add no direction
+      Vec3 l = normalize(w);
+      const Fixed out = ea.local.circle ? dot(l, inside_b - eb.p0) : dot(l, ea.p0 - inside_a);
+      if (out < Fixed::zero()) l = -l;
+      const Fixed s = separation_along(a, b, l);
+      if (s > margin) beyond = true;
+      best.offer(l, s, ea.local.exact && eb.local.exact, i, j);
+    }
+  }
+}
+
+Sat separating_axes(const Body& a, const Body& b, Fixed margin) noexcept {
+  Sat s;
+  face_axes(a, a, b, true, margin, s.face_a, s.beyond);
+  face_axes(b, a, b, false, margin, s.face_b, s.beyond);
+  edge_axes(a, b, margin, s.edge, s.beyond);
+  return s;
+}
+
+/// Cores apart (GJK): separation = distance - radii, normal along the closest points.
+Manifold apart(const Body& a, const Body& b, const Closest& c, Fixed margin) noexcept {
+  if (c.distance - a.radius - b.radius > margin) return {};
+  const Vec3 n = normalize(c.on_b - c.on_a);
+  Manifold m = manifold_from_faces(a, b, n, Reference::any, margin);
+  if (m.count > 0) return m;
+  const std::uint32_t id = pair_feature(face_at(a, n).feature, face_at(b, -n).feature);
+  return single_point(a, b, c.on_a, c.on_b, n, id, margin);
+}
+
+/// The two support points along n as one contact: the last resort of overlapping cores.
+Manifold support_pair(const Body& a, const Body& b, Vec3 n, Fixed margin) noexcept {
+  const SupportPoint sa = support_at(a, n);
+  const SupportPoint sb = support_at(b, -n);
+  return single_point(a, b, sa.point, sb.point, n, pair_feature(sa.feature, sb.feature), margin);
+}
+
+/// Edge against edge between true straight edges: one point midway between their closest points
+/// (box_box's rule), or nothing when the edges pass each other apart.
+bool edge_point(const Body& a, const Body& b, const Best& e, Fixed margin, Manifold& m) noexcept {
+  const WorldEdge ea = world_edge(a, e.index_a);
+  const WorldEdge eb = world_edge(b, e.index_b);
+  const Segment sa{midpoint(ea.p0, ea.p1), ea.direction, length(ea.p1 - ea.p0) >> 1};
+  const Segment sb{midpoint(eb.p0, eb.p1), eb.direction, length(eb.p1 - eb.p0) >> 1};
+  const SegmentParams p = closest_on_segments(sa, sb);
+  const bool crossing = abs(p.s) < sa.half_length && abs(p.t) < sb.half_length;
+  if (!crossing && e.separation > Fixed::zero()) return false;
+  const Vec3 on_a = sa.at(p.s) + e.normal * a.radius;
+  const Vec3 on_b = sb.at(p.t) - e.normal * b.radius;
+  m = {};
+  m.normal = e.normal;
+  add_point(m, a.origin + midpoint(on_a, on_b), e.separation,
+            pair_feature(ea.local.feature, eb.local.feature), margin);
+  return true;
+}
+
+}  // namespace convex::collide_detail
+
+Manifold collide_convex(const ConvexView& a, const Pose& pa, const ConvexView& b, const Pose& pb,
+                        Fixed margin) noexcept {
+  using namespace convex;
+  using namespace convex::collide_detail;
+  const Body A = make_body(a, pa, pa.position);
+  const Body B = make_body(b, pb, pa.position);
+  if (length(B.position) - bounding_radius(a) - bounding_radius(b) > margin) return {};
+  if (is_round(a) || is_round(b)) {
+    const Closest c = gjk_closest(A, B);
+    if (!c.overlap && c.distance > core_epsilon) return apart(A, B, c, margin);
+  }
+  const Sat s = separating_axes(A, B, margin);
+  if (s.beyond) return {};
+  if (!s.face_a.found && !s.face_b.found && !s.edge.found) {  // points / parallel segments meet
+    const Vec3 n = unit_or(B.position - A.position, Vec3::unit_y());
+    return manifold_from_faces(A, B, n, Reference::any, margin);
+  }
+  const Fixed scale = Fixed::one() + max(bounding_radius(a), bounding_radius(b));
+  const bool ref_is_b =
+      s.face_b.found &&
+      (!s.face_a.found || clearly_greater(s.face_b.separation, s.face_a.separation, scale));
+  const Best& face = ref_is_b ? s.face_b : s.face_a;
+  const bool use_edge =
+      s.edge.found && (!face.found || clearly_greater(s.edge.separation, face.separation, scale));
+  const Best& axis = use_edge ? s.edge : face;
+  const bool apart_on_axis = axis.separation > Fixed::zero();
+  const bool straight_edges =
+      a.kind != ConvexKind::cylinder && b.kind != ConvexKind::cylinder && axis.exact;
+  if (use_edge && straight_edges) {
+    Manifold m;
+    if (edge_point(A, B, axis, margin, m)) return m;
+  } else if (axis.exact || !apart_on_axis) {
+    const Reference ref = use_edge ? Reference::any : (ref_is_b ? Reference::b : Reference::a);
+    const Manifold m = manifold_from_faces(A, B, axis.normal, ref, margin);
+    if (m.count > 0 || !apart_on_axis)
+      return m.count > 0 ? m : support_pair(A, B, axis.normal, margin);
+  }
+  const Closest c = gjk_closest(A, B);
+  if (c.overlap) return support_pair(A, B, axis.normal, margin);
+  return apart(A, B, c, margin);
+}
+
+}  // namespace detsim::sim_detail

@@ -1,0 +1,348 @@
+// The convex narrowphase's manifold from two supporting faces (the idea of Jolt's
+// ManifoldBetweenTwoFaces): Sutherland-Hodgman clipping of the incident face against the side
+// planes of the reference polygon, Liang-Barsky clipping of a segment, the overlap of two nearly
+// parallel segments, else their closest points; then reduction to four points.
+//
+// Feature IDs name the features whose intersection a point is, as in collide_box.cpp: an incident
+// vertex against the reference face, an incident edge through a reference side edge, a reference
+// corner against the incident face; never a position in a list.
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include <detsim/fixed/math.hpp>
+#include <detsim/fixed/vec3.hpp>
+
+#include "../collide_util.hpp"
+#include "convex_internal.hpp"
+
+namespace detsim::sim_detail::convex {
+
+namespace manifold_detail {
+
+using namespace narrow;
+
+bool beats(Fixed value, std::uint32_t id, Fixed best, std::uint32_t best_id) noexcept {
+  return value > best || (value == best && id < best_id);
+}
+
+Fixed area(Vec3 p, Vec3 q, Vec3 s, Vec3 normal) noexcept {
+  return dot(cross(q - p, s - p), normal);
+}
+
+constexpr std::size_t kMaxCandidates = 2 * max_face_points;
+
+/// One vertex of the clipped incident polygon; `in_*` describe the polygon edge ending here.
+struct ClipVertex {
+  Vec3 p;
+  std::uint16_t on_ref = 0;
+  std::uint16_t on_inc = 0;
+  bool in_on_plane = false;
+  unsigned in_plane = 0;
+  std::uint16_t in_edge = 0;
+};
+
+struct Polygon {
+  std::array<ClipVertex, kMaxCandidates> v{};
+  unsigned n = 0;
+  void emit(const ClipVertex& x) noexcept {
+    if (n < v.size()) v[n++] = x;
+  }
+};
+
+/// The reference polygon's side planes: outward unit normals and offsets.
+struct SidePlanes {
+  std::array<Vec3, max_face_points> normal{};
+  std::array<Fixed, max_face_points> offset{};
+  unsigned n = 0;
+};
+
+SidePlanes side_planes(const Face& ref) noexcept {
+  SidePlanes s;
+  Vec3 centroid;
+  for (unsigned i = 0; i < ref.count; ++i)
+    centroid += ref.points[i] / Fixed::from_int(static_cast<std::int32_t>(ref.count));
+  for (unsigned q = 0; q < ref.count; ++q) {
+    const Vec3 p = ref.points[q];
+    Vec3 side = normalize(cross(ref.points[(q + 1) % ref.count] - p, ref.normal));
+    if (dot(side, centroid - p) > Fixed::zero()) side = -side;  // either winding works
+    s.normal[q] = side;
+    s.offset[q] = dot(side, p);
+  }
+  s.n = ref.count;
+  return s;
+}
+
+/// The reference corner where side planes q and q2 meet (adjacent edges share a vertex).
+std::uint16_t ref_corner(const Face& ref, unsigned q, unsigned q2) noexcept {
+  if (q2 == (q + 1) % ref.count) return ref.vertex[q2];
+  return ref.vertex[q];
+}
+
+/// One Sutherland-Hodgman pass against side plane q (on the plane counts as inside).
+void clip_pass(const Polygon& in, const SidePlanes& s, unsigned q, const Face& ref,
+               std::uint16_t inc_face, Polygon& out) noexcept {
+  out.n = 0;
+  const auto height = [&](const ClipVertex& x) { return dot(s.normal[q], x.p) - s.offset[q]; };
+  const auto crossing = [&](const ClipVertex& p, const ClipVertex& e) {
+    const Fixed hp = height(p);
+    const Fixed t = hp / (hp - height(e));  // exactly one end is outside: in [0, 1]
+    ClipVertex x = e;
+    x.p = p.p + (e.p - p.p) * t;
+    if (e.in_on_plane) {
+      x.on_ref = ref_corner(ref, q, e.in_plane);
+      x.on_inc = inc_face;
+    } else {
+      x.on_ref = ref.edge[q];
+      x.on_inc = e.in_edge;
+    }
+    return x;
+  };
+  for (unsigned i = 0; i < in.n; ++i) {
+    const ClipVertex& p = in.v[i];
+    const ClipVertex& e = in.v[(i + 1) % in.n];
+    const bool p_in = height(p) <= Fixed::zero();
+    const bool e_in = height(e) <= Fixed::zero();
+    if (p_in && e_in) {
+      out.emit(e);
+    } else if (p_in) {
+      out.emit(crossing(p, e));
+    } else if (e_in) {
+      ClipVertex x = crossing(p, e);
+      x.in_on_plane = true;
+      x.in_plane = q;
+      out.emit(x);
+      out.emit(e);
+    }
+  }
+}
+
+/// The incident face's points inside the reference polygon's side planes.
+Polygon clip_incident(const Face& ref, const Face& inc) noexcept {
+  const SidePlanes s = side_planes(ref);
+  Polygon poly;
+  if (inc.count >= 3) {
+    for (unsigned i = 0; i < inc.count; ++i)
+      poly.emit({inc.points[i], ref.feature, inc.vertex[i], false, 0,
+                 inc.edge[(i + inc.count - 1) % inc.count]});
+    Polygon scratch;
+    for (unsigned q = 0; q < s.n && poly.n > 0; ++q) {
+      clip_pass(poly, s, q, ref, inc.feature, scratch);
+      poly = scratch;
+    }
+    return poly;
+  }
+  // A segment (Liang-Barsky) or a point: parameters [lo, hi] of the part inside every plane.
+  const Vec3 p0 = inc.points[0];
+  const Vec3 p1 = inc.points[inc.count - 1];
+  Fixed lo = Fixed::zero();
+  Fixed hi = Fixed::one();
+  std::uint16_t lo_ref = ref.feature;
+  std::uint16_t hi_ref = ref.feature;
+  for (unsigned q = 0; q < s.n; ++q) {
+    const Fixed h0 = dot(s.normal[q], p0) - s.offset[q];
+    const Fixed h1 = dot(s.normal[q], p1) - s.offset[q];
+    if (h0 > Fixed::zero() && h1 > Fixed::zero()) return poly;
+    if (h0 > Fixed::zero()) {
+      const Fixed t = h0 / (h0 - h1);
+      if (t > lo) {
+        lo = t;
+        lo_ref = ref.edge[q];
+      }
+    } else if (h1 > Fixed::zero()) {
+      const Fixed t = h0 / (h0 - h1);
+      if (t < hi) {
+        hi = t;
+        hi_ref = ref.edge[q];
+      }
+    }
+  }
+  if (lo > hi) return poly;
+  const auto at = [&](Fixed t, std::uint16_t on_ref, std::uint16_t end) {
+    const bool clipped = on_ref != ref.feature;
+    poly.emit({p0 + (p1 - p0) * t, on_ref, clipped ? inc.feature : end, false, 0, 0});
+  };
+  at(lo, lo_ref, inc.vertex[0]);
+  if (inc.count == 2 && hi > lo) at(hi, hi_ref, inc.vertex[1]);
+  return poly;
+}
+
+/// A candidate from a pair of core points (on_a, on_b) along n.
+Candidate candidate(const Body& a, const Body& b, Vec3 on_a, Vec3 on_b, Vec3 n,
+                    std::uint32_t feature) noexcept {
+  const Fixed separation = dot(on_b - on_a, n) - a.radius - b.radius;
+  return {midpoint(on_a + n * a.radius, on_b - n * b.radius), separation, feature};
+}
+
+struct Candidates {
+  std::array<Candidate, kMaxCandidates> c{};
+  std::size_t n = 0;
+  void add(const Candidate& x, Fixed margin) noexcept {
+    if (x.separation <= margin && n < c.size()) c[n++] = x;
+  }
+};
+
+/// Polygon reference: clip, then measure each incident point's height above the reference plane.
+Vec3 clip_contacts(const Body& a, const Body& b, const Face& fa, const Face& fb, bool ref_is_a,
+                   Vec3 n, Fixed margin, Candidates& out) noexcept {
+  const Face& ref = ref_is_a ? fa : fb;
+  const Face& inc = ref_is_a ? fb : fa;
+  const Vec3 toward = ref_is_a ? ref.normal : -ref.normal;  // the ref normal, oriented a -> b
+  const bool snapped = dot(toward, n) >= face_cos;
+  if (snapped) n = toward;
+  const Fixed cosine = abs(dot(n, ref.normal));
+  const Fixed plane = dot(ref.normal, ref.points[0]);
+  const Polygon poly = clip_incident(ref, inc);
+  for (unsigned i = 0; i < poly.n; ++i) {
+    const ClipVertex& v = poly.v[i];
+    const Fixed rise = dot(ref.normal, v.p) - plane;
+    const Fixed t = snapped ? rise : rise / cosine;  // along n, from a's core to b's
+    const Vec3 on_a = ref_is_a ? v.p - n * t : v.p;
+    const Vec3 on_b = ref_is_a ? v.p : v.p + n * t;
+    const std::uint32_t id =
+        ref_is_a ? pair_feature(v.on_ref, v.on_inc) : pair_feature(v.on_inc, v.on_ref);
+    out.add(candidate(a, b, on_a, on_b, n, id), margin);
+  }
+  return n;
+}
+
+Segment as_segment(const Face& f) noexcept {
+  const Vec3 p0 = f.points[0];
+  const Vec3 p1 = f.points[f.count - 1];
+  const Vec3 d = p1 - p0;
+  return {p0 + half(d), normalize_or(d, Vec3::unit_x()), length(d) >> 1};
+}
+
+std::uint16_t segment_feature(const Face& f, Fixed s, Fixed half_length) noexcept {
+  if (f.count < 2) return f.feature;
+  if (s <= -half_length) return f.vertex[0];
+  if (s >= half_length) return f.vertex[1];
+  return f.feature;
+}
+
+/// Segments or points: the ends of the overlap of nearly parallel segments, else closest points.
+void segment_contacts(const Body& a, const Body& b, const Face& fa, const Face& fb, Vec3 n,
+                      Fixed margin, Candidates& out) noexcept {
+  const Segment sa = as_segment(fa);
+  const Segment sb = as_segment(fb);
+  OverlapEnd lo;
+  OverlapEnd hi;
+  if (fa.count == 2 && fb.count == 2 &&
+      length_squared(cross(sa.direction, sb.direction)) < flat_sin2 &&
+      segment_overlap(sa, sb, lo, hi)) {
+    for (const bool top : {false, true}) {
+      const OverlapEnd& end = top ? hi : lo;
+      const Vec3 pa_end = sa.at(end.s);
+      const Fixed t = clamp(dot(pa_end - sb.center, sb.direction), -sb.half_length, sb.half_length);
+      const std::uint16_t on_a = end.a_end ? fa.vertex[top ? 1 : 0] : fa.feature;
+      const std::uint16_t on_b = end.b_end ? fb.vertex[end.b_top ? 1 : 0] : fb.feature;
+      out.add(candidate(a, b, pa_end, sb.at(t), n, pair_feature(on_a, on_b)), margin);
+    }
+    if (out.n > 0) return;
+  }
+  const SegmentParams p = closest_on_segments(sa, sb);
+  out.add(candidate(a, b, sa.at(p.s), sb.at(p.t), n,
+                    pair_feature(segment_feature(fa, p.s, sa.half_length),
+                                 segment_feature(fb, p.t, sb.half_length))),
+          margin);
+}
+
+}  // namespace manifold_detail
+
+using namespace manifold_detail;
+
+void reduce_into(std::span<const Candidate> c, Vec3 normal, Vec3 origin, Manifold& m) noexcept {
+  const auto put = [&](const Candidate& x) {
+    narrow::add_point(m, origin + x.point, x.separation, x.feature, Fixed::max());
+  };
+  if (c.size() <= 4) {
+    for (const Candidate& x : c)
+      put(x);
+    return;
+  }
+  std::array<std::size_t, 4> chosen{};
+  std::size_t count = 0;
+  const auto used = [&](std::size_t i) {
+    for (std::size_t k = 0; k < count; ++k)
+      if (chosen[k] == i) return true;
+    return false;
+  };
+  // The best unused candidate by score (> 0 unless `any`), ties to the lower feature ID.
+  const auto pick = [&](auto&& score, bool any) {
+    std::size_t best = c.size();
+    Fixed best_score;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const Fixed s = score(c[i]);
+      if (used(i) || (!any && s <= Fixed::zero())) continue;
+      if (best == c.size() || beats(s, c[i].feature, best_score, c[best].feature)) {
+        best = i;
+        best_score = s;
+      }
+    }
+    if (best < c.size()) chosen[count++] = best;
+    return best < c.size();
+  };
+  const auto depth = [](const Candidate& x) { return -x.separation; };
+  pick(depth, true);
+  const Vec3 p0 = c[chosen[0]].point;
+  if (pick([&](const Candidate& x) { return length_squared(x.point - p0); }, false)) {
+    const Vec3 p1 = c[chosen[1]].point;
+    const bool left =
+        pick([&](const Candidate& x) { return area(p0, p1, x.point, normal); }, false);
+    const bool right =
+        pick([&](const Candidate& x) { return -area(p0, p1, x.point, normal); }, false);
+    if (left != right) {  // one side only: the point that grows the triangle the most
+      const Vec3 p2 = c[chosen[2]].point;
+      const Vec3 up = left ? normal : -normal;
+      if (!pick(
+              [&](const Candidate& x) {
+                return max(-area(p1, p2, x.point, up), -area(p2, p0, x.point, up));
+              },
+              false))
+        pick(depth, true);
+    } else if (!left) {  // collinear: the deepest two others
+      pick(depth, true);
+      pick(depth, true);
+    }
+  }
+  for (std::size_t k = 0; k < count; ++k)
+    put(c[chosen[k]]);
+}
+
+Manifold manifold_from_faces(const Body& a, const Body& b, Vec3 n, Reference ref,
+                             Fixed margin) noexcept {
+  const Face fa = face_at(a, n);
+  const Face fb = face_at(b, -n);
+  Candidates found;
+  const bool poly_a = fa.count >= 3;
+  const bool poly_b = fb.count >= 3;
+  if (poly_a || poly_b) {
+    bool ref_is_a = poly_a;
+    if (poly_a && poly_b) {
+      if (ref == Reference::b) {
+        ref_is_a = false;
+      } else if (ref == Reference::any) {
+        const Fixed tolerance = Fixed::from_raw(Fixed::one_raw >> 16);
+        ref_is_a = dot(-fb.normal, n) <= dot(fa.normal, n) + tolerance;
+      }
+    }
+    n = clip_contacts(a, b, fa, fb, ref_is_a, n, margin, found);
+  } else {
+    segment_contacts(a, b, fa, fb, n, margin, found);
+  }
+  Manifold m;
+  m.normal = n;
+  reduce_into(std::span<const Candidate>(found.c.data(), found.n), n, a.origin, m);
+  return m;
+}
+
+Manifold single_point(const Body& a, const Body& b, Vec3 on_a, Vec3 on_b, Vec3 n,
+                      std::uint32_t feature, Fixed margin) noexcept {
+  const Candidate c = candidate(a, b, on_a, on_b, n, feature);
+  Manifold m;
+  m.normal = n;
+  narrow::add_point(m, a.origin + c.point, c.separation, c.feature, margin);
+  return m;
+}
+
+}  // namespace detsim::sim_detail::convex
