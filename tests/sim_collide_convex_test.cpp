@@ -1,0 +1,434 @@
+// The generic convex narrowphase (sim/src/geometry/convex*.cpp): hulls, boxes, spheres, capsules
+// and cylinders against each other and against a plane. Every expected value is worked out from
+// the geometry in the comment beside it; hulls are made by hand (support/hull_by_hand.hpp).
+#include <cstdint>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "sim/src/geometry/convex.hpp"
+#include "support/collide_helpers.hpp"
+#include "support/hull_by_hand.hpp"
+
+namespace {
+
+using namespace detsim;
+using namespace detsim::literals;
+using namespace detsim::collide_test;
+using sim_detail::collide_convex;
+using sim_detail::convex_plane;
+using sim_detail::ConvexView;
+using sim_detail::Hull;
+namespace cv = sim_detail::convex;
+
+const Fixed kFine = Fixed::from_raw(Fixed::one_raw >> 20);  // 2^-20: "the same" across algorithms
+const Fixed kPhi = 1.6180339887_fx;
+
+std::uint16_t hull_vertex(unsigned i) {
+  return cv::convex_feature(static_cast<unsigned>(nf::Kind::vertex), i);
+}
+
+unsigned index_of_vertex(const Hull& h, Vec3 p) {
+  for (unsigned i = 0; i < h.vertices.size(); ++i)
+    if (h.vertices[i] == p) return i;
+  return 0xFFFF;
+}
+
+struct Shapes {
+  const Hull cube = box_hull({0.5_fx, 0.5_fx, 0.5_fx});
+  const Hull ground = box_hull({2_fx, 0.5_fx, 2_fx});
+  const Hull wide = box_hull({0.6_fx, 0.5_fx, 0.6_fx});
+  // Apex down at local y = -0.5, base triangle at y = +0.5.
+  const Hull tetra = hull_by_hand({v3(0_fx, -0.5_fx, 0_fx), v3(0.5_fx, 0.5_fx, 0_fx),
+                                   v3(-0.5_fx, 0.5_fx, 0.5_fx), v3(-0.5_fx, 0.5_fx, -0.5_fx)});
+  // A unit wedge: bottom y = -0.5, back face z = -0.5, slope from the back's top to the front.
+  const Hull wedge = hull_by_hand({v3(-0.5_fx, -0.5_fx, -0.5_fx), v3(0.5_fx, -0.5_fx, -0.5_fx),
+                                   v3(-0.5_fx, -0.5_fx, 0.5_fx), v3(0.5_fx, -0.5_fx, 0.5_fx),
+                                   v3(-0.5_fx, 0.5_fx, -0.5_fx), v3(0.5_fx, 0.5_fx, -0.5_fx)});
+  // A 12-point rock: the icosahedron (0, +-1, +-phi) and its cyclic permutations, scaled by 0.3.
+  const Hull rock = [] {
+    std::vector<Vec3> p;
+    for (const Fixed s : {-0.3_fx, 0.3_fx}) {
+      for (const Fixed t : {-0.3_fx, 0.3_fx}) {
+        const Fixed tp = t * kPhi;
+        p.push_back(v3(0_fx, s, tp));
+        p.push_back(v3(s, tp, 0_fx));
+        p.push_back(v3(tp, 0_fx, s));
+      }
+    }
+    return hull_by_hand(p);
+  }();
+};
+
+const Shapes& shapes() {
+  static const Shapes s;
+  return s;
+}
+
+// Same normal, same separations and the same point set within 2^-20.
+void expect_same_contacts(const Manifold& got, const Manifold& want) {
+  ASSERT_EQ(got.count, want.count);
+  if (want.count == 0) return;
+  EXPECT_TRUE(near(got.normal, want.normal, kFine));
+  for (std::size_t i = 0; i < want.count; ++i) {
+    const ContactPoint* p = find_point(got, want.points[i].point, kFine);
+    ASSERT_NE(p, nullptr) << "missing point " << i;
+    EXPECT_TRUE(near(p->separation, want.points[i].separation, kFine));
+  }
+}
+
+// collide_convex(b, a) mirrors collide_convex(a, b).
+void expect_convex_mirrored(const ConvexView& a, const Pose& pa, const ConvexView& b,
+                            const Pose& pb) {
+  const Manifold ab = collide_convex(a, pa, b, pb, kMargin);
+  const Manifold ba = collide_convex(b, pb, a, pa, kMargin);
+  expect_well_formed(ab, kMargin);
+  ASSERT_GT(ab.count, 0U);
+  ASSERT_EQ(ab.count, ba.count);
+  EXPECT_TRUE(near(ba.normal, -ab.normal));
+  for (std::size_t i = 0; i < ab.count; ++i) {
+    const ContactPoint* q = find_feature(ba, nf::mirror_feature(ab.points[i].feature));
+    ASSERT_NE(q, nullptr) << "feature " << std::hex << ab.points[i].feature << " not mirrored";
+    EXPECT_TRUE(near(q->separation, ab.points[i].separation));
+    EXPECT_TRUE(near(q->point, ab.points[i].point));
+  }
+}
+
+// ---- Against box_box ----------------------------------------------------------------------------
+
+// Ground: half extents (2, 0.5, 2) at g, top face y = 0.5; a unit cube above it, as in
+// sim_collide_box_test.cpp. The hand-built box hulls must give box_box's contacts, and the box
+// view its feature IDs too.
+struct VersusBoxBox : ::testing::Test {
+  const Vec3 g = v3(1000_fx, -2_fx, 500_fx);
+  const Shape ground = Shape::box({2_fx, 0.5_fx, 2_fx});
+  const Shape cube = Shape::box({0.5_fx, 0.5_fx, 0.5_fx});
+  void check(const Shape& sa, const Hull& ha, const Pose& pa, const Shape& sb, const Hull& hb,
+             const Pose& pb) const {
+    const Manifold want = collide(sa, pa, sb, pb, kMargin);
+    const Manifold hulls =
+        collide_convex(ConvexView::of_hull(ha), pa, ConvexView::of_hull(hb), pb, kMargin);
+    expect_same_contacts(hulls, want);
+    expect_well_formed(hulls, kMargin);
+    const Manifold views = collide_convex(ConvexView::of(sa), pa, ConvexView::of(sb), pb, kMargin);
+    expect_same_contacts(views, want);
+    EXPECT_EQ(features(views), features(want));
+  }
+};
+
+TEST_F(VersusBoxBox, RestingSeparatedOverhangAndTilted) {
+  const Shapes& s = shapes();
+  // Resting 0.01 deep; 0.05 apart (speculative); hanging over a's +x edge; turned 0.1 rad about z
+  // with its centre at 1.04 (lowest corner 1.04 - 0.5 (cos 0.1 + sin 0.1) ~ 0.4926 below the top
+  // face at 0.5, the other bottom corner ~0.092 above it, within the margin).
+  for (const Pose& pb : {at(g + v3(0.3_fx, 0.99_fx, -0.2_fx)), at(g + v3(0.3_fx, 1.05_fx, 0_fx)),
+                         at(g + v3(1.8_fx, 0.98_fx, 0_fx)),
+                         at(g + v3(0.2_fx, 1.04_fx, 0.1_fx), about(Vec3::unit_z(), 0.1_fx))}) {
+    SCOPED_TRACE(to_string(pb.position.x));
+    check(ground, s.ground, at(g), cube, s.cube, pb);
+  }
+}
+
+TEST_F(VersusBoxBox, OctagonReducedLikeBoxBox) {
+  // b (half extents 0.6, turned 45 degrees about y) on a unit cube: the octagon of
+  // sim_collide_box_test.cpp, reduced to the same four points.
+  const Shapes& s = shapes();
+  check(cube, s.cube, at(g), Shape::box({0.6_fx, 0.5_fx, 0.6_fx}), s.wide,
+        at(g + v3(0_fx, 0.99_fx, 0_fx), about(Vec3::unit_y(), eighth_turn)));
+}
+
+TEST_F(VersusBoxBox, EdgeAgainstEdge) {
+  // a turned 45 degrees about z: top edge along z at height 0.5 sqrt 2. b turned 45 degrees about
+  // x: bottom edge along x, 0.5 sqrt 2 below its centre. Centre heights sqrt 2 + gap apart, b
+  // shifted (0.1, 0.2) along the edges: they cross at (0, 0.5 sqrt 2 + gap / 2, 0.2), gap apart.
+  const Shapes& s = shapes();
+  for (const Fixed gap : {-0.01_fx, 0.05_fx}) {
+    const Pose pa = at(g, about(Vec3::unit_z(), eighth_turn));
+    const Pose pb =
+        at(g + v3(0.1_fx, Fixed::sqrt2() + gap, 0.2_fx), about(Vec3::unit_x(), eighth_turn));
+    check(cube, s.cube, pa, cube, s.cube, pb);
+    const Manifold m =
+        collide_convex(ConvexView::of_hull(s.cube), pa, ConvexView::of_hull(s.cube), pb, kMargin);
+    ASSERT_EQ(m.count, 1U);
+    EXPECT_TRUE(near(m.normal, Vec3::unit_y()));
+    EXPECT_TRUE(near(m.points[0].separation, gap));
+    EXPECT_TRUE(near(m.points[0].point, g + v3(0_fx, half_sqrt2 + (gap >> 1), 0.2_fx)));
+  }
+}
+
+// ---- Hulls -------------------------------------------------------------------------------------
+
+TEST(ConvexHull, TetrahedronVertexIntoABoxFace) {
+  // The apex (local (0, -0.5, 0)) 0.02 below the ground's top face y = 0.5: one point, the apex
+  // against the face, separation -0.02, midway at height 0.49; normal +y (ground into tetra).
+  const Shapes& s = shapes();
+  const Vec3 g = v3(-20_fx, 3_fx, 7_fx);
+  const Vec3 apex = g + v3(0.2_fx, 0.48_fx, 0.1_fx);
+  const Manifold m =
+      collide_convex(ConvexView::box({2_fx, 0.5_fx, 2_fx}), at(g), ConvexView::of_hull(s.tetra),
+                     at(apex + v3(0_fx, 0.5_fx, 0_fx)), kMargin);
+  ASSERT_EQ(m.count, 1U);
+  EXPECT_EQ(m.normal, Vec3::unit_y());
+  EXPECT_EQ(m.points[0].separation, -0.02_fx);
+  EXPECT_TRUE(near(m.points[0].point, apex + v3(0_fx, 0.01_fx, 0_fx)));
+  const unsigned i = index_of_vertex(s.tetra, v3(0_fx, -0.5_fx, 0_fx));
+  EXPECT_EQ(m.points[0].feature, pair(nf::box_face(1, true), hull_vertex(i)));
+}
+
+TEST(ConvexHull, WedgeSlopeOnABoxEdge) {
+  // The wedge's slope is the plane y + z = 0 (local), outward normal (0, 1, 1) / sqrt 2. With its
+  // centre at (0, -0.5 - d, -0.5 - d) the slope is y + z = -1 - 2 d, and the unit cube's edge
+  // along x at (y, z) = (-0.5, -0.5) (y + z = -1) is 2 d / sqrt 2 = d sqrt 2 from it. The wedge's
+  // slope is the reference; the cube's bottom face, clipped by it, keeps that edge's two ends
+  // (x = +-0.5); the normal points from the cube into the wedge: (0, -1, -1) / sqrt 2.
+  const Shapes& s = shapes();
+  const Fixed d = -0.01_fx;
+  const Manifold m =
+      collide_convex(ConvexView::of_hull(s.cube), at({}), ConvexView::of_hull(s.wedge),
+                     at(v3(0_fx, -0.5_fx - d, -0.5_fx - d)), kMargin);
+  ASSERT_EQ(m.count, 2U);
+  EXPECT_TRUE(near(m.normal, v3(0_fx, -half_sqrt2, -half_sqrt2)));
+  for (const Fixed x : {-0.5_fx, 0.5_fx}) {
+    // Midway between the edge's end and the slope: half the separation along the normal.
+    const ContactPoint* c = find_point(
+        m, v3(x, -0.5_fx, -0.5_fx) + v3(0_fx, -half_sqrt2, -half_sqrt2) * (d * half_sqrt2));
+    ASSERT_NE(c, nullptr) << to_string(x);
+    EXPECT_TRUE(near(c->separation, d * Fixed::sqrt2()));
+  }
+  expect_well_formed(m, kMargin);
+}
+
+TEST(ConvexHull, SphereAndCapsuleAgainstHulls) {
+  const Shapes& s = shapes();
+  const ConvexView ball = ConvexView::sphere(0.25_fx);
+  // Above the tetra's top face (y = 0.5) at (-0.2, z = 0) inside its triangle: 0.03 apart.
+  Manifold m = collide_convex(ball, at(v3(-0.2_fx, 0.78_fx, 0_fx)), ConvexView::of_hull(s.tetra),
+                              at({}), kMargin);
+  ASSERT_EQ(m.count, 1U);
+  EXPECT_EQ(m.normal, -Vec3::unit_y());
+  EXPECT_EQ(m.points[0].separation, 0.03_fx);
+  EXPECT_TRUE(near(m.points[0].point, v3(-0.2_fx, 0.515_fx, 0_fx)));
+  // Off the cube's corner by (0.1, 0.1, 0.1): distance 0.1 sqrt 3 - 0.25 (< 0: overlapping), the
+  // normal along the diagonal; and the same as sphere_box.
+  const Pose corner = at(v3(0.6_fx, 0.6_fx, 0.6_fx));
+  m = collide_convex(ball, corner, ConvexView::of_hull(s.cube), at({}), kMargin);
+  ASSERT_EQ(m.count, 1U);
+  EXPECT_TRUE(near(m.points[0].separation, 0.1_fx * sqrt(3_fx) - 0.25_fx));
+  EXPECT_TRUE(near(m.normal, -normalize(v3(1_fx, 1_fx, 1_fx))));
+  expect_same_contacts(m, collide(Shape::sphere(0.25_fx), corner,
+                                  Shape::box({0.5_fx, 0.5_fx, 0.5_fx}), at({}), kMargin));
+  // Centre inside, 0.1 below the top face: out through the top, separation -(0.1 + 0.25).
+  m = collide_convex(ball, at(v3(0.1_fx, 0.4_fx, 0_fx)), ConvexView::of_hull(s.cube), at({}),
+                     kMargin);
+  ASSERT_EQ(m.count, 1U);
+  EXPECT_TRUE(near(m.points[0].separation, -0.35_fx));
+  EXPECT_TRUE(near(m.normal, -Vec3::unit_y()));
+  // A capsule (r 0.25, half 0.3) lying along x on the cube's top face, `gap` above it: two points
+  // at x = +-0.3, each `gap` apart; the cube is a, so the normal is +y.
+  const Fixed gap = 0.02_fx;
+  m = collide_convex(ConvexView::of_hull(s.cube), at({}), ConvexView::capsule(0.25_fx, 0.3_fx),
+                     at(v3(0_fx, 0.75_fx + gap, 0_fx), about(Vec3::unit_z(), -quarter_turn)),
+                     kMargin);
+  ASSERT_EQ(m.count, 2U);
+  EXPECT_TRUE(near(m.normal, Vec3::unit_y()));
+  for (const Fixed x : {-0.3_fx, 0.3_fx}) {
+    const ContactPoint* p = find_point(m, v3(x, 0.5_fx + (gap >> 1), 0_fx));
+    ASSERT_NE(p, nullptr);
+    EXPECT_TRUE(near(p->separation, gap));
+  }
+}
+
+TEST(ConvexHull, RockAgainstBoxIsWellFormedAndRepeatable) {
+  const Shapes& s = shapes();
+  const Pose pb =
+      at(v3(0.1_fx, 0.5_fx + 0.3_fx * kPhi - 0.01_fx, 0_fx), about(v3(1_fx, 0_fx, 0_fx), 0_fx));
+  const ConvexView ground = ConvexView::box({2_fx, 0.5_fx, 2_fx});
+  const Manifold m = collide_convex(ground, at({}), ConvexView::of_hull(s.rock), pb, kMargin);
+  ASSERT_GT(m.count, 0U);
+  expect_well_formed(m, kMargin);
+  // Its lowest vertices (+-0.3, -0.3 phi, 0) are 0.01 into the top face.
+  Fixed deepest = Fixed::max();
+  for (std::size_t i = 0; i < m.count; ++i)
+    deepest = min(deepest, m.points[i].separation);
+  EXPECT_TRUE(near(deepest, -0.01_fx));
+  EXPECT_TRUE(
+      identical(m, collide_convex(ground, at({}), ConvexView::of_hull(s.rock), pb, kMargin)));
+}
+
+// ---- Planes -------------------------------------------------------------------------------------
+
+TEST(ConvexPlane, HullRestingFlatAndTilted) {
+  const Shapes& s = shapes();
+  const Vec3 p = v3(30_fx, -5_fx, 12_fx);
+  const Fixed gap = -0.01_fx;
+  // Flat: the four bottom corners, each exactly `gap` from the plane, midway at height gap / 2.
+  Manifold m = convex_plane(ConvexView::of_hull(s.cube), at(p + v3(0_fx, 0.5_fx + gap, 0_fx)),
+                            at(p), kMargin);
+  ASSERT_EQ(m.count, 4U);
+  EXPECT_EQ(m.normal, -Vec3::unit_y());
+  for (const Fixed x : {-0.5_fx, 0.5_fx}) {
+    for (const Fixed z : {-0.5_fx, 0.5_fx}) {
+      const ContactPoint* c = find_point(m, p + v3(x, gap >> 1, z));
+      ASSERT_NE(c, nullptr);
+      EXPECT_EQ(c->separation, gap);
+      EXPECT_EQ(c->feature, pair(hull_vertex(index_of_vertex(s.cube, v3(x, -0.5_fx, z))), kPlane));
+    }
+  }
+  // Turned 0.3 rad about z, centre at height 1: the lowest corner is 0.5 (cos 0.3 + sin 0.3)
+  // below the centre, and the deepest point's separation is its height.
+  const Fixed theta = 0.3_fx;
+  m = convex_plane(ConvexView::of_hull(s.cube),
+                   at(p + v3(0_fx, 1_fx, 0_fx), about(Vec3::unit_z(), theta)), at(p), 0.5_fx);
+  ASSERT_GT(m.count, 0U);
+  EXPECT_TRUE(near(m.points[0].separation, 1_fx - ((cos(theta) + sin(theta)) >> 1)));
+  // The wedge flat on its bottom: four points; the rock: its two lowest vertices at 0.3 phi.
+  m = convex_plane(ConvexView::of_hull(s.wedge), at(p + v3(0_fx, 0.5_fx, 0_fx)), at(p), kMargin);
+  EXPECT_EQ(m.count, 4U);
+  m = convex_plane(ConvexView::of_hull(s.rock), at(p + v3(0_fx, 0.3_fx * kPhi + gap, 0_fx)), at(p),
+                   kMargin);
+  ASSERT_EQ(m.count, 2U);
+  for (std::size_t i = 0; i < 2; ++i)
+    EXPECT_TRUE(near(m.points[i].separation, gap));
+}
+
+// ---- Cylinders ----------------------------------------------------------------------------------
+
+// Radius 0.4, half height 0.5; lying = turned a quarter about z (its axis along world x).
+struct Cylinder : ::testing::Test {
+  const ConvexView cyl = ConvexView::cylinder(0.4_fx, 0.5_fx);
+  const Vec3 p = v3(-7_fx, 2_fx, 300_fx);
+  const Quat lying = about(Vec3::unit_z(), quarter_turn);
+  static void expect_on_rim(const Manifold& m, Vec3 axis_point, Fixed r, Fixed gap) {
+    ASSERT_EQ(m.count, 4U);
+    std::vector<std::uint32_t> f = features(m);
+    EXPECT_EQ(std::unique(f.begin(), f.end()), f.end());
+    for (std::size_t i = 0; i < 4; ++i) {
+      const Vec3 d = m.points[i].point - axis_point;
+      EXPECT_TRUE(near(d.y, gap >> 1));
+      EXPECT_TRUE(near(length(v3(d.x, 0_fx, d.z)), r));
+      EXPECT_TRUE(near(m.points[i].separation, gap));
+    }
+  }
+};
+
+TEST_F(Cylinder, StandingOnAPlaneAndABox) {
+  // The -y cap `gap` above the plane / the box's top face (y = 0.5): four rim points at gap.
+  const Fixed gap = -0.005_fx;
+  Manifold m = convex_plane(cyl, at(p + v3(0_fx, 0.5_fx + gap, 0_fx)), at(p), kMargin);
+  expect_on_rim(m, p, 0.4_fx, gap);
+  for (std::size_t i = 0; i < 4; ++i)
+    EXPECT_EQ(m.points[i].separation, gap);  // exact: every height here is exact
+  const ConvexView box = ConvexView::box({2_fx, 0.5_fx, 2_fx});
+  m = collide_convex(box, at(p), cyl, at(p + v3(0.1_fx, 1_fx + gap, 0_fx)), kMargin);
+  EXPECT_EQ(m.normal, Vec3::unit_y());
+  expect_on_rim(m, p + v3(0.1_fx, 0.5_fx, 0_fx), 0.4_fx, gap);
+}
+
+TEST_F(Cylinder, LyingOnItsSide) {
+  // Axis along x, centre at height r + gap: the side line touches, two points at x = +-0.5.
+  const Fixed gap = 0.02_fx;
+  const Pose pose = at(p + v3(0_fx, 0.4_fx + gap, 0_fx), lying);
+  for (const Manifold& m : {convex_plane(cyl, pose, at(p), kMargin),
+                            collide_convex(cyl, pose, ConvexView::box({2_fx, 0.5_fx, 2_fx}),
+                                           at(p - v3(0_fx, 0.5_fx, 0_fx)), kMargin)}) {
+    ASSERT_EQ(m.count, 2U);
+    EXPECT_TRUE(near(m.normal, -Vec3::unit_y()));
+    for (const Fixed x : {-0.5_fx, 0.5_fx}) {
+      const ContactPoint* c = find_point(m, p + v3(x, gap >> 1, 0_fx));
+      ASSERT_NE(c, nullptr) << to_string(x);
+      EXPECT_TRUE(near(c->separation, gap));
+    }
+  }
+}
+
+TEST_F(Cylinder, CrossedAtRightAngles) {
+  // a along x, b along z above it: their sides are r_a + r_b + gap - (r_a + r_b) = gap apart at
+  // the crossing point, midway at height r_a + gap / 2 over a's centre.
+  const ConvexView thin = ConvexView::cylinder(0.3_fx, 0.6_fx);
+  for (const Fixed gap : {-0.01_fx, 0.04_fx}) {
+    const Pose pb = at(p + v3(0_fx, 0.7_fx + gap, 0_fx), about(Vec3::unit_x(), quarter_turn));
+    const Manifold m = collide_convex(cyl, at(p, lying), thin, pb, kMargin);
+    ASSERT_EQ(m.count, 1U);
+    EXPECT_TRUE(near(m.normal, Vec3::unit_y()));
+    EXPECT_TRUE(near(m.points[0].separation, gap));
+    EXPECT_TRUE(near(m.points[0].point, p + v3(0_fx, 0.4_fx + (gap >> 1), 0_fx)));
+  }
+}
+
+TEST_F(Cylinder, TiltedOnAPlaneTouchesAtItsLowestRimPoint) {
+  // Tilted 0.4 rad about z with its centre at height 1: the lowest rim point is
+  // h cos 0.4 + r sin 0.4 below the centre.
+  const Fixed t = 0.4_fx;
+  const Manifold m =
+      convex_plane(cyl, at(p + v3(0_fx, 1_fx, 0_fx), about(Vec3::unit_z(), t)), at(p), 0.5_fx);
+  ASSERT_GT(m.count, 0U);
+  expect_well_formed(m, 0.5_fx);
+  EXPECT_TRUE(near(m.points[0].separation, 1_fx - 0.5_fx * cos(t) - 0.4_fx * sin(t)));
+}
+
+// ---- Properties ---------------------------------------------------------------------------------
+
+TEST(ConvexProperties, SwappedPairsMirror) {
+  const Shapes& s = shapes();
+  const ConvexView ground = ConvexView::box({2_fx, 0.5_fx, 2_fx});
+  const ConvexView cube = ConvexView::of_hull(s.cube);
+  expect_convex_mirrored(ground, at({}), cube, at(v3(0.3_fx, 0.99_fx, -0.2_fx)));
+  expect_convex_mirrored(ground, at({}), ConvexView::cylinder(0.4_fx, 0.5_fx),
+                         at(v3(0.1_fx, 0.995_fx, 0_fx)));
+  expect_convex_mirrored(ConvexView::sphere(0.25_fx), at(v3(-0.2_fx, 0.78_fx, 0_fx)),
+                         ConvexView::of_hull(s.tetra), at({}));
+  expect_convex_mirrored(
+      cube, at({}, about(Vec3::unit_z(), eighth_turn)), cube,
+      at(v3(0.1_fx, Fixed::sqrt2() - 0.01_fx, 0.2_fx), about(Vec3::unit_x(), eighth_turn)));
+  expect_convex_mirrored(ground, at({}), ConvexView::of_hull(s.rock),
+                         at(v3(0.1_fx, 0.5_fx + 0.3_fx * kPhi - 0.01_fx, 0_fx)));
+}
+
+TEST(ConvexProperties, OneUlpKeepsTheFeatures) {
+  const Shapes& s = shapes();
+  const Vec3 ulp = v3(Fixed::epsilon(), Fixed::epsilon(), Fixed::epsilon());
+  const ConvexView ground = ConvexView::box({2_fx, 0.5_fx, 2_fx});
+  const auto stable = [&](const ConvexView& a, const Pose& pa, const ConvexView& b, Pose pb) {
+    const Manifold m = collide_convex(a, pa, b, pb, kMargin);
+    pb.position += ulp;
+    const Manifold moved = collide_convex(a, pa, b, pb, kMargin);
+    ASSERT_EQ(m.count, 4U);
+    EXPECT_EQ(features(moved), features(m));
+  };
+  stable(ground, at({}), ConvexView::of_hull(s.cube), at(v3(0.3_fx, 0.99_fx, -0.2_fx)));
+  stable(ground, at({}), ConvexView::cylinder(0.4_fx, 0.5_fx), at(v3(0.1_fx, 0.995_fx, 0_fx)));
+  const Pose on_plane = at(v3(0_fx, 0.49_fx, 0_fx));
+  const Manifold m = convex_plane(ConvexView::of_hull(s.cube), on_plane, at({}), kMargin);
+  const Manifold moved =
+      convex_plane(ConvexView::of_hull(s.cube), at(on_plane.position + ulp), at({}), kMargin);
+  ASSERT_EQ(m.count, 4U);
+  EXPECT_EQ(features(moved), features(m));
+}
+
+TEST(ConvexProperties, MarginIsRespected) {
+  const Shapes& s = shapes();
+  const Fixed in = kMargin * 0.9_fx;
+  const Fixed out = kMargin * 1.1_fx;
+  const ConvexView ground = ConvexView::box({2_fx, 0.5_fx, 2_fx});
+  const ConvexView cube = ConvexView::of_hull(s.cube);
+  const ConvexView cyl = ConvexView::cylinder(0.4_fx, 0.5_fx);
+  for (const auto& [gap, expect_points] : {std::pair{in, true}, std::pair{out, false}}) {
+    SCOPED_TRACE(to_string(gap));
+    const Manifold m[] = {
+        collide_convex(ground, at({}), cube, at(v3(0.3_fx, 1_fx + gap, 0_fx)), kMargin),
+        convex_plane(cyl, at(v3(0_fx, 0.5_fx + gap, 0_fx)), at({}), kMargin),
+        convex_plane(cube, at(v3(0_fx, 0.5_fx + gap, 0_fx)), at({}), kMargin),
+        collide_convex(ConvexView::sphere(0.25_fx), at(v3(-0.2_fx, 0.75_fx + gap, 0_fx)),
+                       ConvexView::of_hull(s.tetra), at({}), kMargin),
+        collide_convex(cyl, at({}, about(Vec3::unit_z(), quarter_turn)), cyl,
+                       at(v3(0_fx, 0.8_fx + gap, 0_fx), about(Vec3::unit_x(), quarter_turn)),
+                       kMargin),
+    };
+    for (const Manifold& x : m) {
+      EXPECT_EQ(x.count > 0, expect_points);
+      expect_well_formed(x, kMargin);
+    }
+  }
+}
+
+}  // namespace
