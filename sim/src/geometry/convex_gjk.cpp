@@ -163,7 +163,7 @@ Closest gjk_closest(const Body& a, const Body& b) noexcept {
   Vec3 start = b.position - a.position;
   if (start == Vec3{}) start = Vec3::unit_x();
   Simplex s = make({support_of_difference(a, b, -start)}, {Fixed::one()});
-  const Fixed floor = Fixed::from_raw(Fixed::one_raw >> 30);
+  const Fixed floor = Fixed::from_raw(4);
   for (int iteration = 0; iteration < gjk_iterations; ++iteration) {
     const Vec3 v = s.closest;
     const Fixed vv = dot(v, v);
@@ -172,7 +172,7 @@ Closest gjk_closest(const Body& a, const Body& b) noexcept {
       break;
     }
     const Vertex w = support_of_difference(a, b, -v);
-    if (vv - dot(v, w.w) <= (vv >> 20) + floor) break;  // no point is much nearer
+    if (vv - dot(v, w.w) <= (vv >> 28) + floor) break;  // no point is much nearer
     bool repeated = false;
     for (int i = 0; i < s.n; ++i)
       repeated = repeated || s.v[static_cast<unsigned>(i)].w == w.w;

@@ -182,21 +182,19 @@ struct Candidates {
   }
 };
 
-/// Polygon reference: clip, then measure each incident point's height above the reference plane.
+/// Polygon reference within face_cos of n: clip, then measure each incident point's height above
+/// the reference plane along the reference normal, which becomes the contact normal (exact
+/// separations for faces resting on each other).
 Vec3 clip_contacts(const Body& a, const Body& b, const Face& fa, const Face& fb, bool ref_is_a,
-                   Vec3 n, Fixed margin, Candidates& out) noexcept {
+                   Fixed margin, Candidates& out) noexcept {
   const Face& ref = ref_is_a ? fa : fb;
   const Face& inc = ref_is_a ? fb : fa;
-  const Vec3 toward = ref_is_a ? ref.normal : -ref.normal;  // the ref normal, oriented a -> b
-  const bool snapped = dot(toward, n) >= face_cos;
-  if (snapped) n = toward;
-  const Fixed cosine = abs(dot(n, ref.normal));
+  const Vec3 n = ref_is_a ? ref.normal : -ref.normal;  // the ref normal, oriented a -> b
   const Fixed plane = dot(ref.normal, ref.points[0]);
   const Polygon poly = clip_incident(ref, inc);
   for (unsigned i = 0; i < poly.n; ++i) {
     const ClipVertex& v = poly.v[i];
-    const Fixed rise = dot(ref.normal, v.p) - plane;
-    const Fixed t = snapped ? rise : rise / cosine;  // along n, from a's core to b's
+    const Fixed t = dot(ref.normal, v.p) - plane;  // from a's core to b's along n
     const Vec3 on_a = ref_is_a ? v.p - n * t : v.p;
     const Vec3 on_b = ref_is_a ? v.p : v.p + n * t;
     const std::uint32_t id =
@@ -245,6 +243,32 @@ void segment_contacts(const Body& a, const Body& b, const Face& fa, const Face& 
                     pair_feature(segment_feature(fa, p.s, sa.half_length),
                                  segment_feature(fb, p.t, sb.half_length))),
           margin);
+}
+
+/// A polygon's edge farthest along `direction` (its lower end's height, ties to the first edge in
+/// the face's own order), as a two-point face; segments and points are returned unchanged.
+Face supporting_edge(const Face& f, Vec3 direction) noexcept {
+  if (f.count < 3) return f;
+  unsigned best = 0;
+  Fixed best_height = Fixed::min();
+  for (unsigned i = 0; i < f.count; ++i) {
+    const unsigned j = (i + 1) % f.count;
+    const Fixed h = min(dot(f.points[i], direction), dot(f.points[j], direction));
+    if (h > best_height) {
+      best_height = h;
+      best = i;
+    }
+  }
+  const unsigned j = (best + 1) % f.count;
+  Face e;
+  e.count = 2;
+  e.points[0] = f.points[best];
+  e.points[1] = f.points[j];
+  e.vertex[0] = f.vertex[best];
+  e.vertex[1] = f.vertex[j];
+  e.edge[0] = e.edge[1] = f.edge[best];
+  e.feature = f.edge[best];
+  return e;
 }
 
 }  // namespace manifold_detail
@@ -326,7 +350,14 @@ Manifold manifold_from_faces(const Body& a, const Body& b, Vec3 n, Reference ref
         ref_is_a = dot(-fb.normal, n) <= dot(fa.normal, n) + tolerance;
       }
     }
-    n = clip_contacts(a, b, fa, fb, ref_is_a, n, margin, found);
+    const Vec3 toward = ref_is_a ? fa.normal : -fb.normal;
+    if (dot(toward, n) >= face_cos) {
+      n = clip_contacts(a, b, fa, fb, ref_is_a, margin, found);
+    } else {
+      // Not a face contact (an edge or a vertex of a polytope is nearest): the supporting edges,
+      // whose closest points are the contact, or two points when they lie along each other.
+      segment_contacts(a, b, supporting_edge(fa, n), supporting_edge(fb, -n), n, margin, found);
+    }
   } else {
     segment_contacts(a, b, fa, fb, n, margin, found);
   }
