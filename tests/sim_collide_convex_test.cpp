@@ -2,6 +2,7 @@
 // and cylinders against each other and against a plane. Every expected value is worked out from
 // the geometry in the comment beside it; hulls are made by hand (support/hull_by_hand.hpp).
 #include <cstdint>
+#include <cstdio>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -431,9 +432,28 @@ TEST(ConvexProperties, MarginIsRespected) {
   }
 }
 
+Manifold mirrored(Manifold m) {
+  m.normal = -m.normal;
+  for (std::size_t i = 0; i < m.count; ++i)
+    m.points[i].feature = nf::mirror_feature(m.points[i].feature);
+  return m;
+}
+
+bool same_contacts(const Manifold& got, const Manifold& want) {
+  if (got.count != want.count) return false;
+  if (want.count > 0 && !near(got.normal, want.normal, kFine)) return false;
+  for (std::size_t i = 0; i < want.count; ++i) {
+    const ContactPoint* p = find_point(got, want.points[i].point, kFine);
+    if (p == nullptr || !near(p->separation, want.points[i].separation, kFine)) return false;
+  }
+  return true;
+}
+
 // Random poses (a fixed-seed LCG): box hulls and box views give box_box's contacts (the same
 // point set and separations within 2^-20; the views also its feature IDs), and a sphere against a
-// box hull gives sphere_box's. 600 poses, about 90 % of them touching or within the margin.
+// box hull gives sphere_box's. box_box prefers its first box's faces and collide_convex the
+// first of its canonical order, so near a tie between two faces the contacts are box_box's in
+// one order or the other. 600 poses, about 90 % of them touching or within the margin.
 TEST(ConvexProperties, RandomPosesAgreeWithThePrimitivePairs) {
   const Shapes& s = shapes();
   std::uint64_t state = 12345;
@@ -445,6 +465,7 @@ TEST(ConvexProperties, RandomPosesAgreeWithThePrimitivePairs) {
   const Shape ground = Shape::box({2_fx, 0.5_fx, 2_fx});
   const Shape ball = Shape::sphere(0.3_fx);
   int touching = 0;
+  int other_order = 0;
   for (int i = 0; i < 600; ++i) {
     SCOPED_TRACE(i);
     const Quat qa = normalize(Quat{next(), next(), next(), next()});
@@ -455,19 +476,23 @@ TEST(ConvexProperties, RandomPosesAgreeWithThePrimitivePairs) {
     const Pose pa = at(v3(5_fx, 1_fx, -3_fx), qa);
     const Pose pb = at(pa.position + v3(next(), next(), next()) * (big ? 1.6_fx : 1.05_fx), qb);
     const Manifold want = collide(sa, pa, cube, pb, kMargin);
+    const Manifold want_swapped = mirrored(collide(cube, pb, sa, pa, kMargin));
     touching += want.count > 0 ? 1 : 0;
-    expect_same_contacts(
-        collide_convex(ConvexView::of_hull(ha), pa, ConvexView::of_hull(s.cube), pb, kMargin),
-        want);
+    const Manifold hulls =
+        collide_convex(ConvexView::of_hull(ha), pa, ConvexView::of_hull(s.cube), pb, kMargin);
     const Manifold views =
         collide_convex(ConvexView::of(sa), pa, ConvexView::of(cube), pb, kMargin);
-    expect_same_contacts(views, want);
-    EXPECT_EQ(features(views), features(want));
+    const bool first = same_contacts(views, want);
+    other_order += first ? 0 : 1;
+    EXPECT_TRUE(first || same_contacts(views, want_swapped));
+    EXPECT_EQ(features(views), features(first ? want : want_swapped));
+    EXPECT_TRUE(same_contacts(hulls, first ? want : want_swapped));
     expect_same_contacts(
         collide_convex(ConvexView::of(ball), pb, ConvexView::of_hull(ha), pa, kMargin),
         collide(ball, pb, sa, pa, kMargin));
   }
   EXPECT_GT(touching, 500);
+  EXPECT_LT(other_order, 30);  // near ties only (11 of 600 when written)
 }
 
 }  // namespace

@@ -15,8 +15,9 @@
 //    clearly greater (collide_util's bias, the same rule as box_box);
 // 4. a face axis clips the incident face against the reference face; an edge axis between true
 //    edges gives the closest points of the two edges (one point, as box_box);
-// 5. apart, and the axis made no contact (corners passing each other, a cylinder's prism axis):
+// 5. apart, and the axis made no contact (corners passing each other), or apart with a cylinder:
 //    GJK closest points and the manifold along their direction.
+#include <array>
 #include <cstdint>
 
 #include <detsim/fixed/math.hpp>
@@ -166,6 +167,12 @@ Manifold apart(const Body& a, const Body& b, const Closest& c, Fixed margin) noe
   if (c.distance - a.radius - b.radius > margin) return {};
   const Vec3 n = normalize(c.on_b - c.on_a);
   Manifold m = manifold_from_faces(a, b, n, Reference::any, margin);
+  // The supporting features' own closest points corrected the normal (GJK converges slowly on a
+  // cylinder's side): once more along it, so that the features themselves sit where it says.
+  if (m.count > 0 && m.normal != n) {
+    const Manifold again = manifold_from_faces(a, b, m.normal, Reference::any, margin);
+    if (again.count > 0) m = again;
+  }
   if (m.count > 0) return m;
   const std::uint32_t id = pair_feature(face_at(a, n).feature, face_at(b, -n).feature);
   return single_point(a, b, c.on_a, c.on_b, n, id, margin);
@@ -199,10 +206,58 @@ bool edge_point(const Body& a, const Body& b, const Best& e, Fixed margin, Manif
 
 }  // namespace convex::collide_detail
 
+namespace convex::collide_detail {
+
+/// A total order on posed views, independent of the argument order: kind, dimensions, a hull's
+/// vertex count, then the pose's raw values. Never addresses (rule 4: not machine-dependent).
+std::array<std::int64_t, 20> order_key(const ConvexView& v, const Pose& p) noexcept {
+  const Mat3& r = p.rotation;
+  const std::int64_t hull_size =
+      v.hull != nullptr ? static_cast<std::int64_t>(v.hull->vertices.size()) : 0;
+  return {static_cast<std::int64_t>(v.kind),
+          v.radius.raw(),
+          v.half_height.raw(),
+          v.half_extents.x.raw(),
+          v.half_extents.y.raw(),
+          v.half_extents.z.raw(),
+          hull_size,
+          p.position.x.raw(),
+          p.position.y.raw(),
+          p.position.z.raw(),
+          r.rows[0].x.raw(),
+          r.rows[0].y.raw(),
+          r.rows[0].z.raw(),
+          r.rows[1].x.raw(),
+          r.rows[1].y.raw(),
+          r.rows[1].z.raw(),
+          r.rows[2].x.raw(),
+          r.rows[2].y.raw(),
+          r.rows[2].z.raw(),
+          0};
+}
+
+Manifold collide_ordered(const ConvexView& a, const Pose& pa, const ConvexView& b, const Pose& pb,
+                         Fixed margin) noexcept;
+
+}  // namespace convex::collide_detail
+
 Manifold collide_convex(const ConvexView& a, const Pose& pa, const ConvexView& b, const Pose& pb,
                         Fixed margin) noexcept {
-  using namespace convex;
   using namespace convex::collide_detail;
+  // The axis choice prefers the first shape's faces (as box_box does); solving every pair in one
+  // order and mirroring makes collide_convex(b, a) collide_convex(a, b) mirrored, bit for bit.
+  if (order_key(b, pb) >= order_key(a, pa)) return collide_ordered(a, pa, b, pb, margin);
+  Manifold m = collide_ordered(b, pb, a, pa, margin);
+  m.normal = -m.normal;
+  for (std::uint8_t i = 0; i < m.count; ++i)
+    m.points[i].feature = narrow::mirror_feature(m.points[i].feature);
+  return m;
+}
+
+Manifold convex::collide_detail::collide_ordered(const ConvexView& a, const Pose& pa,
+                                                 const ConvexView& b, const Pose& pb,
+                                                 Fixed margin) noexcept {
+  using namespace convex;
   const Body A = make_body(a, pa, pa.position);
   const Body B = make_body(b, pb, pa.position);
   if (length(B.position) - bounding_radius(a) - bounding_radius(b) > margin) return {};
@@ -225,12 +280,13 @@ Manifold collide_convex(const ConvexView& a, const Pose& pa, const ConvexView& b
       s.edge.found && (!face.found || clearly_greater(s.edge.separation, face.separation, scale));
   const Best& axis = use_edge ? s.edge : face;
   const bool apart_on_axis = axis.separation > Fixed::zero();
-  const bool straight_edges =
-      a.kind != ConvexKind::cylinder && b.kind != ConvexKind::cylinder && axis.exact;
-  if (use_edge && straight_edges) {
+  // A cylinder's true closest direction (its curved side or rim against a corner) is in no finite
+  // axis set: apart, its axes only bound the distance, so GJK measures it.
+  const bool curved = a.kind == ConvexKind::cylinder || b.kind == ConvexKind::cylinder;
+  if (use_edge && !curved && axis.exact) {
     Manifold m;
     if (edge_point(A, B, axis, margin, m)) return m;
-  } else if (axis.exact || !apart_on_axis) {
+  } else if (!apart_on_axis || (!curved && axis.exact)) {
     const Reference ref = use_edge ? Reference::any : (ref_is_b ? Reference::b : Reference::a);
     const Manifold m = manifold_from_faces(A, B, axis.normal, ref, margin);
     if (m.count > 0 || !apart_on_axis)

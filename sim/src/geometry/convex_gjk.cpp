@@ -102,13 +102,17 @@ Simplex on_triangle(const Vertex& a, const Vertex& b, const Vertex& c) noexcept 
   return triangle_interior(a, b, c);
 }
 
-/// Whether the origin and `opposite` lie on different sides of the plane of (p, q, r).
+/// Whether the origin may lie beyond the face (p, q, r) of a tetrahedron whose fourth vertex is
+/// `opposite`: on the other side of its plane, on the plane, or the tetrahedron too flat (fourth
+/// vertex within 2^-24 m of the plane, as when four support points lie on one face of a box or a
+/// cylinder's cap) to tell. Only a tetrahedron that strictly holds the origin means overlap.
 bool origin_outside(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& opposite) noexcept {
   const Vec3 n = normalize(cross(q - p, r - p));
   const Fixed origin_side = -dot(n, p);
   const Fixed opposite_side = dot(n, opposite - p);
-  return (origin_side > Fixed::zero() && opposite_side < Fixed::zero()) ||
-         (origin_side < Fixed::zero() && opposite_side > Fixed::zero());
+  const Fixed flat = Fixed::from_raw(Fixed::one_raw >> 24);
+  if (abs(opposite_side) <= flat || origin_side == Fixed::zero()) return true;
+  return (origin_side > Fixed::zero()) != (opposite_side > Fixed::zero());
 }
 
 Simplex on_tetrahedron(const Simplex& s) noexcept {

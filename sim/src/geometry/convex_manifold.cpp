@@ -191,7 +191,21 @@ Vec3 clip_contacts(const Body& a, const Body& b, const Face& fa, const Face& fb,
   const Face& inc = ref_is_a ? fb : fa;
   const Vec3 n = ref_is_a ? ref.normal : -ref.normal;  // the ref normal, oriented a -> b
   const Fixed plane = dot(ref.normal, ref.points[0]);
-  const Polygon poly = clip_incident(ref, inc);
+  Polygon poly = clip_incident(ref, inc);
+  // A cylinder's cap tilted against the reference: its true deepest rim point lies between two
+  // polygon points (up to r (1 - cos(pi / 16)) deeper), so it is a candidate of its own.
+  const Body& inc_body = ref_is_a ? b : a;
+  if (inc_body.view->kind == ConvexKind::cylinder && inc.count >= 3 &&
+      length_squared(cross(inc.normal, n)) >= flat_sin2) {
+    Face deepest;
+    const SupportPoint sp = support_at(inc_body, ref_is_a ? -n : n);
+    deepest.count = 1;
+    deepest.points[0] = sp.point;
+    deepest.vertex[0] = deepest.edge[0] = deepest.feature = sp.feature;
+    const Polygon extra = clip_incident(ref, deepest);
+    for (unsigned i = 0; i < extra.n; ++i)
+      poly.emit(extra.v[i]);
+  }
   for (unsigned i = 0; i < poly.n; ++i) {
     const ClipVertex& v = poly.v[i];
     const Fixed t = dot(ref.normal, v.p) - plane;  // from a's core to b's along n
@@ -219,7 +233,7 @@ std::uint16_t segment_feature(const Face& f, Fixed s, Fixed half_length) noexcep
 }
 
 /// Segments or points: the ends of the overlap of nearly parallel segments, else closest points.
-void segment_contacts(const Body& a, const Body& b, const Face& fa, const Face& fb, Vec3 n,
+Vec3 segment_contacts(const Body& a, const Body& b, const Face& fa, const Face& fb, Vec3 n,
                       Fixed margin, Candidates& out) noexcept {
   const Segment sa = as_segment(fa);
   const Segment sb = as_segment(fb);
@@ -236,14 +250,29 @@ void segment_contacts(const Body& a, const Body& b, const Face& fa, const Face& 
       const std::uint16_t on_b = end.b_end ? fb.vertex[end.b_top ? 1 : 0] : fb.feature;
       out.add(candidate(a, b, pa_end, sb.at(t), n, pair_feature(on_a, on_b)), margin);
     }
-    if (out.n > 0) return;
+    if (out.n > 0) return n;
   }
   const SegmentParams p = closest_on_segments(sa, sb);
-  out.add(candidate(a, b, sa.at(p.s), sb.at(p.t), n,
+  const Vec3 on_a = sa.at(p.s);
+  const Vec3 on_b = sb.at(p.t);
+  // Apart, the closest points of the two features give the normal exactly (line against line, an
+  // end against a line), better than a GJK direction iterated on a cylinder's curved side.
+  // Only two lines fix it whatever their positions (their common perpendicular); a point (a
+  // cylinder's rim) would carry the error of the direction that chose it.
+  const Vec3 v = on_b - on_a;
+  if (fa.count == 2 && fb.count == 2 && dot(v, n) > Fixed::zero() && length(v) > core_epsilon)
+    n = normalize(v);
+  out.add(candidate(a, b, on_a, on_b, n,
                     pair_feature(segment_feature(fa, p.s, sa.half_length),
                                  segment_feature(fb, p.t, sb.half_length))),
           margin);
+  return n;
 }
+
+/// The feature of b's face that is nearest along `direction` when the face is not flat against
+/// the other shape: a polytope face's supporting edge, a cylinder cap's exact rim point (its
+/// polygon's chords lie inside the true rim).
+Face supporting_feature(const Body& b, const Face& f, Vec3 direction) noexcept;
 
 /// A polygon's edge farthest along `direction` (its lower end's height, ties to the first edge in
 /// the face's own order), as a two-point face; segments and points are returned unchanged.
@@ -269,6 +298,16 @@ Face supporting_edge(const Face& f, Vec3 direction) noexcept {
   e.edge[0] = e.edge[1] = f.edge[best];
   e.feature = f.edge[best];
   return e;
+}
+
+Face supporting_feature(const Body& b, const Face& f, Vec3 direction) noexcept {
+  if (b.view->kind != ConvexKind::cylinder || f.count < 3) return supporting_edge(f, direction);
+  const SupportPoint s = support_at(b, direction);
+  Face point;
+  point.count = 1;
+  point.points[0] = s.point;
+  point.vertex[0] = point.edge[0] = point.feature = s.feature;
+  return point;
 }
 
 }  // namespace manifold_detail
@@ -356,10 +395,11 @@ Manifold manifold_from_faces(const Body& a, const Body& b, Vec3 n, Reference ref
     } else {
       // Not a face contact (an edge or a vertex of a polytope is nearest): the supporting edges,
       // whose closest points are the contact, or two points when they lie along each other.
-      segment_contacts(a, b, supporting_edge(fa, n), supporting_edge(fb, -n), n, margin, found);
+      n = segment_contacts(a, b, supporting_feature(a, fa, n), supporting_feature(b, fb, -n), n,
+                           margin, found);
     }
   } else {
-    segment_contacts(a, b, fa, fb, n, margin, found);
+    n = segment_contacts(a, b, fa, fb, n, margin, found);
   }
   Manifold m;
   m.normal = n;
