@@ -134,18 +134,26 @@ Face box_face_toward(Vec3 h, Vec3 d) noexcept {
   return f;
 }
 
+/// The face around the support vertex that most faces d (ties to the lower index): the most
+/// aligned face of all may not touch the support vertex, and then its edges are not the nearest.
 Face hull_face_toward(const Hull& hull, Vec3 d) noexcept {
   Face f;
   if (hull.faces.empty()) return f;
-  std::size_t best = 0;
-  Fixed best_dot = dot(hull.faces[0].normal, d);
-  for (std::size_t i = 1; i < hull.faces.size(); ++i) {
-    const Fixed x = dot(hull.faces[i].normal, d);
-    if (x > best_dot) {
+  const std::uint16_t top = hull_support(hull, d);
+  std::size_t best = hull.faces.size();
+  Fixed best_dot;
+  for (std::size_t i = 0; i < hull.faces.size(); ++i) {
+    const HullFace& face = hull.faces[i];
+    bool around = false;
+    for (unsigned k = 0; k < face.count && !around; ++k)
+      around = hull.face_vertices[face.first + k] == top;
+    const Fixed x = dot(face.normal, d);
+    if (around && (best == hull.faces.size() || x > best_dot)) {
       best_dot = x;
       best = i;
     }
   }
+  if (best == hull.faces.size()) best = 0;  // a malformed hull: any face
   const HullFace& face = hull.faces[best];
   f.normal = face.normal;
   f.feature = convex_feature(kFace, static_cast<unsigned>(best));

@@ -162,6 +162,13 @@ Sat separating_axes(const Body& a, const Body& b, Fixed margin) noexcept {
   return s;
 }
 
+Fixed deepest_separation(const Manifold& m) noexcept {
+  Fixed deepest = Fixed::max();
+  for (std::uint8_t i = 0; i < m.count; ++i)
+    deepest = min(deepest, m.points[i].separation);
+  return deepest;
+}
+
 /// Cores apart (GJK): separation = distance - radii, normal along the closest points.
 Manifold apart(const Body& a, const Body& b, const Closest& c, Fixed margin) noexcept {
   if (c.distance - a.radius - b.radius > margin) return {};
@@ -173,7 +180,11 @@ Manifold apart(const Body& a, const Body& b, const Closest& c, Fixed margin) noe
     const Manifold again = manifold_from_faces(a, b, m.normal, Reference::any, margin);
     if (again.count > 0) m = again;
   }
-  if (m.count > 0) return m;
+  // The faces' deepest point must be as near as GJK measured (within 2^-12 m): otherwise they are
+  // not the closest features (a supporting edge beside the nearest point, a rim seen through its
+  // polygon), and the closest points themselves are the contact.
+  const Fixed measured = c.distance - a.radius - b.radius;
+  if (m.count > 0 && abs(deepest_separation(m) - measured) <= (core_epsilon << 4)) return m;
   const std::uint32_t id = pair_feature(face_at(a, n).feature, face_at(b, -n).feature);
   return single_point(a, b, c.on_a, c.on_b, n, id, margin);
 }
@@ -261,7 +272,11 @@ Manifold convex::collide_detail::collide_ordered(const ConvexView& a, const Pose
   const Body A = make_body(a, pa, pa.position);
   const Body B = make_body(b, pb, pa.position);
   if (length(B.position) - bounding_radius(a) - bounding_radius(b) > margin) return {};
-  if (is_round(a) || is_round(b)) {
+  // Round cores and cylinders: GJK first. A cylinder's finite axis set can only prove separation,
+  // never overlap (rim against rim may be apart along a direction no axis has), so SAT only
+  // measures the penetration of cores GJK found to meet.
+  const bool curved = a.kind == ConvexKind::cylinder || b.kind == ConvexKind::cylinder;
+  if (is_round(a) || is_round(b) || curved) {
     const Closest c = gjk_closest(A, B);
     if (!c.overlap && c.distance > core_epsilon) return apart(A, B, c, margin);
   }
@@ -280,17 +295,16 @@ Manifold convex::collide_detail::collide_ordered(const ConvexView& a, const Pose
       s.edge.found && (!face.found || clearly_greater(s.edge.separation, face.separation, scale));
   const Best& axis = use_edge ? s.edge : face;
   const bool apart_on_axis = axis.separation > Fixed::zero();
-  // A cylinder's true closest direction (its curved side or rim against a corner) is in no finite
-  // axis set: apart, its axes only bound the distance, so GJK measures it.
-  const bool curved = a.kind == ConvexKind::cylinder || b.kind == ConvexKind::cylinder;
   if (use_edge && !curved && axis.exact) {
     Manifold m;
     if (edge_point(A, B, axis, margin, m)) return m;
   } else if (!apart_on_axis || (!curved && axis.exact)) {
     const Reference ref = use_edge ? Reference::any : (ref_is_b ? Reference::b : Reference::a);
     const Manifold m = manifold_from_faces(A, B, axis.normal, ref, margin);
-    if (m.count > 0 || !apart_on_axis)
-      return m.count > 0 ? m : support_pair(A, B, axis.normal, margin);
+    if (!apart_on_axis) return m.count > 0 ? m : support_pair(A, B, axis.normal, margin);
+    // Apart, the face's deepest clipped point must be the axis' own gap; deeper than that, the
+    // nearest features lie off the face (a corner beside it) and GJK finds them.
+    if (m.count > 0 && deepest_separation(m) <= axis.separation + core_epsilon) return m;
   }
   const Closest c = gjk_closest(A, B);
   if (c.overlap) return support_pair(A, B, axis.normal, margin);
