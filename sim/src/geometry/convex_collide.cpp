@@ -162,6 +162,9 @@ Sat separating_axes(const Body& a, const Body& b, Fixed margin) noexcept {
   return s;
 }
 
+/// How far above a lower bound of the distance a separation may be from rounding alone (2^-20 m).
+constexpr Fixed rounding_slack = Fixed::from_raw(Fixed::one_raw >> 20);
+
 Fixed deepest_separation(const Manifold& m) noexcept {
   Fixed deepest = Fixed::max();
   for (std::uint8_t i = 0; i < m.count; ++i)
@@ -180,13 +183,23 @@ Manifold apart(const Body& a, const Body& b, const Closest& c, Fixed margin) noe
     const Manifold again = manifold_from_faces(a, b, m.normal, Reference::any, margin);
     if (again.count > 0) m = again;
   }
-  // The faces' deepest point must be as near as GJK measured (within 2^-12 m): otherwise they are
-  // not the closest features (a supporting edge beside the nearest point, a rim seen through its
-  // polygon), and the closest points themselves are the contact.
+  // Separations apart must be lower bounds of the distance (the time-of-impact sweep advances by
+  // them): the gap of the projections on the normal is one. The faces' deepest point may not
+  // exceed it (beyond 2^-20 m of rounding) and must be GJK's distance (within 2^-12 m); otherwise
+  // they are not the nearest features (an edge beside the nearest point, a rim seen through its
+  // polygon) and the closest points are the contact, at the bound along GJK's direction.
   const Fixed measured = c.distance - a.radius - b.radius;
-  if (m.count > 0 && abs(deepest_separation(m) - measured) <= (core_epsilon << 4)) return m;
+  if (m.count > 0) {
+    const Fixed deepest = deepest_separation(m);
+    if (deepest <= separation_along(a, b, m.normal) + rounding_slack &&
+        abs(deepest - measured) <= (core_epsilon << 4))
+      return m;
+  }
   const std::uint32_t id = pair_feature(face_at(a, n).feature, face_at(b, -n).feature);
-  return single_point(a, b, c.on_a, c.on_b, n, id, margin);
+  Manifold one = single_point(a, b, c.on_a, c.on_b, n, id, margin);
+  if (one.count > 0)
+    one.points[0].separation = min(one.points[0].separation, separation_along(a, b, n));
+  return one;
 }
 
 /// The two support points along n as one contact: the last resort of overlapping cores.
@@ -304,7 +317,7 @@ Manifold convex::collide_detail::collide_ordered(const ConvexView& a, const Pose
     if (!apart_on_axis) return m.count > 0 ? m : support_pair(A, B, axis.normal, margin);
     // Apart, the face's deepest clipped point must be the axis' own gap; deeper than that, the
     // nearest features lie off the face (a corner beside it) and GJK finds them.
-    if (m.count > 0 && deepest_separation(m) <= axis.separation + core_epsilon) return m;
+    if (m.count > 0 && deepest_separation(m) <= axis.separation + rounding_slack) return m;
   }
   const Closest c = gjk_closest(A, B);
   if (c.overlap) return support_pair(A, B, axis.normal, margin);

@@ -257,10 +257,13 @@ Vec3 segment_contacts(const Body& a, const Body& b, const Face& fa, const Face& 
   const Vec3 on_b = sb.at(p.t);
   // Apart, the closest points of the two features give the normal exactly (line against line, an
   // end against a line), better than a GJK direction iterated on a cylinder's curved side.
-  // Only two lines fix it whatever their positions (their common perpendicular); a point (a
-  // cylinder's rim) would carry the error of the direction that chose it.
+  // Only two lines crossing between their ends fix it whatever their positions (their common
+  // perpendicular); an end or a point (a cylinder's rim) would carry the error of the direction
+  // that chose it.
   const Vec3 v = on_b - on_a;
-  if (fa.count == 2 && fb.count == 2 && dot(v, n) > Fixed::zero() && length(v) > core_epsilon)
+  const bool inside = abs(p.s) < sa.half_length && abs(p.t) < sb.half_length;
+  if (fa.count == 2 && fb.count == 2 && inside && dot(v, n) > Fixed::zero() &&
+      length(v) > core_epsilon)
     n = normalize(v);
   out.add(candidate(a, b, on_a, on_b, n,
                     pair_feature(segment_feature(fa, p.s, sa.half_length),
