@@ -357,6 +357,23 @@ TEST_F(Cylinder, CrossedAtRightAngles) {
   }
 }
 
+TEST_F(Cylinder, LogsSideBySide) {
+  // Two lying cylinders (axes along x), b's centre r_a + r_b + gap above a's: their side lines
+  // touch along the whole length, two points at x = +-0.5 (the overlap's ends), each `gap` apart.
+  for (const Fixed gap : {-0.01_fx, 0.05_fx}) {
+    SCOPED_TRACE(to_string(gap));
+    const Manifold m = collide_convex(cyl, at(p, lying), cyl,
+                                      at(p + v3(0_fx, 0.8_fx + gap, 0_fx), lying), kMargin);
+    ASSERT_EQ(m.count, 2U);
+    EXPECT_TRUE(near(m.normal, Vec3::unit_y()));
+    for (const Fixed x : {-0.5_fx, 0.5_fx}) {
+      const ContactPoint* c = find_point(m, p + v3(x, 0.4_fx + (gap >> 1), 0_fx));
+      ASSERT_NE(c, nullptr) << to_string(x);
+      EXPECT_TRUE(near(c->separation, gap));
+    }
+  }
+}
+
 TEST_F(Cylinder, TiltedOnAPlaneTouchesAtItsLowestRimPoint) {
   // Tilted 0.4 rad about z with its centre at height 1: the lowest rim point is
   // h cos 0.4 + r sin 0.4 below the centre.

@@ -154,10 +154,30 @@ void edge_axes(const Body& a, const Body& b, Fixed margin, Best& best, bool& bey
   }
 }
 
+/// A cylinder's side direction toward the other shape's interior: the normal of two cylinders
+/// lying side by side (logs), or of a side against a shape beside it, which no prism face has.
+/// Offered after the prism's faces, as a face of the cylinder.
+void radial_axis(const Body& owner, const Body& other, bool owner_is_a, Fixed margin, Best& best,
+                 bool& beyond) noexcept {
+  if (owner.view->kind != ConvexKind::cylinder || beyond) return;
+  const Vec3 axis = owner.rotation.column(1);
+  const Vec3 d = interior(other) - owner.position;
+  const Vec3 radial = d - axis * dot(d, axis);
+  if (length_squared(radial) == Fixed::zero()) return;
+  const Vec3 m = normalize(radial);
+  const Vec3 l = owner_is_a ? m : -m;
+  const Fixed s =
+      owner_is_a ? separation_along(owner, other, l) : separation_along(other, owner, l);
+  if (s > margin) beyond = true;
+  best.offer(l, s, true, sat_face_count(*owner.view), 0);
+}
+
 Sat separating_axes(const Body& a, const Body& b, Fixed margin) noexcept {
   Sat s;
   face_axes(a, a, b, true, margin, s.face_a, s.beyond);
+  radial_axis(a, b, true, margin, s.face_a, s.beyond);
   face_axes(b, a, b, false, margin, s.face_b, s.beyond);
+  radial_axis(b, a, false, margin, s.face_b, s.beyond);
   edge_axes(a, b, margin, s.edge, s.beyond);
   return s;
 }
