@@ -39,6 +39,8 @@ constexpr unsigned kFace = static_cast<unsigned>(Kind::face);
 /// directions are exact and opposite points are exact negatives.
 struct RimTable {
   std::array<Vec3, kRim> at{};
+  std::array<Vec3, kRim> side{};   ///< the prism's side k normal, between points k and k + 1
+  std::array<Vec3, kRim> chord{};  ///< unit direction from point k to point k + 1
   RimTable() noexcept {
     const Fixed two = Fixed::from_int(2);
     const Fixed c = sqrt(two + Fixed::sqrt2()) >> 1;  // cos 22.5
@@ -56,6 +58,10 @@ struct RimTable {
         z = t;
       }
       at[k] = Vec3{x, Fixed::zero(), z};
+    }
+    for (unsigned k = 0; k < kRim; ++k) {
+      side[k] = normalize(at[k] + at[(k + 1) % kRim]);
+      chord[k] = normalize(at[(k + 1) % kRim] - at[k]);
     }
   }
 };
@@ -326,7 +332,7 @@ SatFace sat_face(const ConvexView& v, unsigned i) noexcept {
       return {axis_vector(static_cast<int>(i / 2), i % 2 == 0), true};
     case ConvexKind::cylinder:
       if (i < 2) return {axis_vector(1, i == 0), true};
-      return {normalize(rim_direction(i - 2) + rim_direction(i - 1)), false};
+      return {rim_table().side[(i - 2) % kRim], false};
     case ConvexKind::hull:
       return {v.hull->faces[i].normal, true};
     default:
@@ -355,6 +361,7 @@ SatEdge sat_edge(const ConvexView& v, unsigned i) noexcept {
     case ConvexKind::capsule:
       e.p0 = Vec3{Fixed::zero(), -v.half_height, Fixed::zero()};
       e.p1 = -e.p0;
+      e.direction = Vec3::unit_y();
       e.feature = capsule_core;
       e.circle = true;
       return e;
@@ -368,6 +375,7 @@ SatEdge sat_edge(const ConvexView& v, unsigned i) noexcept {
       const unsigned lo = (s[0] ? 1U : 0U) | (s[1] ? 2U : 0U) | (s[2] ? 4U : 0U);
       e.p0 = box_corner(v.half_extents, lo);
       e.p1 = box_corner(v.half_extents, lo | (1U << static_cast<unsigned>(axis)));
+      e.direction = axis_vector(axis);
       e.n0 = axis_vector((axis + 1) % 3, s1);
       e.n1 = axis_vector((axis + 2) % 3, s2);
       e.feature = box_edge(axis, s);
@@ -386,12 +394,14 @@ SatEdge sat_edge(const ConvexView& v, unsigned i) noexcept {
         const bool top = i < kRim;
         e.p0 = top ? p + up : p - up;
         e.p1 = top ? q + up : q - up;
+        e.direction = rim_table().chord[k];
         e.n0 = axis_vector(1, top);
         e.n1 = side_after;
         return e;
       }
       e.p0 = p - up;  // a side line, through rim point k: a true line of the cylinder
       e.p1 = p + up;
+      e.direction = Vec3::unit_y();
       e.n0 = side_before;
       e.n1 = side_after;
       e.exact = true;
@@ -401,6 +411,7 @@ SatEdge sat_edge(const ConvexView& v, unsigned i) noexcept {
       const HullEdge& h = v.hull->edges[i];
       e.p0 = v.hull->vertices[h.a];
       e.p1 = v.hull->vertices[h.b];
+      e.direction = normalize(e.p1 - e.p0);
       e.n0 = v.hull->faces[h.face_0].normal;
       e.n1 = v.hull->faces[h.face_1].normal;
       e.feature = convex_feature(kEdge, i);

@@ -123,6 +123,7 @@ struct SatFace {
 struct SatEdge {
   Vec3 p0;
   Vec3 p1;
+  Vec3 direction;  ///< unit, p0 -> p1
   Vec3 n0;
   Vec3 n1;
   std::uint16_t feature = 0;

@@ -72,51 +72,96 @@ struct Sat {
 
 struct WorldEdge {
   Vec3 p0;
-  Vec3 p1;
-  Vec3 direction;
-  Vec3 n0;
+  Vec3 local_p1;   ///< the other end, in the body's frame (only edge contacts need it posed)
+  Vec3 direction;  ///< unit, p0 -> p1
+  Vec3 n0;         ///< the Gauss-map arc (world)
   Vec3 n1;
-  SatEdge local;
+  Vec3 arc;  ///< n1 x n0: perpendicular to the arc's plane
+  std::uint16_t feature = 0;
+  bool circle = false;
+  bool exact = true;
 };
 
+/// Edge i of b posed in world space. A box's direction and arc are its rotation's columns.
 WorldEdge world_edge(const Body& b, unsigned i) noexcept {
   const SatEdge e = sat_edge(*b.view, i);
-  WorldEdge w{b.position + b.rotation * e.p0,
-              b.position + b.rotation * e.p1,
-              {},
-              b.rotation * e.n0,
-              b.rotation * e.n1,
-              e};
-  w.direction = normalize(w.p1 - w.p0);
+  WorldEdge w;
+  w.p0 = b.position + b.rotation * e.p0;
+  w.local_p1 = e.p1;
+  w.feature = e.feature;
+  w.circle = e.circle;
+  w.exact = e.exact;
+  if (b.view->kind == ConvexKind::box) {
+    const unsigned axis = i / 4;
+    w.direction = b.rotation.column(axis);
+    const Vec3 u = b.rotation.column((axis + 1) % 3);
+    const Vec3 v = b.rotation.column((axis + 2) % 3);
+    w.n0 = (i & 1U) != 0 ? u : -u;
+    w.n1 = (i & 2U) != 0 ? v : -v;
+  } else {
+    w.direction = b.rotation * e.direction;
+    w.n0 = b.rotation * e.n0;
+    w.n1 = b.rotation * e.n1;
+  }
+  w.arc = cross(w.n1, w.n0);
   return w;
 }
+
+/// The edges of b in world space, posed once per pair (each needs a normalisation) when there
+/// are at most kCachedEdges of them; larger hulls pose them as they are read.
+constexpr unsigned kCachedEdges = 64;
+struct PosedEdges {
+  const Body& body;
+  unsigned count;
+  std::array<WorldEdge, kCachedEdges> cache;
+  explicit PosedEdges(const Body& b) noexcept : body(b), count(sat_edge_count(*b.view)) {
+    if (count > kCachedEdges) return;
+    for (unsigned i = 0; i < count; ++i)
+      cache[i] = world_edge(b, i);
+  }
+  /// Edge i, from the cache or posed into `scratch`.
+  [[nodiscard]] const WorldEdge& at(unsigned i, WorldEdge& scratch) const noexcept {
+    if (count <= kCachedEdges) return cache[i];
+    scratch = world_edge(body, i);
+    return scratch;
+  }
+};
 
 int sign(Fixed x) noexcept {
   return x > Fixed::zero() ? 1 : (x < Fixed::zero() ? -1 : 0);
 }
 
+/// The sign of u . v for vectors of length <= 1 (Gauss-map normals and their cross products),
+/// from 16-bit-truncated components in 64-bit integers: exact integer arithmetic (deterministic),
+/// about 2^-31 of resolution, and several times cheaper than the exact Fixed dot, which the
+/// all-pairs edge test would otherwise call ~2 E_a E_b times.
+int sign_of_dot(Vec3 u, Vec3 v) noexcept {
+  constexpr std::int64_t unit = std::int64_t{1} << 16;
+  const std::int64_t sum = (u.x.raw() / unit) * (v.x.raw() / unit) +
+                           (u.y.raw() / unit) * (v.y.raw() / unit) +
+                           (u.z.raw() / unit) * (v.z.raw() / unit);
+  return sum > 0 ? 1 : (sum < 0 ? -1 : 0);
+}
+
 /// Whether the arc (n0, n1) crosses the great circle perpendicular to u.
 bool arc_meets_circle(Vec3 n0, Vec3 n1, Vec3 u) noexcept {
-  return sign(dot(n0, u)) * sign(dot(n1, u)) <= 0;
+  return sign_of_dot(n0, u) * sign_of_dot(n1, u) <= 0;
 }
 
 /// Whether edges ea (of a) and eb (of b) make a face of the Minkowski difference: their Gauss-map
 /// arcs, a's and b's negated, intersect (Gregorius). A segment core's arc is a whole circle.
 bool minkowski_face(const WorldEdge& ea, const WorldEdge& eb) noexcept {
-  if (ea.local.circle && eb.local.circle) return true;
-  if (ea.local.circle) return arc_meets_circle(-eb.n0, -eb.n1, ea.direction);
-  if (eb.local.circle) return arc_meets_circle(ea.n0, ea.n1, eb.direction);
-  const Vec3 a = ea.n0;
-  const Vec3 b = ea.n1;
-  const Vec3 c = -eb.n0;
-  const Vec3 d = -eb.n1;
-  const Vec3 bxa = cross(b, a);
-  const Vec3 dxc = cross(d, c);
-  const int cba = sign(dot(c, bxa));
-  const int dba = sign(dot(d, bxa));
-  const int adc = sign(dot(a, dxc));
-  const int bdc = sign(dot(b, dxc));
-  return cba * dba < 0 && adc * bdc < 0 && cba * bdc > 0;
+  if (ea.circle && eb.circle) return true;
+  if (ea.circle) return arc_meets_circle(-eb.n0, -eb.n1, ea.direction);
+  if (eb.circle) return arc_meets_circle(ea.n0, ea.n1, eb.direction);
+  // Arcs (a, b) = (ea.n0, ea.n1) and (c, d) = (-eb.n0, -eb.n1); b x a and d x c = (eb.n1 x eb.n0)
+  // are each edge's `arc`, made once per edge. Most pairs fail the first test.
+  const int cba = -sign_of_dot(eb.n0, ea.arc);
+  const int dba = -sign_of_dot(eb.n1, ea.arc);
+  if (cba * dba >= 0) return false;
+  const int adc = sign_of_dot(ea.n0, eb.arc);
+  const int bdc = sign_of_dot(ea.n1, eb.arc);
+  return adc * bdc < 0 && cba * bdc > 0;
 }
 
 void face_axes(const Body& owner, const Body& a, const Body& b, bool owner_is_a, Fixed margin,
@@ -134,22 +179,29 @@ void face_axes(const Body& owner, const Body& a, const Body& b, bool owner_is_a,
 
 void edge_axes(const Body& a, const Body& b, Fixed margin, Best& best, bool& beyond) noexcept {
   const unsigned count_a = sat_edge_count(*a.view);
-  const unsigned count_b = sat_edge_count(*b.view);
+  const PosedEdges edges_b(b);
   const Vec3 inside_a = interior(a);
   const Vec3 inside_b = interior(b);
+  const bool straight =
+      a.view->kind != ConvexKind::cylinder && b.view->kind != ConvexKind::cylinder;
   for (unsigned i = 0; i < count_a && !beyond; ++i) {
     const WorldEdge ea = world_edge(a, i);
-    for (unsigned j = 0; j < count_b && !beyond; ++j) {
-      const WorldEdge eb = world_edge(b, j);
+    for (unsigned j = 0; j < edges_b.count && !beyond; ++j) {
+      WorldEdge scratch;
+      const WorldEdge& eb = edges_b.at(j, scratch);
       if (!minkowski_face(ea, eb)) continue;
       const Vec3 w = cross(ea.direction, eb.direction);
       if (length_squared(w) < parallel_sin2) continue;  // parallel edges add no direction
       Vec3 l = normalize(w);
-      const Fixed out = ea.local.circle ? dot(l, inside_b - eb.p0) : dot(l, ea.p0 - inside_a);
+      const Fixed out = ea.circle ? dot(l, inside_b - eb.p0) : dot(l, ea.p0 - inside_a);
       if (out < Fixed::zero()) l = -l;
-      const Fixed s = separation_along(a, b, l);
+      // On a face of the Minkowski difference both edges support their shapes along l
+      // (Gregorius), so the edges' own gap is the axis' gap, without a support search; a
+      // cylinder's prism edges are not the cylinder's, so it is measured.
+      const Fixed s =
+          straight ? dot(l, eb.p0 - ea.p0) - a.radius - b.radius : separation_along(a, b, l);
       if (s > margin) beyond = true;
-      best.offer(l, s, ea.local.exact && eb.local.exact, i, j);
+      best.offer(l, s, ea.exact && eb.exact, i, j);
     }
   }
 }
@@ -234,8 +286,10 @@ Manifold support_pair(const Body& a, const Body& b, Vec3 n, Fixed margin) noexce
 bool edge_point(const Body& a, const Body& b, const Best& e, Fixed margin, Manifold& m) noexcept {
   const WorldEdge ea = world_edge(a, e.index_a);
   const WorldEdge eb = world_edge(b, e.index_b);
-  const Segment sa{midpoint(ea.p0, ea.p1), ea.direction, length(ea.p1 - ea.p0) >> 1};
-  const Segment sb{midpoint(eb.p0, eb.p1), eb.direction, length(eb.p1 - eb.p0) >> 1};
+  const Vec3 pa1 = a.position + a.rotation * ea.local_p1;
+  const Vec3 pb1 = b.position + b.rotation * eb.local_p1;
+  const Segment sa{midpoint(ea.p0, pa1), ea.direction, length(pa1 - ea.p0) >> 1};
+  const Segment sb{midpoint(eb.p0, pb1), eb.direction, length(pb1 - eb.p0) >> 1};
   const SegmentParams p = closest_on_segments(sa, sb);
   const bool crossing = abs(p.s) < sa.half_length && abs(p.t) < sb.half_length;
   if (!crossing && e.separation > Fixed::zero()) return false;
@@ -243,8 +297,8 @@ bool edge_point(const Body& a, const Body& b, const Best& e, Fixed margin, Manif
   const Vec3 on_b = sb.at(p.t) - e.normal * b.radius;
   m = {};
   m.normal = e.normal;
-  add_point(m, a.origin + midpoint(on_a, on_b), e.separation,
-            pair_feature(ea.local.feature, eb.local.feature), margin);
+  add_point(m, a.origin + midpoint(on_a, on_b), e.separation, pair_feature(ea.feature, eb.feature),
+            margin);
   return true;
 }
 
