@@ -184,10 +184,10 @@ void edge_axes(const Body& a, const Body& b, Fixed margin, Best& best, bool& bey
   const Vec3 inside_b = interior(b);
   const bool straight =
       a.view->kind != ConvexKind::cylinder && b.view->kind != ConvexKind::cylinder;
+  WorldEdge scratch;
   for (unsigned i = 0; i < count_a && !beyond; ++i) {
     const WorldEdge ea = world_edge(a, i);
     for (unsigned j = 0; j < edges_b.count && !beyond; ++j) {
-      WorldEdge scratch;
       const WorldEdge& eb = edges_b.at(j, scratch);
       if (!minkowski_face(ea, eb)) continue;
       const Vec3 w = cross(ea.direction, eb.direction);
