@@ -349,7 +349,18 @@ void reduce_into(std::span<const Candidate> c, Vec3 normal, Vec3 origin, Manifol
     return best < c.size();
   };
   const auto depth = [](const Candidate& x) { return -x.separation; };
-  pick(depth, true);
+  // The first point: the deepest, where depths within 2^-16 m count as equal (lowest feature
+  // wins), so that a face resting a hair off level (a cylinder's 16 rim points, a hull's hexagon)
+  // keeps the same four points from step to step; the manifold's least separation may then
+  // exceed the true least by at most 2^-16 m.
+  Fixed lowest = Fixed::max();
+  for (const Candidate& x : c)
+    lowest = min(lowest, x.separation);
+  pick(
+      [&](const Candidate& x) {
+        return x.separation <= lowest + core_epsilon ? Fixed::one() : Fixed::zero();
+      },
+      false);
   const Vec3 p0 = c[chosen[0]].point;
   if (pick([&](const Candidate& x) { return length_squared(x.point - p0); }, false)) {
     const Vec3 p1 = c[chosen[1]].point;
