@@ -182,6 +182,36 @@ TEST(ConvexHull, RockAgainstBoxIsWellFormedAndRepeatable) {
       identical(m, collide_convex(ground, at({}), ConvexView::of_hull(s.rock), pb, kMargin)));
 }
 
+TEST(ConvexHull, ManySidedPrismRestsOnFourOfItsCorners) {
+  // A 24-sided prism (radius 0.5, half height 0.3: 48 vertices, 72 edges, more than the SAT's
+  // 64-edge cache, so its edges are posed as they are read) resting `gap` into a box's top face:
+  // its 24-gon bottom face reduces to four corners, each at `gap`, on the circle of radius 0.5.
+  // Coincident with itself, it is finite and repeatable.
+  std::vector<Vec3> p;
+  for (int k = 0; k < 24; ++k) {
+    const SinCos sc = sincos(Fixed::two_pi() * Fixed::from_int(k) / 24_fx);
+    p.push_back(v3(sc.cos * 0.5_fx, -0.3_fx, sc.sin * 0.5_fx));
+    p.push_back(v3(sc.cos * 0.5_fx, 0.3_fx, sc.sin * 0.5_fx));
+  }
+  const Hull prism = hull_by_hand(p);
+  ASSERT_EQ(prism.edges.size(), 72U);
+  const Fixed gap = -0.005_fx;
+  const ConvexView ground = ConvexView::box({2_fx, 0.5_fx, 2_fx});
+  const Manifold m = collide_convex(ground, at({}), ConvexView::of_hull(prism),
+                                    at(v3(0_fx, 0.8_fx + gap, 0_fx)), kMargin);
+  ASSERT_EQ(m.count, 4U);
+  EXPECT_EQ(m.normal, Vec3::unit_y());
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_TRUE(near(m.points[i].separation, gap));
+    EXPECT_TRUE(near(length(v3(m.points[i].point.x, 0_fx, m.points[i].point.z)), 0.5_fx, 1e-5_fx));
+  }
+  const ConvexView view = ConvexView::of_hull(prism);
+  const Manifold self = collide_convex(view, at({}), view, at({}), kMargin);
+  ASSERT_GT(self.count, 0U);
+  expect_well_formed(self, kMargin);
+  EXPECT_TRUE(identical(self, collide_convex(view, at({}), view, at({}), kMargin)));
+}
+
 // ---- Planes -------------------------------------------------------------------------------------
 
 TEST(ConvexPlane, HullRestingFlatAndTilted) {
