@@ -540,4 +540,43 @@ TEST(ConvexProperties, CylinderBoxDistanceMatchesSampling) {
   EXPECT_GT(checked, 25);
 }
 
+// Two cylinders overlapping a little at random poses: the penetration is minus the largest gap of
+// the projections over all directions, sampled here on a 100 x 200 grid (a lower bound of that
+// largest gap). The manifold's depth may exceed it by the finite axis set's error only: 0.0042 m
+// at worst over 41 such poses (r = 0.4) when written, against a finer grid.
+TEST(ConvexProperties, CylinderPenetrationIsNearTheLeastOverlap) {
+  Lcg next{31337};
+  const ConvexView cyl = ConvexView::cylinder(0.4_fx, 0.5_fx);
+  int checked = 0;
+  for (int i = 0; i < 60 && checked < 12; ++i) {
+    SCOPED_TRACE(i);
+    const Quat qa = normalize(Quat{next(), next(), next(), next()});
+    const Quat qb = normalize(Quat{next(), next(), next(), next()});
+    const Pose pa = at(v3(1_fx, 2_fx, 3_fx), qa);
+    const Vec3 dir = normalize(v3(next(), next(), next()));
+    const Pose pb = at(pa.position + dir * (0.9_fx + next() * 0.2_fx), qb);
+    const cv::Body a = cv::make_body(cyl, pa, pa.position);
+    const cv::Body b = cv::make_body(cyl, pb, pa.position);
+    Fixed least_overlap = Fixed::min();
+    for (int u = 0; u <= 100; ++u) {
+      const SinCos st = sincos(Fixed::pi() * Fixed::from_int(u) / 100_fx);
+      for (int w = 0; w < 200; ++w) {
+        const SinCos sp = sincos(Fixed::two_pi() * Fixed::from_int(w) / 200_fx);
+        const Vec3 l = v3(st.sin * sp.cos, st.cos, st.sin * sp.sin);
+        least_overlap =
+            max(least_overlap, dot(l, cv::support_at(b, -l).point - cv::support_at(a, l).point));
+      }
+    }
+    if (least_overlap >= Fixed::zero() || least_overlap < -0.1_fx) continue;
+    ++checked;
+    const Manifold m = collide_convex(cyl, pa, cyl, pb, kMargin);
+    ASSERT_GT(m.count, 0U);
+    Fixed deepest = Fixed::max();
+    for (std::size_t q = 0; q < m.count; ++q)
+      deepest = min(deepest, m.points[q].separation);
+    EXPECT_GE(deepest, least_overlap - 0.006_fx);
+  }
+  EXPECT_GE(checked, 8);
+}
+
 }  // namespace

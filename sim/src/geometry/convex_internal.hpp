@@ -67,9 +67,10 @@ enum class Reference : std::uint8_t { any, a, b };
 /// polygon against polygon / segment / point by clipping against the reference polygon's side
 /// planes, segment against segment by their overlap or closest points, else the two support
 /// points. A reference polygon within ~0.3 degree of n gives its own normal (exact separations).
-/// Candidates beyond the margin are dropped; with none left, `m.count` is 0.
+/// With `apart` (cores GJK found apart), two segments crossing between their ends refine n to
+/// their common perpendicular. Candidates beyond the margin are dropped; with none, count is 0.
 [[nodiscard]] Manifold manifold_from_faces(const Body& a, const Body& b, Vec3 n, Reference ref,
-                                           Fixed margin) noexcept;
+                                           Fixed margin, bool apart = false) noexcept;
 
 /// One point from the closest points of the cores (on_a, on_b) along n: the fallback for contacts
 /// no face produces.

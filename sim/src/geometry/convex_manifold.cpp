@@ -234,7 +234,7 @@ std::uint16_t segment_feature(const Face& f, Fixed s, Fixed half_length) noexcep
 
 /// Segments or points: the ends of the overlap of nearly parallel segments, else closest points.
 Vec3 segment_contacts(const Body& a, const Body& b, const Face& fa, const Face& fb, Vec3 n,
-                      Fixed margin, Candidates& out) noexcept {
+                      bool apart, Fixed margin, Candidates& out) noexcept {
   const Segment sa = as_segment(fa);
   const Segment sb = as_segment(fb);
   OverlapEnd lo;
@@ -255,14 +255,15 @@ Vec3 segment_contacts(const Body& a, const Body& b, const Face& fa, const Face& 
   const SegmentParams p = closest_on_segments(sa, sb);
   const Vec3 on_a = sa.at(p.s);
   const Vec3 on_b = sb.at(p.t);
-  // Apart, the closest points of the two features give the normal exactly (line against line, an
+  // Apart (only: overlapping segments' closest points say nothing of the shapes' overlap), the
+  // closest points of the two features give the normal exactly (line against line, an
   // end against a line), better than a GJK direction iterated on a cylinder's curved side.
   // Only two lines crossing between their ends fix it whatever their positions (their common
   // perpendicular); an end or a point (a cylinder's rim) would carry the error of the direction
   // that chose it.
   const Vec3 v = on_b - on_a;
   const bool inside = abs(p.s) < sa.half_length && abs(p.t) < sb.half_length;
-  if (fa.count == 2 && fb.count == 2 && inside && dot(v, n) > Fixed::zero() &&
+  if (apart && fa.count == 2 && fb.count == 2 && inside && dot(v, n) > Fixed::zero() &&
       length(v) > core_epsilon)
     n = normalize(v);
   out.add(candidate(a, b, on_a, on_b, n,
@@ -386,8 +387,8 @@ void reduce_into(std::span<const Candidate> c, Vec3 normal, Vec3 origin, Manifol
     put(c[chosen[k]]);
 }
 
-Manifold manifold_from_faces(const Body& a, const Body& b, Vec3 n, Reference ref,
-                             Fixed margin) noexcept {
+Manifold manifold_from_faces(const Body& a, const Body& b, Vec3 n, Reference ref, Fixed margin,
+                             bool apart) noexcept {
   const Face fa = face_at(a, n);
   const Face fb = face_at(b, -n);
   Candidates found;
@@ -410,10 +411,10 @@ Manifold manifold_from_faces(const Body& a, const Body& b, Vec3 n, Reference ref
       // Not a face contact (an edge or a vertex of a polytope is nearest): the supporting edges,
       // whose closest points are the contact, or two points when they lie along each other.
       n = segment_contacts(a, b, supporting_feature(a, fa, n), supporting_feature(b, fb, -n), n,
-                           margin, found);
+                           apart, margin, found);
     }
   } else {
-    n = segment_contacts(a, b, fa, fb, n, margin, found);
+    n = segment_contacts(a, b, fa, fb, n, apart, margin, found);
   }
   Manifold m;
   m.normal = n;
