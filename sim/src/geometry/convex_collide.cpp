@@ -425,7 +425,13 @@ Manifold convex::collide_detail::collide_ordered(const ConvexView& a, const Pose
     const Reference ref =
         use_edge || refined ? Reference::any : (ref_is_b ? Reference::b : Reference::a);
     const Manifold m = manifold_from_faces(A, B, axis.normal, ref, margin);
-    if (!apart_on_axis) return m.count > 0 ? m : support_pair(A, B, axis.normal, margin);
+    if (!apart_on_axis) {
+      // With a cylinder, the faces along an overlap's axis may be the wrong ones (side lines
+      // crossing beside a rim that overlaps): their points must be as deep as the axis says.
+      const bool deep_enough =
+          !curved || deepest_separation(m) <= axis.separation + (core_epsilon << 4);
+      return m.count > 0 && deep_enough ? m : support_pair(A, B, axis.normal, margin);
+    }
     // Apart, the face's deepest clipped point must be the axis' own gap; deeper than that, the
     // nearest features lie off the face (a corner beside it) and GJK finds them.
     if (m.count > 0 && deepest_separation(m) <= axis.separation + rounding_slack) return m;

@@ -105,9 +105,14 @@ Simplex on_triangle(const Vertex& a, const Vertex& b, const Vertex& c) noexcept 
 /// Whether the origin may lie beyond the face (p, q, r) of a tetrahedron whose fourth vertex is
 /// `opposite`: on the other side of its plane, on the plane, or the tetrahedron too flat (fourth
 /// vertex within 2^-24 m of the plane, as when four support points lie on one face of a box or a
-/// cylinder's cap) to tell. Only a tetrahedron that strictly holds the origin means overlap.
+/// cylinder's cap) or the face a sliver to tell. Only a tetrahedron that strictly holds the origin
+/// means overlap.
 bool origin_outside(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& opposite) noexcept {
-  const Vec3 n = normalize(cross(q - p, r - p));
+  const Vec3 c = cross(q - p, r - p);
+  // A sliver (a curved side's support points crowd together, sin of its angle below 2^-8): its
+  // normal is mostly rounding.
+  if (length_squared(c) <= (length_squared(q - p) * length_squared(r - p)) >> 16) return true;
+  const Vec3 n = normalize(c);
   const Fixed origin_side = -dot(n, p);
   const Fixed opposite_side = dot(n, opposite - p);
   const Fixed flat = Fixed::from_raw(Fixed::one_raw >> 24);

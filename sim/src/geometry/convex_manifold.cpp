@@ -407,11 +407,18 @@ Manifold manifold_from_faces(const Body& a, const Body& b, Vec3 n, Reference ref
     const Vec3 toward = ref_is_a ? fa.normal : -fb.normal;
     if (dot(toward, n) >= face_cos) {
       n = clip_contacts(a, b, fa, fb, ref_is_a, margin, found);
-    } else {
+    } else if (apart) {
       // Not a face contact (an edge or a vertex of a polytope is nearest): the supporting edges,
       // whose closest points are the contact, or two points when they lie along each other.
       n = segment_contacts(a, b, supporting_feature(a, fa, n), supporting_feature(b, fb, -n), n,
                            apart, margin, found);
+    } else {
+      // Overlapping off a face: the closest points of an edge and a rim say nothing of the
+      // overlap; the deepest points along n do (their gap is the axis' own).
+      const SupportPoint sa = support_at(a, n);
+      const SupportPoint sb = support_at(b, -n);
+      found.add(candidate(a, b, sa.point, sb.point, n, pair_feature(sa.feature, sb.feature)),
+                margin);
     }
   } else {
     n = segment_contacts(a, b, fa, fb, n, apart, margin, found);
