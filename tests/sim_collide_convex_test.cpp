@@ -546,8 +546,8 @@ TEST(ConvexProperties, CylinderBoxDistanceMatchesSampling) {
 
 // Two cylinders overlapping a little at random poses: the penetration is minus the largest gap of
 // the projections over all directions, sampled here on a 100 x 200 grid (a lower bound of that
-// largest gap). The manifold's depth may exceed it by the finite axis set's error only: 0.0042 m
-// at worst over 41 such poses (r = 0.4) when written, against a finer grid.
+// largest gap). The manifold's depth may exceed it by the finite axis set's error only: 0.0036 m
+// at worst over 38 such poses (r = 0.4) when written, against a finer grid.
 TEST(ConvexProperties, CylinderPenetrationIsNearTheLeastOverlap) {
   Lcg next{31337};
   const ConvexView cyl = ConvexView::cylinder(0.4_fx, 0.5_fx);
