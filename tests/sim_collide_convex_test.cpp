@@ -248,6 +248,28 @@ TEST(ConvexPlane, HullRestingFlatAndTilted) {
     EXPECT_TRUE(near(m.points[i].separation, gap));
 }
 
+TEST(ConvexPlane, RoundCoresAndATurnedPlaneMatchThePrimitivePairs) {
+  // A sphere and a lying capsule on a plane turned 0.3 rad about z, and the cube hull on it:
+  // the same contacts as sphere_plane, capsule_plane and box_plane (collide() with the plane as b).
+  const Shapes& s = shapes();
+  const Pose plane = at(v3(3_fx, 1_fx, -2_fx), about(Vec3::unit_z(), 0.3_fx));
+  const Vec3 up = plane.rotation.column(1);
+  const Pose above = at(plane.position + up * 0.52_fx, about(Vec3::unit_z(), 0.3_fx));
+  const Shape ball = Shape::sphere(0.5_fx);
+  const Shape capsule = Shape::capsule(0.5_fx, 0.7_fx);
+  const Shape box = Shape::box({0.5_fx, 0.5_fx, 0.5_fx});
+  expect_same_contacts(convex_plane(ConvexView::of(ball), above, plane, kMargin),
+                       collide(ball, above, Shape::plane(), plane, kMargin));
+  const Pose lying = at(above.position, about(Vec3::unit_z(), 0.3_fx + quarter_turn));
+  expect_same_contacts(convex_plane(ConvexView::of(capsule), lying, plane, kMargin),
+                       collide(capsule, lying, Shape::plane(), plane, kMargin));
+  const Manifold hull = convex_plane(ConvexView::of_hull(s.cube), above, plane, kMargin);
+  expect_same_contacts(hull, collide(box, above, Shape::plane(), plane, kMargin));
+  ASSERT_EQ(hull.count, 4U);
+  for (std::size_t i = 0; i < 4; ++i)
+    EXPECT_TRUE(near(hull.points[i].separation, 0.02_fx));
+}
+
 // ---- Cylinders ----------------------------------------------------------------------------------
 
 // Radius 0.4, half height 0.5; lying = turned a quarter about z (its axis along world x).
