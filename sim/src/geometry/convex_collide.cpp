@@ -9,14 +9,19 @@
 // flat contacts (a cap, a box or hull face) are measured exactly.
 //
 // Order of decisions (each deterministic, ties to the lower index):
+// 0. the pair is solved in a canonical order (order_key) and mirrored, so (b, a) mirrors (a, b);
 // 1. bounding spheres beyond the margin: nothing;
-// 2. a round core (sphere point, capsule segment) apart from the other core: GJK closest points;
-// 3. otherwise SAT: a's faces, b's faces, edge pairs, each replacing the incumbent only when
-//    clearly greater (collide_util's bias, the same rule as box_box);
+// 2. a round core (sphere point, capsule segment) or a cylinder: GJK closest points of the cores;
+//    apart when GJK's direction separates their projections: the supporting faces along it,
+//    kept when they agree with GJK's distance, else the closest points (apart());
+// 3. otherwise (and for cores that meet) SAT: a's faces, b's faces (a cylinder adds its radial
+//    direction), edge pairs, each replacing the incumbent only when clearly greater
+//    (collide_util's bias, the same rule as box_box); an overlap on a cylinder's inexact prism
+//    axis is refined by a pattern search (refine_axis);
 // 4. a face axis clips the incident face against the reference face; an edge axis between true
-//    edges gives the closest points of the two edges (one point, as box_box);
-// 5. apart, and the axis made no contact (corners passing each other), or apart with a cylinder:
-//    GJK closest points and the manifold along their direction.
+//    edges gives the closest points of the two edges (one point, as box_box); an overlap off
+//    any face gives the deepest points along the axis;
+// 5. apart, and the axis made no contact (corners passing each other): GJK closest points.
 #include <array>
 #include <cstdint>
 
