@@ -174,12 +174,14 @@ void face_axes(const Body& owner, const Body& a, const Body& b, bool owner_is_a,
   const unsigned count = sat_face_count(*owner.view);
   for (unsigned i = 0; i < count && !beyond; ++i) {
     const SatFace f = sat_face(*owner.view, i);
-    const Vec3 m = unit_or(owner.rotation * f.normal, f.normal);
+    const Vec3 m = owner.rotation * f.normal;  // unit to ~10 ulp: enough to measure a gap
     const Vec3 l = owner_is_a ? m : -m;
     const Fixed s = separation_along(a, b, l);
     if (s > margin) beyond = true;
     best.offer(l, s, f.exact, i, i);
   }
+  // The winner becomes a contact normal: unit within 2 ulp (collide_util's unit_or).
+  if (best.found) best.normal = unit_or(best.normal, Vec3::unit_y());
 }
 
 void edge_axes(const Body& a, const Body& b, Fixed margin, Best& best, bool& beyond) noexcept {
