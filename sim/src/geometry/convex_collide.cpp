@@ -91,12 +91,16 @@ struct WorldEdge {
 WorldEdge world_edge(const Body& b, unsigned i) noexcept {
   const SatEdge e = sat_edge(*b.view, i);
   WorldEdge w;
-  w.p0 = b.position + b.rotation * e.p0;
+  w.p0 = b.unrotated ? b.position + e.p0 : b.position + b.rotation * e.p0;
   w.local_p1 = e.p1;
   w.feature = e.feature;
   w.circle = e.circle;
   w.exact = e.exact;
-  if (b.view->kind == ConvexKind::box) {
+  if (b.unrotated) {
+    w.direction = e.direction;
+    w.n0 = e.n0;
+    w.n1 = e.n1;
+  } else if (b.view->kind == ConvexKind::box) {
     const unsigned axis = i / 4;
     w.direction = b.rotation.column(axis);
     const Vec3 u = b.rotation.column((axis + 1) % 3);
@@ -373,6 +377,7 @@ std::array<std::int64_t, 20> order_key(const ConvexView& v, const Pose& p) noexc
 
 Manifold collide_ordered(const ConvexView& a, const Pose& pa, const ConvexView& b, const Pose& pb,
                          Fixed margin) noexcept;
+Manifold collide_local(const Body& a, const Body& b, Fixed margin) noexcept;
 
 }  // namespace convex::collide_detail
 
@@ -392,9 +397,22 @@ Manifold collide_convex(const ConvexView& a, const Pose& pa, const ConvexView& b
 Manifold convex::collide_detail::collide_ordered(const ConvexView& a, const Pose& pa,
                                                  const ConvexView& b, const Pose& pb,
                                                  Fixed margin) noexcept {
+  // In a's frame: a unrotated at the origin, b through one relative rotation (exact dots, one
+  // rounding each); the manifold is moved back to the world at the end.
+  const Mat3 to_a = transpose(pa.rotation);
+  const Pose local_a{Vec3{}, Mat3::identity()};
+  const Pose local_b{to_a * (pb.position - pa.position), to_a * pb.rotation};
+  const convex::Body A = convex::make_body(a, local_a, Vec3{});
+  const convex::Body B = convex::make_body(b, local_b, Vec3{});
+  const Manifold m = collide_local(A, B, margin);
+  return m.count > 0 ? narrow::to_world(m, pa) : Manifold{};
+}
+
+Manifold convex::collide_detail::collide_local(const Body& A, const Body& B,
+                                               Fixed margin) noexcept {
   using namespace convex;
-  const Body A = make_body(a, pa, pa.position);
-  const Body B = make_body(b, pb, pa.position);
+  const ConvexView& a = *A.view;
+  const ConvexView& b = *B.view;
   if (length(B.position) - bounding_radius(a) - bounding_radius(b) > margin) return {};
   // Round cores and cylinders: GJK first. A cylinder's finite axis set can only prove separation,
   // never overlap (rim against rim may be apart along a direction no axis has), so SAT only

@@ -17,17 +17,27 @@
 namespace detsim::sim_detail::convex {
 
 Body make_body(const ConvexView& v, const Pose& pose, Vec3 origin) noexcept {
-  return {&v, pose.rotation, pose.position - origin, core_radius(v), pose, origin};
+  return {&v,   pose.rotation, pose.position - origin,           core_radius(v),
+          pose, origin,        pose.rotation == Mat3::identity()};
 }
 
 SupportPoint support_at(const Body& b, Vec3 direction) noexcept {
+  if (b.unrotated) {
+    SupportPoint s = core_support(*b.view, direction);
+    s.point += b.position;
+    return s;
+  }
   SupportPoint s = core_support(*b.view, narrow::to_local(b.rotation, direction));
   s.point = b.position + b.rotation * s.point;
   return s;
 }
 
 Face face_at(const Body& b, Vec3 direction) noexcept {
-  return supporting_face(*b.view, b.pose, direction, b.origin);
+  if (!b.unrotated) return supporting_face(*b.view, b.pose, direction, b.origin);
+  Face f = supporting_face(*b.view, direction);
+  for (unsigned i = 0; i < f.count; ++i)
+    f.points[i] += b.position;
+  return f;
 }
 
 namespace gjk_detail {

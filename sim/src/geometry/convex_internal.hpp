@@ -15,15 +15,17 @@
 
 namespace detsim::sim_detail::convex {
 
-/// A view posed relative to the pair's origin (a's position), so that every quantity below is
-/// bounded by the shapes' sizes and their distance, never by world coordinates.
+/// A view posed relative to the pair's origin, so that every quantity below is bounded by the
+/// shapes' sizes and their distance, never by world coordinates. collide_convex works in a's own
+/// frame (a unrotated at the origin), as box_box does: b enters through one relative rotation.
 struct Body {
   const ConvexView* view = nullptr;
   Mat3 rotation;
-  Vec3 position;  ///< relative to the origin
-  Fixed radius;   ///< core_radius(*view)
-  Pose pose;      ///< the world pose, for supporting_face
-  Vec3 origin;    ///< the world origin that positions are relative to
+  Vec3 position;           ///< relative to the origin
+  Fixed radius;            ///< core_radius(*view)
+  Pose pose;               ///< the pose it was made from, for supporting_face
+  Vec3 origin;             ///< the origin that positions are relative to
+  bool unrotated = false;  ///< rotation is the identity (a pair solved in a's frame): no products
 };
 
 [[nodiscard]] Body make_body(const ConvexView& v, const Pose& pose, Vec3 origin) noexcept;
