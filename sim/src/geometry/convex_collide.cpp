@@ -375,6 +375,52 @@ std::array<std::int64_t, 20> order_key(const ConvexView& v, const Pose& p) noexc
           0};
 }
 
+/// GJK's cores apart, and proven so: GJK's direction must separate the cores' projections (a
+/// simplex flattened by rounding can stop short of an origin that lies inside).
+bool proven_apart(const Body& a, const Body& b, const Closest& c) noexcept {
+  return !c.overlap && c.distance > core_epsilon &&
+         separation_along(a, b, normalize(c.on_b - c.on_a)) + a.radius + b.radius > Fixed::zero();
+}
+
+/// The axis that makes the contact: a's best face, b's if clearly better, an edge pair if clearly
+/// better than either (collide_util's bias, as box_box).
+struct Choice {
+  Best axis;
+  bool edge = false;
+  Reference ref = Reference::any;
+};
+Choice choose_axis(const Sat& s, Fixed scale) noexcept {
+  const bool ref_is_b =
+      s.face_b.found &&
+      (!s.face_a.found || clearly_greater(s.face_b.separation, s.face_a.separation, scale));
+  const Best& face = ref_is_b ? s.face_b : s.face_a;
+  const bool edge =
+      s.edge.found && (!face.found || clearly_greater(s.edge.separation, face.separation, scale));
+  if (edge) return {s.edge, true, Reference::any};
+  return {face, false, ref_is_b ? Reference::b : Reference::a};
+}
+
+/// The contact the chosen axis makes: straight edges their closest points; otherwise the
+/// supporting faces along it. Overlapping, always a contact (with a cylinder, the faces' points
+/// must be as deep as the axis says, else the deepest points along it: side lines may cross
+/// beside an overlapping rim). Apart, false when the axis does not give the nearest features: a
+/// cylinder's (GJK measures it), or a face whose clipped points are deeper than its own gap (a
+/// corner beside it).
+bool axis_contact(const Body& a, const Body& b, const Choice& choice, bool curved, Fixed margin,
+                  Manifold& m) noexcept {
+  const Best& axis = choice.axis;
+  const bool apart_on_axis = axis.separation > Fixed::zero();
+  if (choice.edge && !curved && axis.exact) return edge_point(a, b, axis, margin, m);
+  if (apart_on_axis && (curved || !axis.exact)) return false;
+  m = manifold_from_faces(a, b, axis.normal, choice.ref, margin);
+  if (apart_on_axis)
+    return m.count > 0 && deepest_separation(m) <= axis.separation + rounding_slack;
+  const bool deep_enough =
+      !curved || deepest_separation(m) <= axis.separation + (core_epsilon << 4);
+  if (m.count == 0 || !deep_enough) m = support_pair(a, b, axis.normal, margin);
+  return true;
+}
+
 Manifold collide_ordered(const ConvexView& a, const Pose& pa, const ConvexView& b, const Pose& pb,
                          Fixed margin) noexcept;
 Manifold collide_local(const Body& a, const Body& b, Fixed margin) noexcept;
@@ -419,12 +465,8 @@ Manifold convex::collide_detail::collide_local(const Body& A, const Body& B,
   // measures the penetration of cores GJK found to meet.
   const bool curved = a.kind == ConvexKind::cylinder || b.kind == ConvexKind::cylinder;
   if (is_round(a) || is_round(b) || curved) {
-    // Apart only when proven: GJK's direction must separate the cores' projections (a simplex
-    // flattened by rounding can stop short of an origin that lies inside).
     const Closest c = gjk_closest(A, B);
-    if (!c.overlap && c.distance > core_epsilon &&
-        separation_along(A, B, normalize(c.on_b - c.on_a)) + A.radius + B.radius > Fixed::zero())
-      return apart(A, B, c, margin);
+    if (proven_apart(A, B, c)) return apart(A, B, c, margin);
   }
   const Sat s = separating_axes(A, B, margin);
   if (s.beyond) return {};
@@ -432,37 +474,16 @@ Manifold convex::collide_detail::collide_local(const Body& A, const Body& B,
     const Vec3 n = unit_or(B.position - A.position, Vec3::unit_y());
     return manifold_from_faces(A, B, n, Reference::any, margin);
   }
-  const Fixed scale = Fixed::one() + max(bounding_radius(a), bounding_radius(b));
-  const bool ref_is_b =
-      s.face_b.found &&
-      (!s.face_a.found || clearly_greater(s.face_b.separation, s.face_a.separation, scale));
-  const Best& face = ref_is_b ? s.face_b : s.face_a;
-  const bool use_edge =
-      s.edge.found && (!face.found || clearly_greater(s.edge.separation, face.separation, scale));
-  const Best& chosen = use_edge ? s.edge : face;
-  const bool apart_on_axis = chosen.separation > Fixed::zero();
-  const Best axis = curved && !apart_on_axis && !chosen.exact ? refine_axis(A, B, chosen) : chosen;
-  if (use_edge && !curved && axis.exact) {
-    Manifold m;
-    if (edge_point(A, B, axis, margin, m)) return m;
-  } else if (!apart_on_axis || (!curved && axis.exact)) {
-    const bool refined = axis.normal != chosen.normal;
-    const Reference ref =
-        use_edge || refined ? Reference::any : (ref_is_b ? Reference::b : Reference::a);
-    const Manifold m = manifold_from_faces(A, B, axis.normal, ref, margin);
-    if (!apart_on_axis) {
-      // With a cylinder, the faces along an overlap's axis may be the wrong ones (side lines
-      // crossing beside a rim that overlaps): their points must be as deep as the axis says.
-      const bool deep_enough =
-          !curved || deepest_separation(m) <= axis.separation + (core_epsilon << 4);
-      return m.count > 0 && deep_enough ? m : support_pair(A, B, axis.normal, margin);
-    }
-    // Apart, the face's deepest clipped point must be the axis' own gap; deeper than that, the
-    // nearest features lie off the face (a corner beside it) and GJK finds them.
-    if (m.count > 0 && deepest_separation(m) <= axis.separation + rounding_slack) return m;
+  Choice choice = choose_axis(s, Fixed::one() + max(bounding_radius(a), bounding_radius(b)));
+  if (curved && choice.axis.separation <= Fixed::zero() && !choice.axis.exact) {
+    const Best refined = refine_axis(A, B, choice.axis);
+    if (refined.normal != choice.axis.normal) choice.ref = Reference::any;
+    choice.axis = refined;
   }
+  Manifold m;
+  if (axis_contact(A, B, choice, curved, margin, m)) return m;
   const Closest c = gjk_closest(A, B);
-  if (c.overlap) return support_pair(A, B, axis.normal, margin);
+  if (c.overlap) return support_pair(A, B, choice.axis.normal, margin);
   return apart(A, B, c, margin);
 }
 
