@@ -219,6 +219,53 @@ Face capsule_face_toward(Fixed half, Vec3 d) noexcept {
   return f;
 }
 
+/// Box edge i = 4 axis + bits: along `axis`, on the sides (axis + 1, axis + 2) given by bits 0, 1.
+SatEdge box_sat_edge(Vec3 h, unsigned i) noexcept {
+  const int axis = static_cast<int>(i / 4);
+  const bool s1 = (i & 1U) != 0;
+  const bool s2 = (i & 2U) != 0;
+  Signs s{};
+  s[static_cast<unsigned>((axis + 1) % 3)] = s1;
+  s[static_cast<unsigned>((axis + 2) % 3)] = s2;
+  const unsigned lo = (s[0] ? 1U : 0U) | (s[1] ? 2U : 0U) | (s[2] ? 4U : 0U);
+  SatEdge e;
+  e.p0 = box_corner(h, lo);
+  e.p1 = box_corner(h, lo | (1U << static_cast<unsigned>(axis)));
+  e.direction = axis_vector(axis);
+  e.n0 = axis_vector((axis + 1) % 3, s1);
+  e.n1 = axis_vector((axis + 2) % 3, s2);
+  e.feature = box_edge(axis, s);
+  return e;
+}
+
+/// Cylinder edge i of its 16-gon prism: the +y rim's chord k (i = k), the -y rim's (16 + k), or
+/// the side line through rim point k (32 + k), the one edge of the true cylinder among them.
+SatEdge cylinder_sat_edge(const ConvexView& v, unsigned i) noexcept {
+  const RimTable& rim = rim_table();
+  const unsigned k = i % kRim;
+  const Vec3 p = rim.at[k] * v.radius;
+  const Vec3 q = rim.at[(k + 1) % kRim] * v.radius;
+  const Vec3 up{Fixed::zero(), v.half_height, Fixed::zero()};
+  SatEdge e;
+  e.exact = false;
+  e.feature = convex_feature(kEdge, 1 + i);
+  e.n1 = rim.side[k];
+  if (i < 2 * kRim) {
+    const bool top = i < kRim;
+    e.p0 = top ? p + up : p - up;
+    e.p1 = top ? q + up : q - up;
+    e.direction = rim.chord[k];
+    e.n0 = axis_vector(1, top);
+    return e;
+  }
+  e.p0 = p - up;
+  e.p1 = p + up;
+  e.direction = Vec3::unit_y();
+  e.n0 = rim.side[(k + kRim - 1) % kRim];
+  e.exact = true;
+  return e;
+}
+
 }  // namespace view_detail
 
 using namespace view_detail;
@@ -356,59 +403,23 @@ unsigned sat_edge_count(const ConvexView& v) noexcept {
 }
 
 SatEdge sat_edge(const ConvexView& v, unsigned i) noexcept {
-  SatEdge e;
   switch (v.kind) {
-    case ConvexKind::capsule:
+    case ConvexKind::capsule: {
+      SatEdge e;
       e.p0 = Vec3{Fixed::zero(), -v.half_height, Fixed::zero()};
       e.p1 = -e.p0;
       e.direction = Vec3::unit_y();
       e.feature = capsule_core;
       e.circle = true;
       return e;
-    case ConvexKind::box: {
-      const int axis = static_cast<int>(i / 4);
-      const bool s1 = (i & 1U) != 0;
-      const bool s2 = (i & 2U) != 0;
-      Signs s{};
-      s[static_cast<unsigned>((axis + 1) % 3)] = s1;
-      s[static_cast<unsigned>((axis + 2) % 3)] = s2;
-      const unsigned lo = (s[0] ? 1U : 0U) | (s[1] ? 2U : 0U) | (s[2] ? 4U : 0U);
-      e.p0 = box_corner(v.half_extents, lo);
-      e.p1 = box_corner(v.half_extents, lo | (1U << static_cast<unsigned>(axis)));
-      e.direction = axis_vector(axis);
-      e.n0 = axis_vector((axis + 1) % 3, s1);
-      e.n1 = axis_vector((axis + 2) % 3, s2);
-      e.feature = box_edge(axis, s);
-      return e;
     }
-    case ConvexKind::cylinder: {
-      const unsigned k = i % kRim;
-      const Vec3 p = rim_direction(k) * v.radius;
-      const Vec3 q = rim_direction(k + 1) * v.radius;
-      const Vec3 side_before = sat_face(v, 2 + (k + kRim - 1) % kRim).normal;
-      const Vec3 side_after = sat_face(v, 2 + k).normal;
-      const Vec3 up{Fixed::zero(), v.half_height, Fixed::zero()};
-      e.exact = false;
-      e.feature = convex_feature(kEdge, 1 + i);
-      if (i < 2 * kRim) {  // rim chord k of the +y (i < 16) or -y cap
-        const bool top = i < kRim;
-        e.p0 = top ? p + up : p - up;
-        e.p1 = top ? q + up : q - up;
-        e.direction = rim_table().chord[k];
-        e.n0 = axis_vector(1, top);
-        e.n1 = side_after;
-        return e;
-      }
-      e.p0 = p - up;  // a side line, through rim point k: a true line of the cylinder
-      e.p1 = p + up;
-      e.direction = Vec3::unit_y();
-      e.n0 = side_before;
-      e.n1 = side_after;
-      e.exact = true;
-      return e;
-    }
+    case ConvexKind::box:
+      return box_sat_edge(v.half_extents, i);
+    case ConvexKind::cylinder:
+      return cylinder_sat_edge(v, i);
     case ConvexKind::hull: {
       const HullEdge& h = v.hull->edges[i];
+      SatEdge e;
       e.p0 = v.hull->vertices[h.a];
       e.p1 = v.hull->vertices[h.b];
       e.direction = normalize(e.p1 - e.p0);
@@ -418,7 +429,7 @@ SatEdge sat_edge(const ConvexView& v, unsigned i) noexcept {
       return e;
     }
     default:
-      return e;
+      return {};
   }
 }
 
