@@ -314,6 +314,80 @@ Face supporting_feature(const Body& b, const Face& f, Vec3 direction) noexcept {
   return point;
 }
 
+/// Chooses candidates one at a time, never one twice: the best unused one by a score (> 0 unless
+/// `any`), ties to the lower feature ID, so the choice depends on the features, not on the order.
+struct Picker {
+  std::span<const Candidate> c;
+  std::array<std::size_t, 4> chosen{};
+  std::size_t count = 0;
+
+  [[nodiscard]] bool used(std::size_t i) const noexcept {
+    for (std::size_t k = 0; k < count; ++k)
+      if (chosen[k] == i) return true;
+    return false;
+  }
+  [[nodiscard]] Vec3 point(std::size_t k) const noexcept { return c[chosen[k]].point; }
+  template <typename Score>
+  bool pick(Score&& score, bool any) noexcept {
+    std::size_t best = c.size();
+    Fixed best_score;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const Fixed s = score(c[i]);
+      if (used(i) || (!any && s <= Fixed::zero())) continue;
+      if (best == c.size() || beats(s, c[i].feature, best_score, c[best].feature)) {
+        best = i;
+        best_score = s;
+      }
+    }
+    if (best < c.size()) chosen[count++] = best;
+    return best < c.size();
+  }
+  bool pick_deepest() noexcept {
+    return pick([](const Candidate& x) { return -x.separation; }, true);
+  }
+};
+
+/// The first point: the deepest, where depths within 2^-16 m count as equal (lowest feature
+/// wins), so that a face resting a hair off level (a cylinder's 16 rim points, a hull's hexagon)
+/// keeps the same four points from step to step; the manifold's least separation may then exceed
+/// the true least by at most 2^-16 m.
+void pick_deepest_level(Picker& p) noexcept {
+  Fixed lowest = Fixed::max();
+  for (const Candidate& x : p.c)
+    lowest = min(lowest, x.separation);
+  p.pick(
+      [&](const Candidate& x) {
+        return x.separation <= lowest + core_epsilon ? Fixed::one() : Fixed::zero();
+      },
+      false);
+}
+
+/// Then the point farthest from the first, and the two that add the most area on either side of
+/// that diagonal; with all on one side, the one that grows the triangle the most; collinear, the
+/// deepest two others.
+void pick_spread(Picker& p, Vec3 normal) noexcept {
+  const Vec3 p0 = p.point(0);
+  if (!p.pick([&](const Candidate& x) { return length_squared(x.point - p0); }, false)) return;
+  const Vec3 p1 = p.point(1);
+  const bool left =
+      p.pick([&](const Candidate& x) { return area(p0, p1, x.point, normal); }, false);
+  const bool right =
+      p.pick([&](const Candidate& x) { return -area(p0, p1, x.point, normal); }, false);
+  if (left == right) {
+    if (!left) {
+      p.pick_deepest();
+      p.pick_deepest();
+    }
+    return;
+  }
+  const Vec3 p2 = p.point(2);
+  const Vec3 up = left ? normal : -normal;
+  const auto growth = [&](const Candidate& x) {
+    return max(-area(p1, p2, x.point, up), -area(p2, p0, x.point, up));
+  };
+  if (!p.pick(growth, false)) p.pick_deepest();
+}
+
 }  // namespace manifold_detail
 
 using namespace manifold_detail;
@@ -327,64 +401,11 @@ void reduce_into(std::span<const Candidate> c, Vec3 normal, Vec3 origin, Manifol
       put(x);
     return;
   }
-  std::array<std::size_t, 4> chosen{};
-  std::size_t count = 0;
-  const auto used = [&](std::size_t i) {
-    for (std::size_t k = 0; k < count; ++k)
-      if (chosen[k] == i) return true;
-    return false;
-  };
-  // The best unused candidate by score (> 0 unless `any`), ties to the lower feature ID.
-  const auto pick = [&](auto&& score, bool any) {
-    std::size_t best = c.size();
-    Fixed best_score;
-    for (std::size_t i = 0; i < c.size(); ++i) {
-      const Fixed s = score(c[i]);
-      if (used(i) || (!any && s <= Fixed::zero())) continue;
-      if (best == c.size() || beats(s, c[i].feature, best_score, c[best].feature)) {
-        best = i;
-        best_score = s;
-      }
-    }
-    if (best < c.size()) chosen[count++] = best;
-    return best < c.size();
-  };
-  const auto depth = [](const Candidate& x) { return -x.separation; };
-  // The first point: the deepest, where depths within 2^-16 m count as equal (lowest feature
-  // wins), so that a face resting a hair off level (a cylinder's 16 rim points, a hull's hexagon)
-  // keeps the same four points from step to step; the manifold's least separation may then
-  // exceed the true least by at most 2^-16 m.
-  Fixed lowest = Fixed::max();
-  for (const Candidate& x : c)
-    lowest = min(lowest, x.separation);
-  pick(
-      [&](const Candidate& x) {
-        return x.separation <= lowest + core_epsilon ? Fixed::one() : Fixed::zero();
-      },
-      false);
-  const Vec3 p0 = c[chosen[0]].point;
-  if (pick([&](const Candidate& x) { return length_squared(x.point - p0); }, false)) {
-    const Vec3 p1 = c[chosen[1]].point;
-    const bool left =
-        pick([&](const Candidate& x) { return area(p0, p1, x.point, normal); }, false);
-    const bool right =
-        pick([&](const Candidate& x) { return -area(p0, p1, x.point, normal); }, false);
-    if (left != right) {  // one side only: the point that grows the triangle the most
-      const Vec3 p2 = c[chosen[2]].point;
-      const Vec3 up = left ? normal : -normal;
-      if (!pick(
-              [&](const Candidate& x) {
-                return max(-area(p1, p2, x.point, up), -area(p2, p0, x.point, up));
-              },
-              false))
-        pick(depth, true);
-    } else if (!left) {  // collinear: the deepest two others
-      pick(depth, true);
-      pick(depth, true);
-    }
-  }
-  for (std::size_t k = 0; k < count; ++k)
-    put(c[chosen[k]]);
+  Picker picker{c};
+  pick_deepest_level(picker);
+  pick_spread(picker, normal);
+  for (std::size_t k = 0; k < picker.count; ++k)
+    put(c[picker.chosen[k]]);
 }
 
 Manifold manifold_from_faces(const Body& a, const Body& b, Vec3 n, Reference ref, Fixed margin,
