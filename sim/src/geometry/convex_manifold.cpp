@@ -117,22 +117,11 @@ void clip_pass(const Polygon& in, const SidePlanes& s, unsigned q, const Face& r
   }
 }
 
-/// The incident face's points inside the reference polygon's side planes.
-Polygon clip_incident(const Face& ref, const Face& inc) noexcept {
-  const SidePlanes s = side_planes(ref);
+/// A segment (Liang-Barsky) or a point against the side planes: the part inside all of them.
+/// A kept end names itself against the reference face; a cut end, the segment against the
+/// reference edge that cut it.
+Polygon clip_segment(const Face& ref, const SidePlanes& s, const Face& inc) noexcept {
   Polygon poly;
-  if (inc.count >= 3) {
-    for (unsigned i = 0; i < inc.count; ++i)
-      poly.emit({inc.points[i], ref.feature, inc.vertex[i], false, 0,
-                 inc.edge[(i + inc.count - 1) % inc.count]});
-    Polygon scratch;
-    for (unsigned q = 0; q < s.n && poly.n > 0; ++q) {
-      clip_pass(poly, s, q, ref, inc.feature, scratch);
-      poly = scratch;
-    }
-    return poly;
-  }
-  // A segment (Liang-Barsky) or a point: parameters [lo, hi] of the part inside every plane.
   const Vec3 p0 = inc.points[0];
   const Vec3 p1 = inc.points[inc.count - 1];
   Fixed lo = Fixed::zero();
@@ -143,18 +132,14 @@ Polygon clip_incident(const Face& ref, const Face& inc) noexcept {
     const Fixed h0 = dot(s.normal[q], p0) - s.offset[q];
     const Fixed h1 = dot(s.normal[q], p1) - s.offset[q];
     if (h0 > Fixed::zero() && h1 > Fixed::zero()) return poly;
-    if (h0 > Fixed::zero()) {
-      const Fixed t = h0 / (h0 - h1);
-      if (t > lo) {
-        lo = t;
-        lo_ref = ref.edge[q];
-      }
-    } else if (h1 > Fixed::zero()) {
-      const Fixed t = h0 / (h0 - h1);
-      if (t < hi) {
-        hi = t;
-        hi_ref = ref.edge[q];
-      }
+    if (h0 <= Fixed::zero() && h1 <= Fixed::zero()) continue;
+    const Fixed t = h0 / (h0 - h1);  // exactly one end is outside: in [0, 1]
+    if (h0 > Fixed::zero() && t > lo) {
+      lo = t;
+      lo_ref = ref.edge[q];
+    } else if (h1 > Fixed::zero() && t < hi) {
+      hi = t;
+      hi_ref = ref.edge[q];
     }
   }
   if (lo > hi) return poly;
@@ -164,6 +149,22 @@ Polygon clip_incident(const Face& ref, const Face& inc) noexcept {
   };
   at(lo, lo_ref, inc.vertex[0]);
   if (inc.count == 2 && hi > lo) at(hi, hi_ref, inc.vertex[1]);
+  return poly;
+}
+
+/// The incident face's points inside the reference polygon's side planes.
+Polygon clip_incident(const Face& ref, const Face& inc) noexcept {
+  const SidePlanes s = side_planes(ref);
+  if (inc.count < 3) return clip_segment(ref, s, inc);
+  Polygon poly;
+  for (unsigned i = 0; i < inc.count; ++i)
+    poly.emit({inc.points[i], ref.feature, inc.vertex[i], false, 0,
+               inc.edge[(i + inc.count - 1) % inc.count]});
+  Polygon scratch;
+  for (unsigned q = 0; q < s.n && poly.n > 0; ++q) {
+    clip_pass(poly, s, q, ref, inc.feature, scratch);
+    poly = scratch;
+  }
   return poly;
 }
 
