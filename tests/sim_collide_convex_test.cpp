@@ -290,6 +290,27 @@ struct Cylinder : ::testing::Test {
   }
 };
 
+TEST_F(Cylinder, SupportAndSupportingFaces) {
+  // Local axis y: along +y the cap (16 rim points at y = h, radius r, counter-clockwise or not,
+  // normal +y); along +x the side line (two points at x = r, y = -+h); a tilted direction's
+  // support is the rim point below it. A capsule's core + radius is its support too.
+  const cv::Face cap = cv::supporting_face(cyl, v3(0.1_fx, 1_fx, 0_fx));
+  ASSERT_EQ(cap.count, 16U);
+  EXPECT_EQ(cap.normal, Vec3::unit_y());
+  EXPECT_EQ(cap.feature, cv::convex_feature(static_cast<unsigned>(nf::Kind::face), 0));
+  for (unsigned i = 0; i < 16; ++i) {
+    EXPECT_EQ(cap.points[i].y, 0.5_fx);
+    EXPECT_TRUE(near(length(v3(cap.points[i].x, 0_fx, cap.points[i].z)), 0.4_fx));
+  }
+  const cv::Face side = cv::supporting_face(cyl, v3(1_fx, 0.2_fx, 0_fx));
+  ASSERT_EQ(side.count, 2U);
+  EXPECT_TRUE(near(side.points[0], v3(0.4_fx, -0.5_fx, 0_fx)));
+  EXPECT_TRUE(near(side.points[1], v3(0.4_fx, 0.5_fx, 0_fx)));
+  EXPECT_TRUE(near(cv::support(cyl, at(p), v3(0_fx, -1_fx, 1_fx)), p + v3(0_fx, -0.5_fx, 0.4_fx)));
+  EXPECT_TRUE(near(cv::support(ConvexView::capsule(0.25_fx, 0.5_fx), at(p), v3(1_fx, 0_fx, 0_fx)),
+                   p + v3(0.25_fx, 0.5_fx, 0_fx)));
+}
+
 TEST_F(Cylinder, StandingOnAPlaneAndABox) {
   // The -y cap `gap` above the plane / the box's top face (y = 0.5): four rim points at gap.
   const Fixed gap = -0.005_fx;
