@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "sim/src/geometry/convex.hpp"
+#include "sim/src/geometry/convex_internal.hpp"
 #include "support/collide_helpers.hpp"
 #include "support/hull_by_hand.hpp"
 
@@ -139,5 +140,51 @@ struct Lcg {
     return Fixed::from_raw(static_cast<std::int64_t>(state >> 31) - (std::int64_t{1} << 32));
   }
 };
+
+/// The least separation of a manifold (Fixed::max() when it has no point).
+inline Fixed deepest(const Manifold& m) {
+  Fixed d = Fixed::max();
+  for (std::size_t i = 0; i < m.count; ++i)
+    d = min(d, m.points[i].separation);
+  return d;
+}
+
+/// Two random poses: a at `origin`, b at an offset whose components lie in [-reach, reach), each
+/// turned at random. Draws are made in braced lists, so in the same order on every compiler.
+struct PosePair {
+  Pose a;
+  Pose b;
+};
+inline PosePair random_pair(Lcg& next, Vec3 origin, Fixed reach) {
+  const Quat qa = normalize(Quat{next(), next(), next(), next()});
+  const Quat qb = normalize(Quat{next(), next(), next(), next()});
+  const Vec3 offset{next(), next(), next()};
+  return {at(origin, qa), at(origin + offset * reach, qb)};
+}
+/// As random_pair, b at `distance` + `jitter` x [-1, 1) from a in a random direction.
+inline PosePair random_pair_apart(Lcg& next, Vec3 origin, Fixed distance, Fixed jitter) {
+  const Quat qa = normalize(Quat{next(), next(), next(), next()});
+  const Quat qb = normalize(Quat{next(), next(), next(), next()});
+  const Vec3 direction = normalize(Vec3{next(), next(), next()});
+  const Fixed d = distance + next() * jitter;
+  return {at(origin, qa), at(origin + direction * d, qb)};
+}
+
+/// The largest gap of the two cores' projections over a grid of directions (steps polar x
+/// 2 steps azimuthal): minus their penetration when they overlap, as sampled (a lower bound).
+inline Fixed largest_sampled_gap(const sim_detail::convex::Body& a,
+                                 const sim_detail::convex::Body& b, int steps) {
+  Fixed largest = Fixed::min();
+  for (int u = 0; u <= steps; ++u) {
+    const SinCos st = sincos(Fixed::pi() * Fixed::from_int(u) / Fixed::from_int(steps));
+    for (int w = 0; w < 2 * steps; ++w) {
+      const SinCos sp = sincos(Fixed::pi() * Fixed::from_int(w) / Fixed::from_int(steps));
+      const Vec3 l{st.sin * sp.cos, st.cos, st.sin * sp.sin};
+      largest = max(largest, dot(l, sim_detail::convex::support_at(b, -l).point -
+                                        sim_detail::convex::support_at(a, l).point));
+    }
+  }
+  return largest;
+}
 
 }  // namespace detsim::collide_test
