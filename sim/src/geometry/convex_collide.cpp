@@ -348,18 +348,26 @@ bool edge_point(const Body& a, const Body& b, const Best& e, Fixed margin, Manif
 namespace convex::collide_detail {
 
 /// A total order on posed views, independent of the argument order: kind, dimensions, a hull's
-/// vertex count, then the pose's raw values. Never addresses (rule 4: not machine-dependent).
-std::array<std::int64_t, 20> order_key(const ConvexView& v, const Pose& p) noexcept {
+/// vertex count, bounds and radius, then the pose's raw values. Never addresses (rule 4: not
+/// machine-dependent). Equal keys (the same shape at the same pose) solve as given.
+std::array<std::int64_t, 26> order_key(const ConvexView& v, const Pose& p) noexcept {
+  const Hull empty;
+  const Hull& h = v.hull != nullptr ? *v.hull : empty;
   const Mat3& r = p.rotation;
-  const std::int64_t hull_size =
-      v.hull != nullptr ? static_cast<std::int64_t>(v.hull->vertices.size()) : 0;
   return {static_cast<std::int64_t>(v.kind),
           v.radius.raw(),
           v.half_height.raw(),
           v.half_extents.x.raw(),
           v.half_extents.y.raw(),
           v.half_extents.z.raw(),
-          hull_size,
+          static_cast<std::int64_t>(h.vertices.size()),
+          h.bounding_radius.raw(),
+          h.aabb_min.x.raw(),
+          h.aabb_min.y.raw(),
+          h.aabb_min.z.raw(),
+          h.aabb_max.x.raw(),
+          h.aabb_max.y.raw(),
+          h.aabb_max.z.raw(),
           p.position.x.raw(),
           p.position.y.raw(),
           p.position.z.raw(),
@@ -371,8 +379,7 @@ std::array<std::int64_t, 20> order_key(const ConvexView& v, const Pose& p) noexc
           r.rows[1].z.raw(),
           r.rows[2].x.raw(),
           r.rows[2].y.raw(),
-          r.rows[2].z.raw(),
-          0};
+          r.rows[2].z.raw()};
 }
 
 /// GJK's cores apart, and proven so: GJK's direction must separate the cores' projections (a
