@@ -15,6 +15,8 @@
 
 #include "collide.hpp"
 #include "collide_util.hpp"
+#include "geometry/convex.hpp"
+#include "geometry/geometry.hpp"
 
 namespace detsim::sim_detail {
 
@@ -512,13 +514,33 @@ Manifold primitive(const PosedShape& a, const PosedShape& b, Fixed margin) noexc
 
 /// One row per pair of shape types that can touch, with a.type <= b.type: a new shape type adds
 /// its rows here (and its pair functions). Pairs without a row have no manifold: two planes, which
-/// are static and unbounded, and for now any pair with a cylinder (the generic convex narrowphase
-/// will add those rows).
+/// are static and unbounded. Shapes with sub-shapes (compounds, surfaces) are taken apart before
+/// this table (collide_parts.cpp).
 struct PairRow {
   ShapeType a;
   ShapeType b;
   PairFunction collide;
 };
+
+// The generic convex narrowphase (geometry/convex.hpp) for the pairs with a cylinder or a convex
+// hull: one view over every convex shape.
+ConvexView view_of(const PosedShape& s) noexcept {
+  return s.geometry != nullptr ? ConvexView::of_hull(s.geometry->hull()) : ConvexView::of(s.shape);
+}
+
+Manifold convex_pair(const PosedShape& a, const PosedShape& b, Fixed margin) noexcept {
+  return collide_convex(view_of(a), a.pose, view_of(b), b.pose, margin);
+}
+
+// The plane is a (its type is below the cylinder's and the hull's): convex_plane's manifold,
+// mirrored.
+Manifold plane_convex(const PosedShape& a, const PosedShape& b, Fixed margin) noexcept {
+  Manifold m = convex_plane(view_of(b), b.pose, a.pose, margin);
+  m.normal = -m.normal;
+  for (std::uint8_t i = 0; i < m.count; ++i)
+    m.points[i].feature = mirror_feature(m.points[i].feature);
+  return m;
+}
 
 constexpr PairRow kPairs[] = {
     {ShapeType::sphere, ShapeType::sphere, primitive<sphere_sphere>},
@@ -530,6 +552,17 @@ constexpr PairRow kPairs[] = {
     {ShapeType::box, ShapeType::plane, primitive<box_plane>},
     {ShapeType::capsule, ShapeType::capsule, primitive<capsule_capsule>},
     {ShapeType::capsule, ShapeType::plane, primitive<capsule_plane>},
+    {ShapeType::sphere, ShapeType::cylinder, convex_pair},
+    {ShapeType::box, ShapeType::cylinder, convex_pair},
+    {ShapeType::capsule, ShapeType::cylinder, convex_pair},
+    {ShapeType::plane, ShapeType::cylinder, plane_convex},
+    {ShapeType::cylinder, ShapeType::cylinder, convex_pair},
+    {ShapeType::sphere, ShapeType::convex, convex_pair},
+    {ShapeType::box, ShapeType::convex, convex_pair},
+    {ShapeType::capsule, ShapeType::convex, convex_pair},
+    {ShapeType::plane, ShapeType::convex, plane_convex},
+    {ShapeType::cylinder, ShapeType::convex, convex_pair},
+    {ShapeType::convex, ShapeType::convex, convex_pair},
 };
 
 /// kPairs as a table indexed by the two type values, which stay below kTypeLimit.

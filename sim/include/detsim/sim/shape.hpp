@@ -39,8 +39,7 @@ enum class ShapeType : std::uint8_t {
 /// - capsule: `radius` > 0, `half_height` >= 0: the core segment runs from (0, -half_height, 0) to
 ///   (0, +half_height, 0).
 /// - cylinder: `radius` > 0, `half_height` > 0: the axis runs from (0, -half_height, 0) to
-///   (0, +half_height, 0), with flat ends. (No collision pairs yet: it collides with nothing until
-///   the convex narrowphase handles it.)
+///   (0, +half_height, 0), with flat ends.
 /// - plane: no parameters. Solid below the plane through the body's position whose outward normal
 ///   is the body's local +y axis, rotated by its orientation. Only a static body can have one.
 /// - convex: `geometry`, a convex hull of the body's world (its points are in the body's frame;
