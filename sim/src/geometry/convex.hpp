@@ -163,4 +163,14 @@ struct SatEdge {
 [[nodiscard]] Manifold convex_plane(const ConvexView& a, const Pose& pa, const Pose& pb,
                                     Fixed margin) noexcept;
 
+struct TriangleData;
+
+/// The manifold of `a` against one triangle of a static surface (a mesh's or a heightfield's):
+/// `tri` in the surface's frame, posed by `surface`; the normal from `a` into the triangle's
+/// solid (back) side. One-sided, with internal edges (flat or concave neighbours) taking the face
+/// normal (geometry/convex_triangle.cpp).
+[[nodiscard]] Manifold collide_triangle(const ConvexView& a, const Pose& pa,
+                                        const TriangleData& tri, const Pose& surface,
+                                        Fixed margin) noexcept;
+
 }  // namespace detsim::sim_detail
