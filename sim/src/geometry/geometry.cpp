@@ -99,13 +99,13 @@ Expected<GeometryId> World::create_convex_hull(std::span<const Vec3> points) {
 Expected<GeometryId> World::create_mesh(std::span<const Vec3> vertices,
                                         std::span<const std::uint32_t> indices) {
   auto mesh = sim_detail::build_mesh(vertices, indices);
-  if (!mesh) return Status::error("invalid mesh: " + mesh.message());
+  if (!mesh) return Status::error("invalid " + mesh.message());
   return sim_detail::add(*s_, sim_detail::make_mesh_geometry(std::move(*mesh)));
 }
 
 Expected<GeometryId> World::create_heightfield(const HeightfieldDef& def) {
   auto hf = sim_detail::build_heightfield(def);
-  if (!hf) return Status::error("invalid heightfield: " + hf.message());
+  if (!hf) return Status::error("invalid " + hf.message());
   return sim_detail::add(*s_, sim_detail::make_heightfield_geometry(std::move(*hf)));
 }
 
