@@ -2,6 +2,8 @@
 // kind keeps. A new shape type gets these checks by adding its examples to `examples` below; the
 // contract tests then hold it to the same geometry as the others (derived from what each function
 // promises, never from a recorded run).
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <set>
 #include <span>
@@ -57,6 +59,52 @@ std::vector<Example> hull_examples() {
   return out;
 }
 
+// Surfaces (static only, no inside): a closed cube's 12 triangles about the origin, and a tilted
+// heightfield whose grid starts at the origin.
+std::vector<Example> mesh_examples() {
+  std::vector<Vec3> cube;
+  for (const int i : {0, 1, 2, 3, 4, 5, 6, 7})
+    cube.push_back({(i & 1) != 0 ? 0.5_fx : -0.5_fx, (i & 2) != 0 ? 0.5_fx : -0.5_fx,
+                    (i & 4) != 0 ? 0.5_fx : -0.5_fx});
+  std::vector<std::uint32_t> indices;
+  for (const auto& q : std::vector<std::array<std::uint32_t, 4>>{
+           {0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}})
+    indices.insert(indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+  auto mesh = sim_detail::build_mesh(cube, indices);
+  EXPECT_TRUE(mesh.ok()) << mesh.message();
+  if (!mesh.ok()) return {};
+  return {{Shape::mesh(GeometryId{1}), sim_detail::make_mesh_geometry(std::move(*mesh))}};
+}
+
+std::vector<Example> heightfield_examples() {
+  HeightfieldDef d;
+  d.rows = 4;
+  d.columns = 5;
+  d.cell_size = 0.5_fx;
+  for (std::uint32_t i = 0; i < d.rows * d.columns; ++i)
+    d.heights.push_back(Fixed::from_int(static_cast<std::int32_t>(i % 3)) / 4_fx -
+                        Fixed::from_int(static_cast<std::int32_t>(i / d.columns)) / 8_fx);
+  auto hf = sim_detail::build_heightfield(d);
+  EXPECT_TRUE(hf.ok()) << hf.message();
+  if (!hf.ok()) return {};
+  return {
+      {Shape::heightfield(GeometryId{1}), sim_detail::make_heightfield_geometry(std::move(*hf))}};
+}
+
+// A surface kind: bounded but static only — a mesh or a heightfield. It has no inside (contains
+// is false everywhere), no volume and no mass, so the contracts of solids adapt for it below.
+bool is_surface(const ShapeKind* kind) {
+  return kind->bounded && kind->static_only;
+}
+
+// Triangle 0 of a surface's geometry (a point on the surface: its centroid).
+Vec3 first_centroid(const sim_detail::Geometry* g) {
+  const sim_detail::TriangleData t = g->type == sim_detail::GeometryType::mesh
+                                         ? sim_detail::triangle(g->mesh(), 0)
+                                         : sim_detail::triangle(g->heightfield(), 0);
+  return (t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3_fx;
+}
+
 // Shapes of each type that a body may have, from small and flat to long.
 std::vector<Example> examples(ShapeType type) {
   const auto plain = [](std::initializer_list<Shape> shapes) {
@@ -79,6 +127,10 @@ std::vector<Example> examples(ShapeType type) {
                     Shape::cylinder(0.25_fx, 1.5_fx)});
     case ShapeType::convex:
       return hull_examples();
+    case ShapeType::mesh:
+      return mesh_examples();
+    case ShapeType::heightfield:
+      return heightfield_examples();
   }
   ADD_FAILURE() << "no examples of shape type " << static_cast<unsigned>(type)
                 << ": add them to examples() in this file";
@@ -120,6 +172,12 @@ TEST(ShapeKinds, MassPropertiesHaveTheGivenMassAndPositiveMoments) {
         EXPECT_EQ(mass_properties(s, 3_fx), MassProperties{}) << kind->name;
         continue;
       }
+      if (is_surface(kind)) {  // a surface has no mass: only static bodies have one
+        EXPECT_EQ(kind->volume(s, g), Fixed::zero()) << kind->name;
+        EXPECT_EQ(kind->mass_properties(s, g, 3_fx), MassProperties{}) << kind->name;
+        EXPECT_FALSE(kind->checked_volume(s, g).over()) << kind->name;
+        continue;
+      }
       EXPECT_GT(kind->volume(s, g), Fixed::zero()) << kind->name;
       const MassProperties m = kind->mass_properties(s, g, 3_fx);
       // The primitives' free functions are the kinds' (geometry needs its world: zero there).
@@ -147,7 +205,8 @@ TEST(ShapeKinds, MassPropertiesHaveTheGivenMassAndPositiveMoments) {
 
 // Points in the cube of side 4R about the origin: those the shape contains lie within the
 // bounding radius and the bounding box, and the smallest dimension's ball about the centre is
-// inside the shape.
+// inside the shape. A surface contains no point (it has no inside) and its smallest dimension is
+// 0: its samples must all be outside, and there is no ball to check.
 TEST(ShapeKinds, ContainedPointsLieWithinTheBoundsAndTheSmallestDimensionIsInside) {
   Rng rng(7);
   for (const ShapeKind* kind : shape_kinds()) {
@@ -162,11 +221,16 @@ TEST(ShapeKinds, ContainedPointsLieWithinTheBoundsAndTheSmallestDimensionIsInsid
         const Vec3 p{rng.uniform(-2_fx * r, 2_fx * r), rng.uniform(-2_fx * r, 2_fx * r),
                      rng.uniform(-2_fx * r, 2_fx * r)};
         if (!kind->contains(s, g, p)) continue;
+        ASSERT_FALSE(is_surface(kind)) << kind->name << ": a surface has no inside";
         ++inside;
         ASSERT_LE(length(p), r + Fixed::from_raw(16)) << kind->name;
         ASSERT_LE(abs(p.x), box.x) << kind->name;
         ASSERT_LE(abs(p.y), box.y) << kind->name;
         ASSERT_LE(abs(p.z), box.z) << kind->name;
+      }
+      if (is_surface(kind)) {
+        EXPECT_EQ(kind->smallest_dimension(s, g), Fixed::zero()) << kind->name;
+        continue;
       }
       EXPECT_GT(inside, 0) << kind->name << ": no sample fell inside";
       const Fixed d = kind->smallest_dimension(s, g);
@@ -181,6 +245,11 @@ TEST(ShapeKinds, ContainedPointsLieWithinTheBoundsAndTheSmallestDimensionIsInsid
 // A ray aimed at the centre from outside the bounding ball hits the surface: the hit point is on
 // the ray, within the bounding radius, and within 2^-16 m of the surface: a step on along the ray
 // is inside the shape, a step back outside it. A ray aimed away from it misses.
+//
+// A surface has no inside to step into, and its centre need not lie on it (a heightfield's grid
+// starts at the origin): its rays aim at a point on it (triangle 0's centroid) and must hit no
+// farther than that point, on the ray, within the bounding radius, with a unit normal facing the
+// ray's origin; rays aimed away miss.
 TEST(ShapeKinds, RaysAtTheCentreHitTheSurfaceAndRaysAwayMiss) {
   Rng rng(11);
   const Fixed step_back = Fixed::from_raw(Fixed::one_raw >> 16);
@@ -190,10 +259,21 @@ TEST(ShapeKinds, RaysAtTheCentreHitTheSurfaceAndRaysAwayMiss) {
       const Shape& s = e.shape;
       const sim_detail::Geometry* g = e.geometry.get();
       const Fixed r = kind->bounding_radius(s, g);
+      const Vec3 aim = is_surface(kind) ? first_centroid(g) : Vec3::zero();
       for (int i = 0; i < 200; ++i) {
         const Vec3 v = rng.unit_vector();
-        const Vec3 p = -v * (r * 2_fx + 1_fx);
+        const Vec3 p = aim - v * (r * 2_fx + 1_fx);
         const auto hit = kind->ray(s, g, p, v);
+        if (is_surface(kind)) {
+          ASSERT_TRUE(hit.has_value()) << kind->name;
+          EXPECT_LE(hit->t, r * 2_fx + 1_fx + Fixed::from_raw(1 << 12)) << kind->name;
+          EXPECT_LE(length(hit->point - (p + v * hit->t)), Fixed::from_raw(1 << 12)) << kind->name;
+          EXPECT_LE(length(hit->point), r + Fixed::from_raw(1 << 12)) << kind->name;
+          EXPECT_NEAR(length(hit->normal).to_double(), 1.0, 1e-6) << kind->name;
+          EXPECT_LT(dot(hit->normal, v), Fixed::zero()) << kind->name;
+          EXPECT_FALSE(kind->ray(s, g, p, -v).has_value()) << kind->name;
+          continue;
+        }
         ASSERT_TRUE(hit.has_value()) << kind->name;
         EXPECT_LE(length(hit->point - (p + v * hit->t)), Fixed::from_raw(1 << 12)) << kind->name;
         EXPECT_LE(length(hit->point), r + Fixed::from_raw(1 << 12)) << kind->name;
@@ -224,6 +304,15 @@ TEST(ShapeKinds, TheBoundingBoxHoldsTheRotatedShape) {
           EXPECT_LE(abs(p.x) + outline.radius, box.x + Fixed::from_raw(64)) << kind->name;
           EXPECT_LE(abs(p.y) + outline.radius, box.y + Fixed::from_raw(64)) << kind->name;
           EXPECT_LE(abs(p.z) + outline.radius, box.z + Fixed::from_raw(64)) << kind->name;
+        }
+        // A surface's triangles lie in the box too.
+        EXPECT_EQ(outline.triangles.empty(), !is_surface(kind)) << kind->name;
+        for (const auto& t : outline.triangles) {
+          for (const Vec3 p : t) {
+            EXPECT_LE(abs(p.x), box.x + Fixed::from_raw(64)) << kind->name;
+            EXPECT_LE(abs(p.y), box.y + Fixed::from_raw(64)) << kind->name;
+            EXPECT_LE(abs(p.z), box.z + Fixed::from_raw(64)) << kind->name;
+          }
         }
       }
     }

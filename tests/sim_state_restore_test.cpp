@@ -16,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include "sim/src/shapes.hpp"
 #include "support/state_helpers.hpp"
 
 namespace detsim {
@@ -244,8 +245,11 @@ TEST_F(RejectedRestore, BodyIdsMustBeAscendingUniqueAndKnown) {
 TEST_F(RejectedRestore, UnknownShapeOrBodyType) {
   const auto sphere_set = static_cast<std::size_t>(decoded_.bodies[1].set);
   ASSERT_EQ(decoded_.sets[sphere_set].shape.type, ShapeType::sphere);
-  for (const std::uint8_t type :
-       {std::uint8_t{0}, std::uint8_t{7}, std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
+  // 0, the first value past the table of kinds (7 became the triangle mesh; new types keep
+  // moving it), and two far ones.
+  const auto past_last = static_cast<std::uint8_t>(sim_detail::shape_kinds().back()->type) + 1;
+  for (const std::uint8_t type : {std::uint8_t{0}, static_cast<std::uint8_t>(past_last),
+                                  std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
     Decoded d = decoded_;
     d.sets[sphere_set].shape.type = static_cast<ShapeType>(type);
     d.sets[sphere_set].shape.radius = Fixed{};

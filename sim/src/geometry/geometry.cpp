@@ -45,6 +45,30 @@ std::shared_ptr<const Geometry> make_hull_geometry(Hull hull) {
   return g;
 }
 
+// The mesh's and heightfield's own canonical encodings (a version byte, then their defining data)
+// are what their readers rebuild from, so the hash covers exactly what defines the geometry.
+std::shared_ptr<const Geometry> make_mesh_geometry(Mesh mesh) {
+  auto g = std::make_shared<Geometry>();
+  g->type = GeometryType::mesh;
+  ByteWriter w;
+  w.u8(static_cast<std::uint8_t>(g->type));
+  write(mesh, w);
+  g->hash = hash64(w.bytes());
+  g->data = std::move(mesh);
+  return g;
+}
+
+std::shared_ptr<const Geometry> make_heightfield_geometry(Heightfield hf) {
+  auto g = std::make_shared<Geometry>();
+  g->type = GeometryType::heightfield;
+  ByteWriter w;
+  w.u8(static_cast<std::uint8_t>(g->type));
+  write(hf, w);
+  g->hash = hash64(w.bytes());
+  g->data = std::move(hf);
+  return g;
+}
+
 namespace {
 
 // Geometry IDs are 32-bit like body IDs; a world that registered this many has bigger problems.
@@ -70,6 +94,39 @@ Expected<GeometryId> World::create_convex_hull(std::span<const Vec3> points) {
   auto hull = sim_detail::build_hull(points);
   if (!hull) return Status::error("invalid convex hull: " + hull.message());
   return sim_detail::add(*s_, sim_detail::make_hull_geometry(std::move(*hull)));
+}
+
+Expected<GeometryId> World::create_mesh(std::span<const Vec3> vertices,
+                                        std::span<const std::uint32_t> indices) {
+  auto mesh = sim_detail::build_mesh(vertices, indices);
+  if (!mesh) return Status::error("invalid " + mesh.message());
+  return sim_detail::add(*s_, sim_detail::make_mesh_geometry(std::move(*mesh)));
+}
+
+Expected<GeometryId> World::create_heightfield(const HeightfieldDef& def) {
+  auto hf = sim_detail::build_heightfield(def);
+  if (!hf) return Status::error("invalid " + hf.message());
+  return sim_detail::add(*s_, sim_detail::make_heightfield_geometry(std::move(*hf)));
+}
+
+Expected<std::uint32_t> World::mesh_dropped_triangles(GeometryId id) const {
+  const sim_detail::Geometry* g = sim_detail::find_geometry(s_->geometries, id);
+  if (g == nullptr)
+    return Status::error("no geometry with ID " + std::to_string(id.value) + " (" +
+                         std::to_string(s_->geometries.size()) + " registered)");
+  if (g->type != sim_detail::GeometryType::mesh)
+    return Status::error("geometry " + std::to_string(id.value) + " is a " +
+                         sim_detail::geometry_type_name(g->type) + ", not a triangle mesh");
+  return g->mesh().dropped_triangles;
+}
+
+Expected<ShapeOutline> World::body_outline(BodyId id) const {
+  const auto b = body(id);
+  if (!b) return Status::error(b.message());
+  ShapeOutline out;
+  sim_detail::shape_kind(b->shape.type)
+      .outline(b->shape, s_->geometry(b->shape), b->position, b->orientation, out);
+  return out;
 }
 
 std::size_t World::geometry_count() const noexcept {

@@ -65,5 +65,11 @@ void write_hull_content(const Hull& hull, ByteWriter& w);
 
 /// A geometry of hull `hull`, its hash computed.
 [[nodiscard]] std::shared_ptr<const Geometry> make_hull_geometry(Hull hull);
+/// A geometry of mesh `mesh`, its hash computed: XXH3-64 of the type byte (2) and the mesh's
+/// canonical encoding (mesh.hpp's write).
+[[nodiscard]] std::shared_ptr<const Geometry> make_mesh_geometry(Mesh mesh);
+/// A geometry of heightfield `hf`, its hash computed: XXH3-64 of the type byte (3) and the
+/// heightfield's canonical encoding (heightfield.hpp's write).
+[[nodiscard]] std::shared_ptr<const Geometry> make_heightfield_geometry(Heightfield hf);
 
 }  // namespace detsim::sim_detail

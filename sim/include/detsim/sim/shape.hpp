@@ -25,12 +25,15 @@ struct GeometryId {
 /// The kinds of shape. The numeric values are part of the canonical state encoding: never
 /// renumber, only append.
 enum class ShapeType : std::uint8_t {
-  sphere = 1,    ///< centred on the body's origin
-  box = 2,       ///< oriented box centred on the body's origin
-  capsule = 3,   ///< segment along the body's local y axis, swept by a sphere
-  plane = 4,     ///< half-space below the body's local y = 0 plane; static bodies only
-  cylinder = 5,  ///< flat-ended cylinder along the body's local y axis
-  convex = 6,    ///< a convex hull registered with the world (World::create_convex_hull)
+  sphere = 1,       ///< centred on the body's origin
+  box = 2,          ///< oriented box centred on the body's origin
+  capsule = 3,      ///< segment along the body's local y axis, swept by a sphere
+  plane = 4,        ///< half-space below the body's local y = 0 plane; static bodies only
+  cylinder = 5,     ///< flat-ended cylinder along the body's local y axis
+  convex = 6,       ///< a convex hull registered with the world (World::create_convex_hull)
+  mesh = 7,         ///< a triangle mesh registered with the world (World::create_mesh); static only
+  heightfield = 8,  ///< a heightfield registered with the world (World::create_heightfield);
+                    ///< static only
 };
 
 /// A shape in the body's local frame (lengths in metres).
@@ -44,6 +47,10 @@ enum class ShapeType : std::uint8_t {
 ///   is the body's local +y axis, rotated by its orientation. Only a static body can have one.
 /// - convex: `geometry`, a convex hull of the body's world (its points are in the body's frame;
 ///   its centre of mass need not be the body's origin).
+/// - mesh: `geometry`, a triangle mesh of the body's world; heightfield: `geometry`, a heightfield
+///   of the body's world. Surfaces, not solids: two-sided, no inside, no volume or mass. Only a
+///   static body can have one. (No collision pairs yet: they collide with nothing until the mesh
+///   narrowphase handles them; ray casts see them.)
 /// Fields that a type does not use are zero. Build shapes with the named constructors.
 struct Shape {
   ShapeType type = ShapeType::sphere;
@@ -69,6 +76,12 @@ struct Shape {
   }
   [[nodiscard]] static constexpr Shape cylinder(Fixed radius, Fixed half_height) noexcept {
     return {ShapeType::cylinder, radius, half_height, {}, {}};
+  }
+  [[nodiscard]] static constexpr Shape mesh(GeometryId mesh) noexcept {
+    return {ShapeType::mesh, {}, {}, {}, mesh};
+  }
+  [[nodiscard]] static constexpr Shape heightfield(GeometryId heightfield) noexcept {
+    return {ShapeType::heightfield, {}, {}, {}, heightfield};
   }
 
   friend constexpr bool operator==(const Shape&, const Shape&) noexcept = default;

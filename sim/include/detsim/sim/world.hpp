@@ -18,8 +18,10 @@
 #include <detsim/core/status.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
+#include <detsim/sim/geometry.hpp>
 #include <detsim/sim/joint.hpp>
 #include <detsim/sim/mass.hpp>
+#include <detsim/sim/shape_outline.hpp>
 #include <detsim/sim/state_sections.hpp>
 #include <detsim/sim/world_def.hpp>
 
@@ -172,6 +174,26 @@ class World {
   /// wrong: more than 4096 points, a component beyond +-10^4 m, fewer than 4 points that are not
   /// coplanar (a flat or degenerate cloud), or a hull of more than 256 corners.
   Expected<GeometryId> create_convex_hull(std::span<const Vec3> points);
+  /// Registers a triangle mesh (body frame, metres) for static bodies (Shape::mesh): `indices`
+  /// read as triples into `vertices`, each counter-clockwise seen from the side its normal points
+  /// to (a mesh is two-sided: rays hit either side). Degenerate triangles (repeated indices, zero
+  /// area, or too small for a reliable normal: every component of twice the area vector below
+  /// 2^-24 m^2) are dropped and counted (mesh_dropped_triangles); the others keep
+  /// their input order, which is the order of triangle indices. Refused, with a message naming what
+  /// is wrong and registering nothing: an index count not divisible by 3; more than 2^20 triangles
+  /// or vertices; a vertex component beyond +-10^4 m; an index out of range ("invalid mesh:
+  /// triangle 7: index 3 is 12, but there are 10 vertices"); no triangle left.
+  Expected<GeometryId> create_mesh(std::span<const Vec3> vertices,
+                                   std::span<const std::uint32_t> indices);
+  /// Registers a heightfield (HeightfieldDef: a grid of heights in the local x-z plane) for static
+  /// bodies (Shape::heightfield). Refused, with a message naming the field and registering
+  /// nothing: rows or columns outside 2..4096, a heights count other than rows * columns, a cell
+  /// size below 2^-10 m or a grid wider than 10^4 m, a height beyond +-10^4 m.
+  Expected<GeometryId> create_heightfield(const HeightfieldDef& def);
+  /// How many of the triangles given to create_mesh were dropped as degenerate. Not part of the
+  /// content hash: two inputs that differ only by degenerate triangles are the same mesh. An error
+  /// for an unknown ID or a geometry that is not a triangle mesh.
+  [[nodiscard]] Expected<std::uint32_t> mesh_dropped_triangles(GeometryId id) const;
   /// Registered geometries, 0 .. n-1 being IDs 1 .. n (geometry is never removed).
   [[nodiscard]] std::size_t geometry_count() const noexcept;
   /// The content hash of a geometry (XXH3-64 of its canonical encoding, docs/STATE.md): equal
@@ -197,6 +219,10 @@ class World {
   [[nodiscard]] std::vector<BodyId> body_ids() const;
   /// A copy of a body's state, or an error for an unknown ID.
   [[nodiscard]] Expected<BodyState> body(BodyId id) const;
+  /// What a viewer draws for a body (detsim/sim/shape_outline.hpp) at its current pose: the same
+  /// as shape_outline for a primitive, and also for the shapes whose geometry is registered with
+  /// the world (convex hulls, meshes, heightfields). An error for an unknown ID.
+  [[nodiscard]] Expected<ShapeOutline> body_outline(BodyId id) const;
 
   /// Switches between kinematic and dynamic (either way, keeping the velocity) or to/from static
   /// (velocity zeroed). A dynamic body gets its mass back from its shape and definition.
