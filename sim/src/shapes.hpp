@@ -1,7 +1,8 @@
 // One home per shape type. Internal to detsim::sim.
 //
 // Everything the library does with a shape that depends on its type lives in that type's file
-// (shape_sphere.cpp, shape_box.cpp, shape_capsule.cpp, shape_plane.cpp, shape_cylinder.cpp) as one
+// (shape_sphere.cpp, shape_box.cpp, shape_capsule.cpp, shape_plane.cpp, shape_cylinder.cpp,
+// shape_convex.cpp, shape_compound.cpp) as one
 // ShapeKind: its checks, mass properties, bounds, ray and containment tests, canonical encoding and
 // outline. The rest of the library asks the kind (shape_kind(type)) and never switches on
 // ShapeType, so a new type is its file, a row in shapes.cpp's table and its rows in the collision
@@ -113,6 +114,7 @@ extern const ShapeKind capsule_kind;
 extern const ShapeKind plane_kind;
 extern const ShapeKind cylinder_kind;
 extern const ShapeKind convex_kind;
+extern const ShapeKind compound_kind;
 
 /// Every kind, ascending by type.
 [[nodiscard]] std::span<const ShapeKind* const> shape_kinds() noexcept;

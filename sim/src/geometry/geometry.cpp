@@ -45,6 +45,32 @@ std::shared_ptr<const Geometry> make_hull_geometry(Hull hull) {
   return g;
 }
 
+void write_compound_content(const Compound& compound, ByteWriter& w) {
+  w.var(compound.parts.size());
+  for (const CompoundPart& part : compound.parts) {
+    const Shape& shape = part.child.shape;
+    w.u8(static_cast<std::uint8_t>(shape.type));
+    if (part.geometry != nullptr) {
+      w.u64(part.geometry->hash);
+    } else {
+      shape_kind(shape.type).write(shape, w);
+    }
+    w.var_vec3(part.child.position);
+    w.var_quat(part.child.orientation);
+  }
+}
+
+std::shared_ptr<const Geometry> make_compound_geometry(Compound compound) {
+  auto g = std::make_shared<Geometry>();
+  g->type = GeometryType::compound;
+  ByteWriter w;
+  w.u8(static_cast<std::uint8_t>(g->type));
+  write_compound_content(compound, w);
+  g->hash = hash64(w.bytes());
+  g->data = std::move(compound);
+  return g;
+}
+
 namespace {
 
 // Geometry IDs are 32-bit like body IDs; a world that registered this many has bigger problems.
@@ -70,6 +96,12 @@ Expected<GeometryId> World::create_convex_hull(std::span<const Vec3> points) {
   auto hull = sim_detail::build_hull(points);
   if (!hull) return Status::error("invalid convex hull: " + hull.message());
   return sim_detail::add(*s_, sim_detail::make_hull_geometry(std::move(*hull)));
+}
+
+Expected<GeometryId> World::create_compound(std::span<const CompoundChild> children) {
+  auto compound = sim_detail::build_compound(s_->geometries, children);
+  if (!compound) return Status::error("invalid compound: " + compound.message());
+  return sim_detail::add(*s_, sim_detail::make_compound_geometry(std::move(*compound)));
 }
 
 std::size_t World::geometry_count() const noexcept {

@@ -31,6 +31,7 @@ enum class ShapeType : std::uint8_t {
   plane = 4,     ///< half-space below the body's local y = 0 plane; static bodies only
   cylinder = 5,  ///< flat-ended cylinder along the body's local y axis
   convex = 6,    ///< a convex hull registered with the world (World::create_convex_hull)
+  compound = 9,  ///< parts placed in the body's frame, registered (World::create_compound)
 };
 
 /// A shape in the body's local frame (lengths in metres).
@@ -45,6 +46,8 @@ enum class ShapeType : std::uint8_t {
 ///   is the body's local +y axis, rotated by its orientation. Only a static body can have one.
 /// - convex: `geometry`, a convex hull of the body's world (its points are in the body's frame;
 ///   its centre of mass need not be the body's origin).
+/// - compound: `geometry`, a compound of the body's world: primitives and convex hulls placed in
+///   the body's frame (its centre of mass is wherever the parts put it). No collisions yet.
 /// Fields that a type does not use are zero. Build shapes with the named constructors.
 struct Shape {
   ShapeType type = ShapeType::sphere;
@@ -70,6 +73,9 @@ struct Shape {
   }
   [[nodiscard]] static constexpr Shape cylinder(Fixed radius, Fixed half_height) noexcept {
     return {ShapeType::cylinder, radius, half_height, {}, {}};
+  }
+  [[nodiscard]] static constexpr Shape compound(GeometryId compound) noexcept {
+    return {ShapeType::compound, {}, {}, {}, compound};
   }
 
   friend constexpr bool operator==(const Shape&, const Shape&) noexcept = default;

@@ -14,12 +14,15 @@ namespace detsim {
 /// `radius` (a sphere: its centre and radius; a capsule: the two ends of its core and its radius;
 /// a box: its eight corners, radius 0; a cylinder: 16 points on each end circle, radius 0), or, for
 /// a plane (`half_space`), the solid below the plane through `points[0]` with outward unit normal
-/// `normal`. For display only: nothing the simulation computes depends on it.
+/// `normal`. A compound is drawn as its parts: `points` is empty and `parts` holds one outline
+/// per part (in part order), each placed by the part's pose. For display only: nothing the
+/// simulation computes depends on it.
 struct ShapeOutline {
   bool half_space = false;
   std::vector<Vec3> points;
   Fixed radius{};
   Vec3 normal{};
+  std::vector<ShapeOutline> parts;  ///< a compound's parts (empty for every other shape)
 };
 
 /// The outline of `shape` at `position` with the unit quaternion `orientation`. A shape of a type

@@ -18,6 +18,7 @@
 #include <detsim/core/status.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
+#include <detsim/sim/geometry.hpp>
 #include <detsim/sim/joint.hpp>
 #include <detsim/sim/mass.hpp>
 #include <detsim/sim/state_sections.hpp>
@@ -168,6 +169,16 @@ class World {
   /// wrong: more than 4096 points, a component beyond +-10^4 m, fewer than 4 points that are not
   /// coplanar (a flat or degenerate cloud), or a hull of more than 256 corners.
   Expected<GeometryId> create_convex_hull(std::span<const Vec3> points);
+  /// Registers a compound of `children` (1 to 64): spheres, boxes, capsules, cylinders and convex
+  /// hulls of this world, each placed by its position (metres) and unit orientation in the
+  /// compound's frame (Shape::compound). The parts must not overlap: mass properties treat the
+  /// compound as their sum, one density throughout, so the centre of mass is wherever the parts
+  /// put it. No collisions yet: a compound body collides with nothing (rays and mass properties
+  /// work). Refused, with a message naming the child and what is wrong: no children, more than
+  /// 64, a shape that is not one of those (a plane, a mesh, a heightfield, a compound, or an
+  /// invalid size or geometry ID), a non-unit orientation, a position component beyond +-10^4 m,
+  /// or a volume or moment of inertia per unit mass above the limits (2^31 - 1).
+  Expected<GeometryId> create_compound(std::span<const CompoundChild> children);
   /// Registered geometries, 0 .. n-1 being IDs 1 .. n (geometry is never removed).
   [[nodiscard]] std::size_t geometry_count() const noexcept;
   /// The content hash of a geometry (XXH3-64 of its canonical encoding, docs/STATE.md): equal
