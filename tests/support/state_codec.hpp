@@ -5,22 +5,22 @@
 //   "DSIM" u32 version=5 | var section count (6) | six sections, each: var name length, name,
 //   var section version (bodies 2, the others 1), u32 payload length, payload. The payloads, in
 //   this order: globals: u64 frame | u32 next ID | definition (fixed width);  rng: 4 x u64;
-//   geometry: var count, then per geometry u8 type (1 convex hull), u64 content hash;
+//   geometry: var count, then per geometry u8 type (1 convex hull, 4 compound), u64 content hash;
 //   bodies: u32 property-set count, sets in first-use order | u32 body count, bodies ascending by
 //   ID;  contacts: u32 contact count, contacts ascending by (a, b);  joints: u32 next joint ID,
 //   u32 joint count, joints ascending by ID.
 // `var` is canonical LEB128 (at most 5 bytes for a 32-bit field, 10 for a 64-bit one); `vfixed` a
 // var of the zigzag raw value. A set: type u8, shape (type u8, then its vfixed sizes, or a convex
-// hull's geometry ID var), mass, inertia, centre of mass (vec3), inertia axes (quat), friction,
-// restitution, linear and angular damping (vfixed), layer u32, mask u32, flags u8 (sensor, CCD). A
-// body: ID step var, set index var, flags u8 (awake, user data, force, torque follow), position,
-// orientation, velocities, sleep time (vfixed), then the flagged values. A contact: a step var, b -
-// a var, point byte (count in bits 0-2, reported in bit 3), then per point: feature on a, feature
-// on b (var: index * 4 + kind), three impulses (vfixed). A joint: ID step var, type u8 (0-5), body
-// a var, body b var, flags u8 (limit enabled, motor enabled, collide connected, broken, user data
-// follows), anchor, axis (vec3), eleven definition numbers (vfixed), local anchors a and b, local
-// axes a and b (vec3), relative orientation (quat), length (vfixed), linear and angular impulse
-// (vec3), axial, motor and limit impulse (vfixed), then the user data.
+// hull's or a compound's geometry ID var), mass, inertia, centre of mass (vec3), inertia axes
+// (quat), friction, restitution, linear and angular damping (vfixed), layer u32, mask u32, flags u8
+// (sensor, CCD). A body: ID step var, set index var, flags u8 (awake, user data, force, torque
+// follow), position, orientation, velocities, sleep time (vfixed), then the flagged values. A
+// contact: a step var, b - a var, point byte (count in bits 0-2, reported in bit 3), then per
+// point: feature on a, feature on b (var: index * 4 + kind), three impulses (vfixed). A joint: ID
+// step var, type u8 (0-5), body a var, body b var, flags u8 (limit enabled, motor enabled, collide
+// connected, broken, user data follows), anchor, axis (vec3), eleven definition numbers (vfixed),
+// local anchors a and b, local axes a and b (vec3), relative orientation (quat), length (vfixed),
+// linear and angular impulse (vec3), axial, motor and limit impulse (vfixed), then the user data.
 //
 // decode() is strict about what the layout itself says (canonical vars, enum values, flag bits,
 // zero values flagged present, set order and use, ID and pair order, point bytes, features) and
@@ -461,10 +461,11 @@ inline DecodedSet read_set(StateReader& r) {
     case ShapeType::plane:
       break;
     case ShapeType::convex:
+    case ShapeType::compound:
       s.shape.geometry = GeometryId{static_cast<std::uint32_t>(r.var("geometry ID", 32))};
       break;
     default:
-      r.fail(shape_at, "shape type: not 1 to 6");
+      r.fail(shape_at, "shape type: not 1 to 6 or 9");
   }
   s.mass_at = r.at();
   s.mass = r.vfixed("mass");
@@ -678,7 +679,7 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
           DecodedGeometry g;
           g.at = r.at();
           g.type = r.u8("geometry type");
-          if (r.ok() && g.type != 1) r.fail(g.at, "geometry type: not 1");
+          if (r.ok() && g.type != 1 && g.type != 4) r.fail(g.at, "geometry type: not 1 or 4");
           g.hash = r.u64("geometry hash");
           d.geometries.push_back(g);
         }
@@ -785,6 +786,7 @@ inline void write_set(StateWriter& w, const DecodedSet& s) {
       w.vfixed(s.shape.half_height);
       break;
     case ShapeType::convex:
+    case ShapeType::compound:
       w.var(s.shape.geometry.value);
       break;
     default:
