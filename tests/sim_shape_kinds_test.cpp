@@ -105,6 +105,32 @@ Vec3 first_centroid(const sim_detail::Geometry* g) {
   return (t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3_fx;
 }
 
+// Compounds about the origin (the contract's "centre": their centroid, and the smallest dimension
+// is the largest part's, so that part sits on the origin): a box between two spheres, and a turned
+// cube hull between two capsules lying along x. Built as a world builds them, on a table of its
+// own (the hull is its geometry 1).
+std::vector<Example> compound_examples() {
+  std::vector<Example> out;
+  const auto make = [&out](const sim_detail::GeometryTable& table,
+                           const std::vector<CompoundChild>& children) {
+    auto c = sim_detail::build_compound(table, children);
+    EXPECT_TRUE(c.ok()) << c.message();
+    if (!c.ok()) return;
+    out.push_back({Shape::compound(GeometryId{static_cast<std::uint32_t>(table.size() + 1)}),
+                   sim_detail::make_compound_geometry(std::move(*c))});
+  };
+  const Quat none = Quat::identity();
+  make({}, {{Shape::box({0.5_fx, 0.5_fx, 0.5_fx}), {}, none},
+            {Shape::sphere(0.4_fx), {1.5_fx, 0_fx, 0_fx}, none},
+            {Shape::sphere(0.4_fx), {-1.5_fx, 0_fx, 0_fx}, none}});
+  const sim_detail::GeometryTable table{hull_examples()[0].geometry};
+  const Quat lying = from_axis_angle(Vec3::unit_z(), Fixed::half_pi());
+  make(table, {{Shape::convex(GeometryId{1}), {}, from_axis_angle(Vec3::unit_y(), 0.5_fx)},
+               {Shape::capsule(0.3_fx, 0.4_fx), {0_fx, 1.2_fx, 0_fx}, lying},
+               {Shape::capsule(0.3_fx, 0.4_fx), {0_fx, -1.2_fx, 0_fx}, lying}});
+  return out;
+}
+
 // Shapes of each type that a body may have, from small and flat to long.
 std::vector<Example> examples(ShapeType type) {
   const auto plain = [](std::initializer_list<Shape> shapes) {
@@ -131,6 +157,8 @@ std::vector<Example> examples(ShapeType type) {
       return mesh_examples();
     case ShapeType::heightfield:
       return heightfield_examples();
+    case ShapeType::compound:
+      return compound_examples();
   }
   ADD_FAILURE() << "no examples of shape type " << static_cast<unsigned>(type)
                 << ": add them to examples() in this file";
@@ -297,13 +325,18 @@ TEST(ShapeKinds, TheBoundingBoxHoldsTheRotatedShape) {
         const Quat q = from_axis_angle(rng.unit_vector(), rng.uniform(0_fx, 3_fx));
         const Mat3 rotation = to_mat3(q);
         const Vec3 box = kind->aabb_extent(s, g, rotation);
-        // The outline's points grown by its radius are the extreme points of a convex shape.
+        // The outline's points grown by its radius are the extreme points of a convex shape (of
+        // each part of a compound).
         ShapeOutline outline;
         kind->outline(s, g, Vec3{}, q, outline);
-        for (const Vec3 p : outline.points) {
-          EXPECT_LE(abs(p.x) + outline.radius, box.x + Fixed::from_raw(64)) << kind->name;
-          EXPECT_LE(abs(p.y) + outline.radius, box.y + Fixed::from_raw(64)) << kind->name;
-          EXPECT_LE(abs(p.z) + outline.radius, box.z + Fixed::from_raw(64)) << kind->name;
+        std::vector<ShapeOutline> pieces = outline.parts;
+        pieces.push_back(outline);
+        for (const ShapeOutline& piece : pieces) {
+          for (const Vec3 p : piece.points) {
+            EXPECT_LE(abs(p.x) + piece.radius, box.x + Fixed::from_raw(64)) << kind->name;
+            EXPECT_LE(abs(p.y) + piece.radius, box.y + Fixed::from_raw(64)) << kind->name;
+            EXPECT_LE(abs(p.z) + piece.radius, box.z + Fixed::from_raw(64)) << kind->name;
+          }
         }
         // A surface's triangles lie in the box too.
         EXPECT_EQ(outline.triangles.empty(), !is_surface(kind)) << kind->name;
@@ -434,6 +467,32 @@ TEST(ShapeOutline, EachShapeIsDrawnFromItsDefinition) {
   Shape unknown;
   unknown.type = static_cast<ShapeType>(99);
   EXPECT_TRUE(shape_outline(unknown, at, q).points.empty());
+}
+
+// A compound is drawn as its parts, each its own outline at the part's world pose; its bounds
+// hold every part.
+TEST(ShapeKinds, ACompoundsOutlineIsItsPartsAtTheirPoses) {
+  const ShapeKind& kind = *find_shape_kind(ShapeType::compound);
+  const std::vector<Example> e = compound_examples();
+  ASSERT_EQ(e.size(), 2U);
+  const sim_detail::Geometry* g = e[0].geometry.get();
+  const Vec3 at{1_fx, 2_fx, 3_fx};
+  const Quat q = from_axis_angle(Vec3::unit_z(), Fixed::half_pi());  // local x -> world y
+  ShapeOutline out;
+  kind.outline(e[0].shape, g, at, q, out);
+  EXPECT_TRUE(out.points.empty());
+  ASSERT_EQ(out.parts.size(), 3U);
+  EXPECT_EQ(out.parts[0].points.size(), 8U);  // the box's corners
+  ASSERT_EQ(out.parts[1].points.size(), 1U);  // a sphere: its centre, grown by its radius
+  EXPECT_EQ(out.parts[1].radius, 0.4_fx);
+  EXPECT_NEAR(out.parts[1].points[0].x.to_double(), 1, 1e-8);
+  EXPECT_NEAR(out.parts[1].points[0].y.to_double(), 3.5, 1e-8);
+  EXPECT_NEAR(out.parts[2].points[0].y.to_double(), 0.5, 1e-8);
+  // Bounds: the spheres reach 1.9 along local x, the box 0.5 across; radius 1.9.
+  const Vec3 box = kind.aabb_extent(e[0].shape, g, Mat3::identity());
+  EXPECT_EQ(box, (Vec3{1.9_fx, 0.5_fx, 0.5_fx}));
+  EXPECT_EQ(kind.bounding_radius(e[0].shape, g), 1.9_fx);
+  EXPECT_EQ(kind.smallest_dimension(e[0].shape, g), 0.5_fx);
 }
 
 }  // namespace

@@ -14,9 +14,9 @@ namespace sim_detail {
 namespace {
 
 /// Every kind, ascending by type: a new shape type is a row here.
-constexpr std::array<const ShapeKind*, 8> kKinds = {&sphere_kind, &box_kind,        &capsule_kind,
-                                                    &plane_kind,  &cylinder_kind,   &convex_kind,
-                                                    &mesh_kind,   &heightfield_kind};
+constexpr std::array<const ShapeKind*, 9> kKinds = {
+    &sphere_kind, &box_kind,  &capsule_kind,     &plane_kind,   &cylinder_kind,
+    &convex_kind, &mesh_kind, &heightfield_kind, &compound_kind};
 
 }  // namespace
 

@@ -2,7 +2,7 @@
 //
 // Everything the library does with a shape that depends on its type lives in that type's file
 // (shape_sphere.cpp, shape_box.cpp, shape_capsule.cpp, shape_plane.cpp, shape_cylinder.cpp,
-// shape_convex.cpp, shape_mesh.cpp for meshes and heightfields) as one
+// shape_convex.cpp, shape_mesh.cpp for meshes and heightfields, shape_compound.cpp) as one
 // ShapeKind: its checks, mass properties, bounds, ray and containment tests, canonical encoding and
 // outline. The rest of the library asks the kind (shape_kind(type)) and never switches on
 // ShapeType, so a new type is its file, a row in shapes.cpp's table and its rows in the collision
@@ -116,6 +116,7 @@ extern const ShapeKind cylinder_kind;
 extern const ShapeKind convex_kind;
 extern const ShapeKind mesh_kind;
 extern const ShapeKind heightfield_kind;
+extern const ShapeKind compound_kind;
 
 /// Every kind, ascending by type.
 [[nodiscard]] std::span<const ShapeKind* const> shape_kinds() noexcept;

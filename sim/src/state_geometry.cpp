@@ -53,7 +53,7 @@ bool read_geometry(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
     if (!r.ok()) return false;
     const std::string id = "geometry " + std::to_string(i + 1);
     if (type < static_cast<std::uint8_t>(GeometryType::convex_hull) ||
-        type > static_cast<std::uint8_t>(GeometryType::heightfield)) {
+        type > static_cast<std::uint8_t>(GeometryType::compound)) {
       error = "byte " + std::to_string(at) + ": " + id + ": unknown geometry type " +
               std::to_string(type);
       return false;

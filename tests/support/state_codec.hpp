@@ -5,8 +5,8 @@
 //   "DSIM" u32 version=5 | var section count (6) | six sections, each: var name length, name,
 //   var section version (bodies 2, the others 1), u32 payload length, payload. The payloads, in
 //   this order: globals: u64 frame | u32 next ID | definition (fixed width);  rng: 4 x u64;
-//   geometry: var count, then per geometry u8 type (1 convex hull, 2 triangle mesh, 3 heightfield),
-//   u64 content hash;
+//   geometry: var count, then per geometry u8 type (1 convex hull, 2 triangle mesh, 3 heightfield,
+//   4 compound), u64 content hash;
 //   bodies: u32 property-set count, sets in first-use order | u32 body count, bodies ascending by
 //   ID;  contacts: u32 contact count, contacts ascending by (a, b);  joints: u32 next joint ID,
 //   u32 joint count, joints ascending by ID.
@@ -467,10 +467,11 @@ inline DecodedSet read_set(StateReader& r) {
     case ShapeType::convex:
     case ShapeType::mesh:
     case ShapeType::heightfield:
+    case ShapeType::compound:
       s.shape.geometry = GeometryId{static_cast<std::uint32_t>(r.var("geometry ID", 32))};
       break;
     default:
-      r.fail(shape_at, "shape type: not 1 to 8");
+      r.fail(shape_at, "shape type: not 1 to 9");
   }
   s.mass_at = r.at();
   s.mass = r.vfixed("mass");
@@ -697,7 +698,7 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
           DecodedGeometry g;
           g.at = r.at();
           g.type = r.u8("geometry type");
-          if (r.ok() && (g.type < 1 || g.type > 3)) r.fail(g.at, "geometry type: not 1 to 3");
+          if (r.ok() && (g.type < 1 || g.type > 4)) r.fail(g.at, "geometry type: not 1 to 4");
           g.hash = r.u64("geometry hash");
           d.geometries.push_back(g);
         }
@@ -806,6 +807,7 @@ inline void write_set(StateWriter& w, const DecodedSet& s) {
       w.vfixed(s.shape.half_height);
       break;
     case ShapeType::convex:
+    case ShapeType::compound:
       w.var(s.shape.geometry.value);
       break;
     default:

@@ -66,6 +66,29 @@ std::shared_ptr<const Geometry> make_heightfield_geometry(Heightfield hf) {
   write(hf, w);
   g->hash = hash64(w.bytes());
   g->data = std::move(hf);
+void write_compound_content(const Compound& compound, ByteWriter& w) {
+  w.var(compound.parts.size());
+  for (const CompoundPart& part : compound.parts) {
+    const Shape& shape = part.child.shape;
+    w.u8(static_cast<std::uint8_t>(shape.type));
+    if (part.geometry != nullptr) {
+      w.u64(part.geometry->hash);
+    } else {
+      shape_kind(shape.type).write(shape, w);
+    }
+    w.var_vec3(part.child.position);
+    w.var_quat(part.child.orientation);
+  }
+}
+
+std::shared_ptr<const Geometry> make_compound_geometry(Compound compound) {
+  auto g = std::make_shared<Geometry>();
+  g->type = GeometryType::compound;
+  ByteWriter w;
+  w.u8(static_cast<std::uint8_t>(g->type));
+  write_compound_content(compound, w);
+  g->hash = hash64(w.bytes());
+  g->data = std::move(compound);
   return g;
 }
 
@@ -127,6 +150,10 @@ Expected<ShapeOutline> World::body_outline(BodyId id) const {
   sim_detail::shape_kind(b->shape.type)
       .outline(b->shape, s_->geometry(b->shape), b->position, b->orientation, out);
   return out;
+Expected<GeometryId> World::create_compound(std::span<const CompoundChild> children) {
+  auto compound = sim_detail::build_compound(s_->geometries, children);
+  if (!compound) return Status::error("invalid compound: " + compound.message());
+  return sim_detail::add(*s_, sim_detail::make_compound_geometry(std::move(*compound)));
 }
 
 std::size_t World::geometry_count() const noexcept {

@@ -10,10 +10,13 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <variant>
 #include <vector>
 
 #include <detsim/core/bytes.hpp>
+#include <detsim/core/status.hpp>
+#include <detsim/sim/geometry.hpp>
 #include <detsim/sim/shape.hpp>
 
 #include "compound.hpp"
@@ -71,5 +74,23 @@ void write_hull_content(const Hull& hull, ByteWriter& w);
 /// A geometry of heightfield `hf`, its hash computed: XXH3-64 of the type byte (3) and the
 /// heightfield's canonical encoding (heightfield.hpp's write).
 [[nodiscard]] std::shared_ptr<const Geometry> make_heightfield_geometry(Heightfield hf);
+
+/// The compound of `children` (compound.cpp): each child's shape checked against `table` (a
+/// primitive a dynamic body may have, or a convex hull of the table), its pose checked, and the
+/// solid of the parts computed. Refuses, with a message naming the child and what is wrong: no
+/// children, more than max_compound_parts, a shape that is not a valid primitive or convex hull of
+/// the table, a non-unit orientation, a position component beyond +-10^4 m, or a volume or moment
+/// of inertia (per unit mass) beyond the limits of limits.hpp.
+[[nodiscard]] Expected<Compound> build_compound(const GeometryTable& table,
+                                                std::span<const CompoundChild> children);
+
+/// The canonical encoding of a compound's content, which its hash covers: the part count, then
+/// per part its shape type, its fields (a primitive: its kind's encoding; a convex hull: the
+/// hull's content hash, never its ID, so that equal compounds hash equal in any world), its
+/// position and its orientation as given.
+void write_compound_content(const Compound& compound, ByteWriter& w);
+
+/// A geometry of compound `compound`, its hash computed.
+[[nodiscard]] std::shared_ptr<const Geometry> make_compound_geometry(Compound compound);
 
 }  // namespace detsim::sim_detail

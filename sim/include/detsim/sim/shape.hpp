@@ -34,6 +34,7 @@ enum class ShapeType : std::uint8_t {
   mesh = 7,         ///< a triangle mesh registered with the world (World::create_mesh); static only
   heightfield = 8,  ///< a heightfield registered with the world (World::create_heightfield);
                     ///< static only
+  compound = 9,     ///< parts placed in the body's frame, registered (World::create_compound)
 };
 
 /// A shape in the body's local frame (lengths in metres).
@@ -49,8 +50,9 @@ enum class ShapeType : std::uint8_t {
 ///   its centre of mass need not be the body's origin).
 /// - mesh: `geometry`, a triangle mesh of the body's world; heightfield: `geometry`, a heightfield
 ///   of the body's world. Surfaces, not solids: two-sided, no inside, no volume or mass. Only a
-///   static body can have one. (No collision pairs yet: they collide with nothing until the mesh
-///   narrowphase handles them; ray casts see them.)
+///   static body can have one.
+/// - compound: `geometry`, a compound of the body's world: primitives and convex hulls placed in
+///   the body's frame (its centre of mass is wherever the parts put it).
 /// Fields that a type does not use are zero. Build shapes with the named constructors.
 struct Shape {
   ShapeType type = ShapeType::sphere;
@@ -82,6 +84,9 @@ struct Shape {
   }
   [[nodiscard]] static constexpr Shape heightfield(GeometryId heightfield) noexcept {
     return {ShapeType::heightfield, {}, {}, {}, heightfield};
+  }
+  [[nodiscard]] static constexpr Shape compound(GeometryId compound) noexcept {
+    return {ShapeType::compound, {}, {}, {}, compound};
   }
 
   friend constexpr bool operator==(const Shape&, const Shape&) noexcept = default;

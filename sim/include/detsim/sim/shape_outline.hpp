@@ -20,7 +20,9 @@ namespace detsim {
 /// `normal`. A surface (a triangle mesh, a heightfield) is drawn as its `triangles` (world space,
 /// in the geometry's triangle order, at most the first max_outline_triangles of them;
 /// `surface_triangles` says how many it has), and its `points` are the eight corners of its local
-/// bounding box (radius 0), for a viewer that draws only points. For display only: nothing the
+/// bounding box (radius 0), for a viewer that draws only points.
+/// A compound is drawn as its parts: `points` is empty and `parts` holds one outline per part (in
+/// part order), each placed by the part's pose. For display only: nothing the
 /// simulation computes depends on it.
 struct ShapeOutline {
   bool half_space = false;
@@ -29,6 +31,7 @@ struct ShapeOutline {
   Vec3 normal{};
   std::vector<std::array<Vec3, 3>> triangles;  ///< a surface's triangles; empty for a solid
   std::uint32_t surface_triangles = 0;         ///< all of a surface's triangles, drawn or not
+  std::vector<ShapeOutline> parts;  ///< a compound's parts (empty for every other shape)
 };
 
 /// The most triangles an outline holds: a viewer's budget, not a limit of the geometry.

@@ -194,6 +194,15 @@ class World {
   /// content hash: two inputs that differ only by degenerate triangles are the same mesh. An error
   /// for an unknown ID or a geometry that is not a triangle mesh.
   [[nodiscard]] Expected<std::uint32_t> mesh_dropped_triangles(GeometryId id) const;
+  /// Registers a compound of `children` (1 to 64): spheres, boxes, capsules, cylinders and convex
+  /// hulls of this world, each placed by its position (metres) and unit orientation in the
+  /// compound's frame (Shape::compound). The parts must not overlap: mass properties treat the
+  /// compound as their sum, one density throughout, so the centre of mass is wherever the parts
+  /// put it. Refused, with a message naming the child and what is wrong: no children, more than
+  /// 64, a shape that is not one of those (a plane, a mesh, a heightfield, a compound, or an
+  /// invalid size or geometry ID), a non-unit orientation, a position component beyond +-10^4 m,
+  /// or a volume or moment of inertia per unit mass above the limits (2^31 - 1).
+  Expected<GeometryId> create_compound(std::span<const CompoundChild> children);
   /// Registered geometries, 0 .. n-1 being IDs 1 .. n (geometry is never removed).
   [[nodiscard]] std::size_t geometry_count() const noexcept;
   /// The content hash of a geometry (XXH3-64 of its canonical encoding, docs/STATE.md): equal
