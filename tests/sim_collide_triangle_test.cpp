@@ -262,4 +262,52 @@ TEST_F(Shared, DeterministicAndStable) {
   }
 }
 
+TEST_F(Shared, NoGhostNormalsOnAFlatFloor) {
+  // Random boxes, cylinders, rocks and capsules near the shared edge, turned anyhow about y and
+  // tilted up to ~0.1 rad, their lowest point between 0.02 deep and 0.05 above the floor: on a
+  // flat floor every manifold of either triangle has the face normal -y (within 2^-20) and no
+  // separation below the lowest point's height d. With the edge a boundary instead, some contacts
+  // on it must tilt (the ghost bumps this removes).
+  const ConvexView box = ConvexView::box({0.5_fx, 0.25_fx, 0.5_fx});
+  const ConvexView cyl = ConvexView::cylinder(0.4_fx, 0.3_fx);
+  const ConvexView rock = ConvexView::of_hull(shapes().rock);
+  const ConvexView capsule = ConvexView::capsule(0.2_fx, 0.6_fx);
+  Lcg next{0x7121A9u};
+  int tilted_on_boundary = 0;
+  int contacts = 0;
+  for (int i = 0; i < 400; ++i) {
+    const ConvexView& v = i % 4 == 0 ? box : (i % 4 == 1 ? cyl : (i % 4 == 2 ? rock : capsule));
+    const Quat turn =
+        normalize(about(Vec3::unit_y(), next() * Fixed::pi()) *
+                  about(normalize(v3(next(), 0_fx, next())), next() * 0.1_fx) *
+                  (i % 4 == 3 ? about(Vec3::unit_z(), quarter_turn) : Quat::identity()));
+    const Fixed d = 0.015_fx + next() * 0.035_fx;
+    Pose pose = place(v3(next() * 0.6_fx, 0_fx, next() * 2_fx), turn);
+    const Vec3 low = sim_detail::convex::support(v, pose, -Vec3::unit_y());
+    pose.position.y += surface.position.y - low.y + d;
+    for (const bool flat : {true, false}) {
+      make(false, flat ? EdgeKind::flat : EdgeKind::boundary);
+      for (const TriangleData* t : {&left, &right}) {
+        const Manifold m = collide_triangle(v, pose, *t, surface, kMargin);
+        expect_well_formed(m, kMargin);
+        if (m.count == 0) continue;
+        if (!flat) {
+          tilted_on_boundary += near(m.normal, -Vec3::unit_y(), kExact) ? 0 : 1;
+          continue;
+        }
+        ++contacts;
+        EXPECT_TRUE(near(m.normal, -Vec3::unit_y(), kExact)) << "case " << i;
+        for (std::size_t k = 0; k < m.count; ++k)
+          EXPECT_GE(m.points[k].separation, d - 1e-5_fx)
+              << "case " << i << " tri " << (t == &left) << " f " << std::hex
+              << m.points[k].feature << std::dec << " p " << to_string(m.points[k].point.x) << " "
+              << to_string(m.points[k].point.y - surface.position.y) << " "
+              << to_string(m.points[k].point.z - surface.position.z);
+      }
+    }
+  }
+  EXPECT_GT(contacts, 400);
+  EXPECT_GT(tilted_on_boundary, 0);
+}
+
 }  // namespace

@@ -115,15 +115,15 @@ bool inside_prism(const Tri& t, Vec3 p) noexcept {
 TriPoint closest_on_triangle(const Tri& t, Vec3 p) noexcept {
   if (inside_prism(t, p)) return {p - t.n * dot(t.n, p - t.v[0]), tri_face};
   TriPoint best;
-  Fixed best_d2 = Fixed::max();
+  Fixed best_d = Fixed::max();
   for (unsigned k = 0; k < 3; ++k) {
     const Fixed s = clamp(dot(p - t.v[k], t.dir[k]), Fixed::zero(), t.len[k]);
     TriPoint x{t.v[k] + t.dir[k] * s, tri_edge(k)};
     if (s == Fixed::zero()) x = {t.v[k], tri_vertex(k)};
     if (s == t.len[k]) x = {t.v[(k + 1) % 3], tri_vertex((k + 1) % 3)};
-    const Fixed d2 = length_squared(p - x.q);
-    if (d2 < best_d2) {
-      best_d2 = d2;
+    const Fixed d = length(p - x.q);  // no overflow, whatever the distance
+    if (d < best_d) {
+      best_d = d;
       best = x;
     }
   }
@@ -132,11 +132,16 @@ TriPoint closest_on_triangle(const Tri& t, Vec3 p) noexcept {
 
 constexpr std::size_t kTriCandidates = 2 * max_face_points + 2;
 
+/// Candidates with their pairs of surface points (a's, the triangle's), so that the internal-edge
+/// rule can project each pair on the face normal.
 struct TriCandidates {
   std::array<Candidate, kTriCandidates> c{};
+  std::array<Vec3, kTriCandidates> pair{};  ///< the triangle's point minus a's
   std::size_t n = 0;
-  void add(const Candidate& x, Fixed margin) noexcept {
-    if (x.separation <= margin && n < c.size()) c[n++] = x;
+  void add(Vec3 on_a, Vec3 on_b, Fixed separation, std::uint32_t feature, Fixed margin) noexcept {
+    if (separation > margin || n >= c.size()) return;
+    c[n] = {midpoint(on_a, on_b), separation, feature};
+    pair[n++] = on_b - on_a;
   }
 };
 
@@ -162,9 +167,7 @@ void face_contacts(const Body& a, const Tri& t, Fixed margin, TriCandidates& out
     const Fixed h = dot(t.n, p - t.v[0]);
     const Vec3 on_a = p - t.n * a.radius;
     const Vec3 on_b = p - t.n * h;
-    out.add(
-        {midpoint(on_a, on_b), h - a.radius, pair_feature(clipped[i].on_inc, clipped[i].on_ref)},
-        margin);
+    out.add(on_a, on_b, h - a.radius, pair_feature(clipped[i].on_inc, clipped[i].on_ref), margin);
   }
 }
 
@@ -181,7 +184,7 @@ bool a_face_contacts(const Body& a, const Tri& t, Vec3 m, Fixed margin,
     const Vec3 p = clipped[i].point;
     const Fixed s = dot(ref.normal, p) - plane;
     const Vec3 on_a = p - ref.normal * s;
-    out.add({midpoint(on_a, p), s, pair_feature(clipped[i].on_ref, clipped[i].on_inc)}, margin);
+    out.add(on_a, p, s, pair_feature(clipped[i].on_ref, clipped[i].on_inc), margin);
   }
   return true;
 }
@@ -194,15 +197,13 @@ void support_contact(const Body& a, const Tri& t, Vec3 l, bool face, Fixed margi
   const Vec3 on_a = s.point + l * a.radius;
   if (face) {
     const Fixed h = dot(t.n, s.point - t.v[0]);
-    out.add({midpoint(on_a, s.point - t.n * h), h - a.radius, pair_feature(s.feature, tri_face)},
-            margin);
+    out.add(on_a, s.point - t.n * h, h - a.radius, pair_feature(s.feature, tri_face), margin);
     return;
   }
   unsigned k = 0;
   for (unsigned i = 1; i < 3; ++i)
     if (dot(l, t.v[i]) < dot(l, t.v[k])) k = i;
-  out.add({midpoint(on_a, t.v[k]), dot(l, t.v[k] - s.point) - a.radius,
-           pair_feature(s.feature, tri_vertex(k))},
+  out.add(on_a, t.v[k], dot(l, t.v[k] - s.point) - a.radius, pair_feature(s.feature, tri_vertex(k)),
           margin);
 }
 
@@ -302,7 +303,7 @@ void edge_contact(const Body& a, const Tri& t, const Axis& axis, Fixed margin,
   if (p.t <= -sb.half_length) on_tri = tri_vertex(k);
   if (p.t >= sb.half_length) on_tri = tri_vertex((k + 1) % 3);
   const Vec3 on_a = sa.at(p.s) + axis.l * a.radius;
-  out.add({midpoint(on_a, sb.at(p.t)), axis.separation, pair_feature(e.feature, on_tri)}, margin);
+  out.add(on_a, sb.at(p.t), axis.separation, pair_feature(e.feature, on_tri), margin);
 }
 
 /// The polytope / cylinder manifold: SAT, the chosen axis' contacts (the triangle's face unless
@@ -390,25 +391,27 @@ Vec3 round_contacts(const Body& a, const Tri& t, Fixed margin, TriCandidates& ou
     face_contacts(a, t, margin, out);
     if (out.n > 0) return -t.n;
   }
-  out.add({midpoint(c.on_a + n * a.radius, c.on_b), c.distance - a.radius, c.feature}, margin);
+  out.add(c.on_a + n * a.radius, c.on_b, c.distance - a.radius, c.feature, margin);
   return n;
 }
 
-/// The internal-edge rule: a normal other than the face's stays only when a point touches a real
-/// feature; else the face normal, each point's pair (along the old normal) projected on it.
-void remove_internal_edges(const Tri& t, Fixed margin, Manifold& m) noexcept {
+/// The internal-edge rule: a normal other than the face's stays only when a candidate touches a
+/// real feature; else the face normal, each candidate's pair of surface points projected on it
+/// (its midpoint unchanged), those beyond the margin dropped.
+Vec3 remove_internal_edges(const Tri& t, Vec3 normal, Fixed margin, TriCandidates& found) noexcept {
   const Vec3 face = -t.n;
-  if (m.count == 0 || m.normal == face) return;
-  for (std::uint8_t i = 0; i < m.count; ++i)
-    if (real_feature(t, static_cast<std::uint16_t>(m.points[i].feature >> 16))) return;
-  const Fixed cosine = dot(m.normal, face);
-  Manifold out;
-  out.normal = face;
-  for (std::uint8_t i = 0; i < m.count; ++i) {
-    const ContactPoint& p = m.points[i];
-    add_point(out, p.point, p.separation * cosine, p.feature, margin);
+  if (normal == face) return normal;
+  for (std::size_t i = 0; i < found.n; ++i)
+    if (real_feature(t, static_cast<std::uint16_t>(found.c[i].feature >> 16))) return normal;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < found.n; ++i) {
+    const Fixed separation = dot(found.pair[i], face);
+    if (separation > margin) continue;
+    found.c[kept] = {found.c[i].point, separation, found.c[i].feature};
+    found.pair[kept++] = found.pair[i];
   }
-  m = out;
+  found.n = kept;
+  return face;
 }
 
 }  // namespace convex::triangle_detail
@@ -425,7 +428,12 @@ Manifold collide_triangle(const ConvexView& a, const Pose& pa, const TriangleDat
   const Mat3 to_a = transpose(pa.rotation);
   const Tri t = make_tri(tri, to_a * surface.rotation, to_a * (surface.position - pa.position));
   const Body A = make_body(a, Pose{Vec3{}, Mat3::identity()}, Vec3{});
-  // Bounding sphere beyond the margin from the triangle: nothing.
+  // a's bounding sphere beyond the margin from the triangle's bounds, then from the triangle.
+  const Fixed reach = bounding_radius(a) + margin;
+  for (int i = 0; i < 3; ++i) {
+    const auto c = [&](unsigned k) { return narrow::component(t.v[k], i); };
+    if (min(c(0), min(c(1), c(2))) > reach || max(c(0), max(c(1), c(2))) < -reach) return {};
+  }
   if (length(closest_on_triangle(t, Vec3{}).q) - bounding_radius(a) > margin) return {};
   // One-sided: a's centre (a hull's bounding-box centre) behind the plane by more than the margin.
   const Vec3 centre =
@@ -433,14 +441,13 @@ Manifold collide_triangle(const ConvexView& a, const Pose& pa, const TriangleDat
   if (dot(t.n, centre - t.v[0]) < -margin) return {};
   TriCandidates found;
   const bool round = a.kind == ConvexKind::sphere || a.kind == ConvexKind::capsule;
-  const Vec3 normal =
+  Vec3 normal =
       round ? round_contacts(A, t, margin, found) : polytope_contacts(A, t, margin, found);
-  if (found.n == 0) return {};
+  normal = remove_internal_edges(t, normal, margin, found);
+  if (found.n == 0 || !into_back(t, normal)) return {};
   Manifold m;
   m.normal = normal;
   reduce_into(std::span<const Candidate>(found.c.data(), found.n), normal, Vec3{}, m);
-  remove_internal_edges(t, margin, m);
-  if (m.count == 0 || !into_back(t, m.normal)) return {};
   return narrow::to_world(m, pa);
 }
 
