@@ -299,15 +299,38 @@ TEST_F(Shared, NoGhostNormalsOnAFlatFloor) {
         EXPECT_TRUE(near(m.normal, -Vec3::unit_y(), kExact)) << "case " << i;
         for (std::size_t k = 0; k < m.count; ++k)
           EXPECT_GE(m.points[k].separation, d - 1e-5_fx)
-              << "case " << i << " tri " << (t == &left) << " f " << std::hex
-              << m.points[k].feature << std::dec << " p " << to_string(m.points[k].point.x) << " "
-              << to_string(m.points[k].point.y - surface.position.y) << " "
-              << to_string(m.points[k].point.z - surface.position.z);
+              << "case " << i << ", feature " << std::hex << m.points[k].feature;
       }
     }
   }
   EXPECT_GT(contacts, 400);
   EXPECT_GT(tilted_on_boundary, 0);
+}
+
+TEST_F(Shared, RidgeContactsPointIntoTheBack) {
+  // Random shapes over the 30-degree ridge, up to 0.05 into either face: every manifold is well
+  // formed, its normal points into the back side of its triangle (dot with -face normal > 0),
+  // and a second call gives the same bits.
+  make(true, EdgeKind::convex);
+  const ConvexView box = ConvexView::box({0.5_fx, 0.25_fx, 0.5_fx});
+  const ConvexView rock = ConvexView::of_hull(shapes().rock);
+  const ConvexView ball = ConvexView::sphere(0.4_fx);
+  Lcg next{0x5EED5u};
+  int contacts = 0;
+  for (int i = 0; i < 300; ++i) {
+    const ConvexView& v = i % 3 == 0 ? box : (i % 3 == 1 ? rock : ball);
+    const Quat turn = normalize(Quat{next(), next(), next(), next()});
+    const Pose pose = place(v3(next() * 0.8_fx, 0.45_fx + next() * 0.1_fx, next() * 2_fx), turn);
+    for (const TriangleData* t : {&left, &right}) {
+      const Manifold m = collide_triangle(v, pose, *t, surface, kMargin);
+      expect_well_formed(m, kMargin);
+      EXPECT_TRUE(identical(collide_triangle(v, pose, *t, surface, kMargin), m));
+      if (m.count == 0) continue;
+      ++contacts;
+      EXPECT_GT(dot(m.normal, -t->normal), Fixed::zero()) << "case " << i;
+    }
+  }
+  EXPECT_GT(contacts, 100);
 }
 
 }  // namespace

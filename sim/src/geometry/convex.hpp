@@ -174,11 +174,11 @@ struct SatEdge {
 ///   axes that do not are only used to prove separation; a round core beside the triangle whose
 ///   closest-point normal does not is dropped). A box half through the triangle's interior gets
 ///   the face normal.
-/// - Internal edges: a manifold whose normal is not the face normal keeps it only when a point's
-///   triangle feature is a real feature (an edge that is boundary or convex, or a vertex with
-///   such an edge beside it); otherwise (the face, flat or concave edges, their vertices) it
-///   takes -face normal, each separation multiplied by the cosine between the two normals (the
-///   point pair projected on the new normal), points beyond the margin dropped.
+/// - Internal edges: a normal other than the face normal stays only when a contact point (before
+///   reduction) has a real triangle feature (an edge that is boundary or convex, or a vertex with
+///   such an edge beside it); otherwise (the face, flat or concave edges, their vertices) the
+///   manifold takes -face normal, each point's pair of surface points projected on it (the
+///   midpoint kept), points beyond the margin dropped.
 /// - Features: a's as collide_convex names them; the triangle's face feature(face, 0), edge k
 ///   (vertex k -> k + 1) feature(edge, k), vertex k feature(vertex, k).
 /// - Algorithm: round cores by closest points of the core and the triangle; polytopes and

@@ -17,10 +17,11 @@
 // Then the reference face (the triangle's or a's) clips the other (convex_manifold.cpp), or the
 // closest points of two edges, reduced to four points.
 //
-// Internal edges (Jolt's "active edges", Bullet's btAdjustInternalEdgeContacts): a manifold whose
-// normal is not the face normal keeps it only when one of its points touches a real feature of
-// the triangle (a convex or boundary edge, or a vertex beside one); otherwise it takes the face
-// normal, each point's pair projected on it (separation times the cosine between the normals).
+// Internal edges (Jolt's "active edges", Bullet's btAdjustInternalEdgeContacts): a normal that is
+// not the face normal stays only when a candidate touches a real feature of the triangle (a convex
+// or boundary edge, or a vertex beside one); otherwise the face normal, each candidate's pair of
+// surface points projected on it before the reduction to four. The pair, not the separation, is
+// projected: an edge pair's separation is its axis' gap, shorter than its clamped pair.
 #include <array>
 #include <cstddef>
 #include <cstdint>
