@@ -27,6 +27,7 @@
 
 #include "../collide.hpp"
 #include "hull.hpp"
+#include "triangle.hpp"
 
 namespace detsim::sim_detail {
 
@@ -163,12 +164,28 @@ struct SatEdge {
 [[nodiscard]] Manifold convex_plane(const ConvexView& a, const Pose& pa, const Pose& pb,
                                     Fixed margin) noexcept;
 
-struct TriangleData;
-
-/// The manifold of `a` against one triangle of a static surface (a mesh's or a heightfield's):
-/// `tri` in the surface's frame, posed by `surface`; the normal from `a` into the triangle's
-/// solid (back) side. One-sided, with internal edges (flat or concave neighbours) taking the face
-/// normal (geometry/convex_triangle.cpp).
+/// Convex `a` at `pa` against one triangle `tri` of a static surface (mesh or heightfield) posed
+/// by `surface` (`tri` in the surface's frame): collide.hpp's conventions with the triangle as b,
+/// so a body resting on a floor triangle gets normal ~ -(world face normal). At most four points,
+/// every one within `margin` (>= 0).
+/// - One-sided: the triangle bounds solid on its back side. No contact when a's centre (a hull's
+///   bounding-box centre) lies behind the triangle's plane by more than the margin, and every
+///   contact normal n_c points into the back side: dot(n_c, -face normal) >= 2^-16 (separating
+///   axes that do not are only used to prove separation; a round core beside the triangle whose
+///   closest-point normal does not is dropped). A box half through the triangle's interior gets
+///   the face normal.
+/// - Internal edges: a normal other than the face normal stays only when a contact point (before
+///   reduction) has a real triangle feature (an edge that is boundary or convex, or a vertex with
+///   such an edge beside it); otherwise (the face, flat or concave edges, their vertices) the
+///   manifold takes -face normal, each point's pair of surface points projected on it (the
+///   midpoint kept), points beyond the margin dropped.
+/// - Features: a's as collide_convex names them; the triangle's face feature(face, 0), edge k
+///   (vertex k -> k + 1) feature(edge, k), vertex k feature(vertex, k).
+/// - Algorithm: round cores by closest points of the core and the triangle; polytopes and
+///   cylinders by SAT over the face normal, a's face normals and Gauss-map-pruned edge pairs
+///   (true supports), then the triangle (or a's face) as the reference face, clipped and
+///   reduced as collide_convex does. Solved in a's frame, so poses within +-2^30 m are exact to
+///   the geometry's ulps; no iteration.
 [[nodiscard]] Manifold collide_triangle(const ConvexView& a, const Pose& pa,
                                         const TriangleData& tri, const Pose& surface,
                                         Fixed margin) noexcept;

@@ -3,6 +3,7 @@
 // two supporting faces. Internal to the convex_*.cpp files.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 
@@ -61,6 +62,20 @@ struct Candidate {
 /// Creation for Physics Simulations", GDC 2015). Ties go to the lower feature ID, so the result
 /// depends on the features, not on the candidates' order. Writes into m (world: + origin).
 void reduce_into(std::span<const Candidate> c, Vec3 normal, Vec3 origin, Manifold& m) noexcept;
+
+/// A point of an incident face kept by a reference polygon's side planes, with the features whose
+/// intersection it is (collide_convex's clipping, for callers with a face of their own: a
+/// triangle of a static surface).
+struct ClippedPoint {
+  Vec3 point;
+  std::uint16_t on_ref = 0;
+  std::uint16_t on_inc = 0;
+};
+/// Clips `inc` (a polygon, a segment or a point) against the side planes of polygon `ref` (3 or
+/// more points, either winding, `ref.normal` set); writes at most out.size() points, returns how
+/// many.
+[[nodiscard]] std::size_t clip_to_face(const Face& ref, const Face& inc,
+                                       std::span<ClippedPoint> out) noexcept;
 
 /// Which face the separating axis test chose as the reference, if any.
 enum class Reference : std::uint8_t { any, a, b };

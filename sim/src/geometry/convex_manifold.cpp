@@ -451,6 +451,14 @@ Manifold manifold_from_faces(const Body& a, const Body& b, Vec3 n, Reference ref
   return m;
 }
 
+std::size_t clip_to_face(const Face& ref, const Face& inc, std::span<ClippedPoint> out) noexcept {
+  const Polygon poly = clip_incident(ref, inc);
+  std::size_t n = 0;
+  for (unsigned i = 0; i < poly.n && n < out.size(); ++i)
+    out[n++] = {poly.v[i].p, poly.v[i].on_ref, poly.v[i].on_inc};
+  return n;
+}
+
 Manifold single_point(const Body& a, const Body& b, Vec3 on_a, Vec3 on_b, Vec3 n,
                       std::uint32_t feature, Fixed margin) noexcept {
   const Candidate c = candidate(a, b, on_a, on_b, n, feature);
