@@ -61,8 +61,7 @@ Fixed part_radius(const PlacedPart& p) noexcept {
 }
 
 ConvexView view_of_part(const PlacedPart& p) noexcept {
-  return p.geometry != nullptr ? ConvexView::of_hull(p.geometry->hull())
-                               : ConvexView::of(*p.shape);
+  return p.geometry != nullptr ? ConvexView::of_hull(p.geometry->hull()) : ConvexView::of(*p.shape);
 }
 
 void mirror(Manifold& m) noexcept {
@@ -157,8 +156,8 @@ void collide_all(const PosedShape& a, const PosedShape& b, Fixed margin,
     const Fixed ra = part_radius(pa);
     for (const PlacedPart& pb : parts_b) {
       if (distance(pa.pose.position, pb.pose.position) > ra + part_radius(pb) + margin) continue;
-      const Manifold m = collide({*pa.shape, pa.geometry, pa.pose},
-                                 {*pb.shape, pb.geometry, pb.pose}, margin);
+      const Manifold m =
+          collide({*pa.shape, pa.geometry, pa.pose}, {*pb.shape, pb.geometry, pb.pose}, margin);
       if (m.count > 0) out.push_back({pa.index, pb.index, m});
     }
   }

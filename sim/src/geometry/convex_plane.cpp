@@ -110,7 +110,8 @@ Manifold convex_plane(const ConvexView& a, const Pose& pa, const Pose& pb, Fixed
   vertex_points(a, f, margin, found);
   Manifold m;
   m.normal = -f.up;
-  reduce_into(std::span<const convex::Candidate>(found.c.data(), found.n), m.normal, pa.position, m);
+  reduce_into(std::span<const convex::Candidate>(found.c.data(), found.n), m.normal, pa.position,
+              m);
   return m;
 }
 

@@ -448,7 +448,7 @@ Manifold collide_triangle(const ConvexView& a, const Pose& pa, const TriangleDat
   if (found.n == 0 || !into_back(t, normal)) return {};
   Manifold m;
   m.normal = normal;
-  reduce_into(std::span<const Candidate>(found.c.data(), found.n), normal, Vec3{}, m);
+  reduce_into(std::span<const convex::Candidate>(found.c.data(), found.n), normal, Vec3{}, m);
   return narrow::to_world(m, pa);
 }
 

@@ -66,6 +66,9 @@ std::shared_ptr<const Geometry> make_heightfield_geometry(Heightfield hf) {
   write(hf, w);
   g->hash = hash64(w.bytes());
   g->data = std::move(hf);
+  return g;
+}
+
 void write_compound_content(const Compound& compound, ByteWriter& w) {
   w.var(compound.parts.size());
   for (const CompoundPart& part : compound.parts) {
@@ -150,6 +153,8 @@ Expected<ShapeOutline> World::body_outline(BodyId id) const {
   sim_detail::shape_kind(b->shape.type)
       .outline(b->shape, s_->geometry(b->shape), b->position, b->orientation, out);
   return out;
+}
+
 Expected<GeometryId> World::create_compound(std::span<const CompoundChild> children) {
   auto compound = sim_detail::build_compound(s_->geometries, children);
   if (!compound) return Status::error("invalid compound: " + compound.message());

@@ -31,7 +31,7 @@ struct ShapeOutline {
   Vec3 normal{};
   std::vector<std::array<Vec3, 3>> triangles;  ///< a surface's triangles; empty for a solid
   std::uint32_t surface_triangles = 0;         ///< all of a surface's triangles, drawn or not
-  std::vector<ShapeOutline> parts;  ///< a compound's parts (empty for every other shape)
+  std::vector<ShapeOutline> parts;             ///< a compound's parts (empty for every other shape)
 };
 
 /// The most triangles an outline holds: a viewer's budget, not a limit of the geometry.
