@@ -178,18 +178,21 @@ WorldDef world_def(Input& in) {
 }
 
 Shape shape(Input& in) {
-  const auto type = static_cast<ShapeType>(in.byte() % 6);  // 0 and 5 name no type
+  const auto type = static_cast<ShapeType>(in.byte() % 8);  // 0 and 7 name no type
   Shape s;
   s.type = type;
   const std::uint8_t fields = in.byte();
   // Mostly the fields the type uses; sometimes every field, which the checks must refuse.
   const bool all = (fields & 0x80U) != 0;
-  if (all || type == ShapeType::sphere || type == ShapeType::capsule) s.radius = in.fixed();
-  if (all || type == ShapeType::capsule) s.half_height = in.fixed();
+  const bool round = type == ShapeType::capsule || type == ShapeType::cylinder;
+  if (all || type == ShapeType::sphere || round) s.radius = in.fixed();
+  if (all || round) s.half_height = in.fixed();
   if (all || type == ShapeType::box) {
     const Fixed h = in.fixed();
     s.half_extents = (fields & 1U) != 0 ? Vec3{h, h, h} : Vec3{h, in.fixed(), in.fixed()};
   }
+  // A geometry ID: mostly the convex hull's, sometimes on a primitive (refused) or unknown.
+  if (all || type == ShapeType::convex) s.geometry = GeometryId{in.byte() % 4U};
   return s;
 }
 

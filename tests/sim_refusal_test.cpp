@@ -260,7 +260,7 @@ TEST(Refusal, ForcesWithinTheAccumulationAndAccelerationLimits) {
         [&](World& x) {
           return x.apply_force_at_point(id, {0_fx, 1_fx, 0_fx}, {Fixed::min(), 0_fx, 0_fx});
         },
-        {"lever arm (point - position) x"});
+        {"lever arm (point - centre of mass) x"});
   }
 }
 

@@ -342,11 +342,11 @@ TEST_F(CanonicalRestore, FlaggedValuesAreNotZero) {
 }
 
 TEST_F(CanonicalRestore, FeaturesBeyondTheirRange) {
-  // A feature is index * 4 + kind with an 8-bit index: at most 1023.
+  // A feature is index * 4 + kind with a 14-bit index: at most 65535.
   const DecodedContact& contact = decoded_.contacts[0];
   ASSERT_GT(contact.point_count(), 0U);
-  for (const std::uint64_t feature : {std::uint64_t{1024}, std::uint64_t{1027},
-                                      std::uint64_t{0xFFFF}, std::uint64_t{0xFFFFFFFF}}) {
+  for (const std::uint64_t feature : {std::uint64_t{65536}, std::uint64_t{65539},
+                                      std::uint64_t{0x7FFFF}, std::uint64_t{0xFFFFFFFF}}) {
     Decoded d = decoded_;
     d.contacts[0].points[0].feature_a = feature;
     expect_refused_at(encode(d), {contact.at, contact.points[0].at},

@@ -11,10 +11,12 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "sim/src/shapes.hpp"
 #include "support/state_helpers.hpp"
 
 namespace detsim {
@@ -243,8 +245,11 @@ TEST_F(RejectedRestore, BodyIdsMustBeAscendingUniqueAndKnown) {
 TEST_F(RejectedRestore, UnknownShapeOrBodyType) {
   const auto sphere_set = static_cast<std::size_t>(decoded_.bodies[1].set);
   ASSERT_EQ(decoded_.sets[sphere_set].shape.type, ShapeType::sphere);
-  for (const std::uint8_t type :
-       {std::uint8_t{0}, std::uint8_t{5}, std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
+  // 0, the first value past the table of kinds (7 became the triangle mesh; new types keep
+  // moving it), and two far ones.
+  const auto past_last = static_cast<std::uint8_t>(sim_detail::shape_kinds().back()->type) + 1;
+  for (const std::uint8_t type : {std::uint8_t{0}, static_cast<std::uint8_t>(past_last),
+                                  std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
     Decoded d = decoded_;
     d.sets[sphere_set].shape.type = static_cast<ShapeType>(type);
     d.sets[sphere_set].shape.radius = Fixed{};
@@ -345,15 +350,28 @@ TEST_F(RejectedRestore, ContactsMustNameExistingBodiesInOrder) {
 }
 
 TEST_F(RejectedRestore, ContactFlagsMustBeConsistent) {
-  // The point byte: the count in bits 0-2 (0-4), reported in bit 3 (only with points), nothing
-  // else. (Touching is "has points", so version 1's "points but not touching" cannot be written.)
+  // The point byte: the count in bits 0-2 (0-4), reported in bit 3 (only with points), sub-shapes
+  // follow in bit 4, nothing else. (Touching is "has points", so version 1's "points but not
+  // touching" cannot be written.)
   const auto with_points = static_cast<std::size_t>(
       std::find_if(decoded_.contacts.begin(), decoded_.contacts.end(),
                    [](const DecodedContact& c) { return c.point_count() > 0; }) -
       decoded_.contacts.begin());
   ASSERT_LT(with_points, decoded_.contacts.size());
   const DecodedContact& c = decoded_.contacts[with_points];
-  for (const int bits : {0x10, 0x20, 0x40, 0x80, 0xF0}) {  // bits that mean nothing
+  // Sub-shapes must be parts the shapes have: these pairs are of whole shapes (sub-shape 0 only),
+  // and bit 4 with both 0 is not canonical.
+  for (const auto& [sub_a, sub_b, part] :
+       {std::tuple{1, 0, "sub-shape 1 of body"}, std::tuple{0, 3, "sub-shape 3 of body"},
+        std::tuple{0, 0, "not both 0"}}) {
+    Decoded d = decoded_;
+    d.contacts[with_points].points_byte = static_cast<std::uint8_t>(c.points_byte | kSubShapes);
+    d.contacts[with_points].sub_a = static_cast<std::uint64_t>(sub_a);
+    d.contacts[with_points].sub_b = static_cast<std::uint64_t>(sub_b);
+    const std::string message = expect_rejected(target_, encode(d));
+    EXPECT_TRUE(contains(message, part)) << message;
+  }
+  for (const int bits : {0x20, 0x40, 0x80, 0xE0}) {  // bits that mean nothing
     Decoded d = decoded_;
     d.contacts[with_points].points_byte = static_cast<std::uint8_t>(c.points_byte | bits);
     const std::string message = expect_rejected(target_, encode(d));

@@ -76,20 +76,21 @@ void expect_refused(const Bytes& bad, std::initializer_list<const char*> parts) 
   EXPECT_EQ(w.save(), before);
 }
 
-TEST(StateSections, AWorldsStateIsItsFiveSectionsAndTheirHashes) {
+TEST(StateSections, AWorldsStateIsItsSixSectionsAndTheirHashes) {
   const World w = sample_world();
   const Bytes state = w.save();
   auto found = read_state_sections(state);
   ASSERT_TRUE(found.ok()) << found.message();
   const StateHashes h = w.hashes();
-  ASSERT_EQ(found->size(), 5U);
-  ASSERT_EQ(h.sections.size(), 5U);
-  const char* names[] = {"globals", "rng", "bodies", "contacts", "joints"};
-  std::size_t next = 9;  // magic, version, the count 5 in one byte
-  for (std::size_t i = 0; i < 5; ++i) {
+  ASSERT_EQ(found->size(), 6U);
+  ASSERT_EQ(h.sections.size(), 6U);
+  const char* names[] = {"globals", "rng", "geometry", "bodies", "contacts", "joints"};
+  const std::uint32_t versions[] = {1, 1, 1, 2, 2, 1};
+  std::size_t next = 9;  // magic, version, the count 6 in one byte
+  for (std::size_t i = 0; i < 6; ++i) {
     const StateSection& s = (*found)[i];
     EXPECT_EQ(s.name, names[i]);
-    EXPECT_EQ(s.version, 1U);
+    EXPECT_EQ(s.version, versions[i]);
     EXPECT_EQ(s.offset, next);  // the sections follow one another
     EXPECT_EQ(s.payload_offset, s.offset + 1 + s.name.size() + 1 + 4);
     EXPECT_EQ(s.record.size(), s.payload_offset - s.offset + s.payload.size());
@@ -120,8 +121,8 @@ TEST(StateSections, TheListOfSectionsMustBeAWorlds) {
   expect_refused(container(missing), {"section \"joints\" is missing"});
 
   std::vector<Section> newer = good;
-  newer[2].version = 2;
-  expect_refused(container(newer), {"section \"bodies\" version 2, this build reads 1"});
+  newer[3].version = 3;
+  expect_refused(container(newer), {"section \"bodies\" version 3, this build reads 2"});
 
   // A payload must be read to exactly its end.
   std::vector<Section> longer = good;
@@ -160,7 +161,7 @@ TEST(StateSections, TheContainerIsChecked) {
   Bytes huge(state.begin(), state.begin() + 8);
   put_var(huge, 0xFFFFFFFFFFULL);
   expect_refused(huge, {"section count", "exceeds"});
-  expect_refused(container(good, 3), {"state encoding version 3, this build reads 4"});
+  expect_refused(container(good, 3), {"state encoding version 3, this build reads 5"});
 }
 
 }  // namespace

@@ -37,21 +37,22 @@ TEST(StateFormat, DefaultWorldStartsWithMagicAndVersion) {
   EXPECT_EQ(bytes[1], 'S');
   EXPECT_EQ(bytes[2], 'I');
   EXPECT_EQ(bytes[3], 'M');
-  EXPECT_EQ((Bytes(bytes.begin() + 4, bytes.begin() + 8)), (Bytes{4, 0, 0, 0}));
-  EXPECT_EQ(state_encoding_version, 4U);
-  // Then the section count (var 5) and the first section's record: its name's length (7),
+  EXPECT_EQ((Bytes(bytes.begin() + 4, bytes.begin() + 8)), (Bytes{5, 0, 0, 0}));
+  EXPECT_EQ(state_encoding_version, 5U);
+  // Then the section count (var 6) and the first section's record: its name's length (7),
   // "globals", its version (var 1) and its payload's length: frame 8 + next ID 4 + definition 137
   // = 149 = 0x95 (u32); then frame 0 (u64) and the next body ID, 1 (u32).
   EXPECT_EQ((Bytes(bytes.begin() + 8, bytes.begin() + 22)),
-            (Bytes{5, 7, 'g', 'l', 'o', 'b', 'a', 'l', 's', 1, 0x95, 0, 0, 0}));
+            (Bytes{6, 7, 'g', 'l', 'o', 'b', 'a', 'l', 's', 1, 0x95, 0, 0, 0}));
   EXPECT_EQ((Bytes(bytes.begin() + 22, bytes.begin() + 34)),
             (Bytes{0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0}));
   // magic 4 + version 4 + count 1, each section's name length, name, version and payload length
-  // (1 + 7 + 1 + 4, 1 + 3 + 1 + 4, 1 + 6 + 1 + 4, 1 + 8 + 1 + 4, 1 + 6 + 1 + 4), and the
-  // payloads: globals 149, RNG 32, bodies two empty counts 8, contacts one empty count 4, joints
-  // the next joint ID 1 and an empty count, 8.
-  EXPECT_EQ(bytes.size(), 9U + 13 + 9 + 12 + 14 + 12 + (8 + 4 + kDefinitionBytes) + 32 + 8 + 4 + 8);
-  EXPECT_EQ(bytes.size(), 270U);
+  // (1 + 7 + 1 + 4, 1 + 3 + 1 + 4, 1 + 8 + 1 + 4, 1 + 6 + 1 + 4, 1 + 8 + 1 + 4, 1 + 6 + 1 + 4),
+  // and the payloads: globals 149, RNG 32, geometry an empty var count 1, bodies two empty counts
+  // 8, contacts one empty count 4, joints the next joint ID 1 and an empty count, 8.
+  EXPECT_EQ(bytes.size(),
+            9U + 13 + 9 + 14 + 12 + 14 + 12 + (8 + 4 + kDefinitionBytes) + 32 + 1 + 8 + 4 + 8);
+  EXPECT_EQ(bytes.size(), 285U);
   EXPECT_EQ((Bytes(bytes.end() - 8, bytes.end())), (Bytes{1, 0, 0, 0, 0, 0, 0, 0}));
 
   const Decoded d = decode(bytes);
@@ -60,7 +61,8 @@ TEST(StateFormat, DefaultWorldStartsWithMagicAndVersion) {
   EXPECT_EQ(d.rng, Rng(0).state());
   EXPECT_EQ(d.globals_at, 22U);
   EXPECT_EQ(d.rng_at, d.globals_at + 12 + kDefinitionBytes + 9);  // after rng's section header
-  EXPECT_EQ(d.property_count_at, d.rng_at + 32 + 12);
+  EXPECT_EQ(d.geometry_count_at, d.rng_at + 32 + 14);
+  EXPECT_EQ(d.property_count_at, d.geometry_count_at + 1 + 12);
   EXPECT_EQ(d.contact_count_at, d.body_count_at + 4 + 14);
   EXPECT_EQ(d.next_joint_id_at, d.contact_count_at + 4 + 12);
   EXPECT_EQ(d.next_joint_id, 1U);
@@ -178,9 +180,10 @@ TEST(StateFormat, HashesAreXxh3OfTheCanonicalSections) {
         << kSectionNames[i];
   }
   EXPECT_EQ(d.section_at[0], 9U);
-  EXPECT_EQ(d.bodies.back().end, d.section_at[3]);
-  EXPECT_EQ(h.section("bodies"),
-            xxh3(all.subspan(d.section_at[2], d.section_at[3] - d.section_at[2])));
+  EXPECT_EQ(d.bodies.back().end, d.section_at[kContacts]);
+  EXPECT_EQ(
+      h.section("bodies"),
+      xxh3(all.subspan(d.section_at[kBodies], d.section_at[kContacts] - d.section_at[kBodies])));
   EXPECT_EQ(h.section("no such section"), 0U);
   // body_hash: the body's set, then its record as if it were the only body.
   for (std::size_t i = 0; i < d.bodies.size(); ++i) {

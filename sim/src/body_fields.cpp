@@ -45,7 +45,8 @@ constexpr FieldGroup property = FieldGroup::property;
 constexpr FieldGroup motion = FieldGroup::motion;
 
 // BodyState's fields after id, type and shape, in declaration order. The encoding follows from
-// the order and the groups (docs/STATE.md, "bodies"): never reorder, only append.
+// the order and the groups (docs/STATE.md, "bodies"): a change of it is a new version of the
+// "bodies" section (center_of_mass and inertia_axes came in version 2).
 constexpr std::array kFields{
     field("position", motion, &BodyState::position),
     field("orientation", motion, &BodyState::orientation),
@@ -53,6 +54,8 @@ constexpr std::array kFields{
     field("angular_velocity", motion, &BodyState::angular_velocity),
     field("mass", property, &BodyState::mass),
     field("inertia", property, &BodyState::inertia),
+    field("center_of_mass", property, &BodyState::center_of_mass),
+    field("inertia_axes", property, &BodyState::inertia_axes),
     field("friction", property, &BodyState::friction),
     field("restitution", property, &BodyState::restitution),
     field("linear_damping", property, &BodyState::linear_damping),

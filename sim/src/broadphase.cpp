@@ -110,46 +110,68 @@ std::vector<SweepItem> sorted_sweep_items(WorldState& s, std::vector<std::uint32
 
 // The new contact list: the contacts whose pair persists (with their cached impulses) and new ones
 // for the new pairs; the pairs that ended report their end.
+// The body pairs are the groups of the contact list (a body pair holds one contact per pair of
+// sub-shapes in touch, world_state.hpp): a pair that stays keeps all of its contacts, a new pair
+// gets one contact of sub-shapes (0, 0), and a pair whose boxes parted loses them all (one end
+// event for the group).
 void merge_contacts(WorldState& s, const std::vector<std::uint64_t>& pairs) {
   const auto index_a = [](std::uint64_t pair) { return static_cast<std::uint32_t>(pair >> 32); };
   const auto index_b = [](std::uint64_t pair) {
     return static_cast<std::uint32_t>(pair & 0xFFFFFFFFU);
   };
+  const auto same_pair = [](const Contact& x, const Contact& y) {
+    return x.a == y.a && x.b == y.b;
+  };
   // At rest the pairs are the last step's: only the indices need refreshing.
-  bool same = pairs.size() == s.contacts.size();
-  for (std::size_t k = 0; same && k < pairs.size(); ++k) {
-    same = s.contacts[k].a == s.bodies[index_a(pairs[k])].id.value &&
-           s.contacts[k].b == s.bodies[index_b(pairs[k])].id.value;
+  bool same = true;
+  std::size_t k = 0;
+  for (std::size_t c = 0; same && c < s.contacts.size(); ++c) {
+    if (c > 0 && same_pair(s.contacts[c], s.contacts[c - 1])) continue;
+    same = k < pairs.size() && s.contacts[c].a == s.bodies[index_a(pairs[k])].id.value &&
+           s.contacts[c].b == s.bodies[index_b(pairs[k])].id.value;
+    ++k;
   }
-  if (same) {
-    for (std::size_t k = 0; k < pairs.size(); ++k) {
-      s.contacts[k].index_a = index_a(pairs[k]);
-      s.contacts[k].index_b = index_b(pairs[k]);
+  if (same && k == pairs.size()) {
+    k = 0;
+    for (std::size_t c = 0; c < s.contacts.size(); ++c) {
+      if (c > 0 && !same_pair(s.contacts[c], s.contacts[c - 1])) ++k;
+      s.contacts[c].index_a = index_a(pairs[k]);
+      s.contacts[c].index_b = index_b(pairs[k]);
     }
     return;
   }
   std::vector<Contact> merged;
   merged.reserve(pairs.size());
   std::size_t old = 0;
+  const auto end_group = [&] {  // the group at `old` parted: its end event once, then skip it
+    report_end(s, s.contacts[old]);
+    const Contact& first = s.contacts[old];
+    while (old < s.contacts.size() && same_pair(s.contacts[old], first))
+      ++old;
+  };
   for (const std::uint64_t pair : pairs) {
     const std::uint32_t a = s.bodies[index_a(pair)].id.value;
     const std::uint32_t b = s.bodies[index_b(pair)].id.value;
     while (old < s.contacts.size() &&
            (s.contacts[old].a < a || (s.contacts[old].a == a && s.contacts[old].b < b)))
-      report_end(s, s.contacts[old++]);  // a pair whose boxes parted
+      end_group();  // a pair whose boxes parted
     if (old < s.contacts.size() && s.contacts[old].a == a && s.contacts[old].b == b) {
-      merged.push_back(s.contacts[old++]);
+      while (old < s.contacts.size() && s.contacts[old].a == a && s.contacts[old].b == b) {
+        merged.push_back(s.contacts[old++]);
+        merged.back().index_a = index_a(pair);
+        merged.back().index_b = index_b(pair);
+      }
     } else {
       Contact c;
       c.a = a;
       c.b = b;
+      c.index_a = index_a(pair);
+      c.index_b = index_b(pair);
       merged.push_back(c);
     }
-    merged.back().index_a = index_a(pair);
-    merged.back().index_b = index_b(pair);
   }
-  for (; old < s.contacts.size(); ++old)
-    report_end(s, s.contacts[old]);
+  while (old < s.contacts.size())
+    end_group();
   s.contacts = std::move(merged);
 }
 
@@ -184,7 +206,7 @@ void keep_within_budget(const WorldState& s, std::vector<std::uint64_t>& pairs) 
         used.assign(s.bodies.size(), 0);
         radius.resize(s.bodies.size());
         for (std::size_t b = 0; b < s.bodies.size(); ++b)
-          radius[b] = bounding_radius(s.bodies[b].shape);
+          radius[b] = bounding_radius(s.bodies[b].shape, s.geometry(s.bodies[b].shape));
       }
       // Each counts the other if the other is at least half its size.
       const bool i_counts = (radius[j] << 1) >= radius[i];

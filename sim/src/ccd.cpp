@@ -75,12 +75,15 @@ struct Sweep {
 
 // The signed distance between two posed shapes, as the narrowphase measures it (a lower bound of
 // the true distance when apart), or `beyond` when they are farther apart than that.
-Fixed distance(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, Fixed beyond) {
-  const Manifold m = collide(a, pa, b, pb, beyond);
-  if (m.count == 0) return beyond;
-  Fixed d = m.points[0].separation;
-  for (std::size_t k = 1; k < m.count; ++k)
-    d = min(d, m.points[k].separation);
+// Over every pair of sub-shapes (a compound's parts, a surface's triangles).
+Fixed distance(const WorldState& s, const Shape& a, const Pose& pa, const Shape& b, const Pose& pb,
+               Fixed beyond, std::vector<SubManifold>& scratch) {
+  collide_all({a, s.geometry(a), pa}, {b, s.geometry(b), pb}, beyond, scratch);
+  Fixed d = beyond;
+  for (const SubManifold& sub : scratch) {
+    for (std::size_t k = 0; k < sub.manifold.count; ++k)
+      d = min(d, sub.manifold.points[k].separation);
+  }
   return d;
 }
 
@@ -119,15 +122,17 @@ std::vector<Mover> movers(const WorldState& s) {
     const Derived& d = s.derived[i];
     const Vec3 travel = body.position - d.start_position;
     const Fixed distance_moved = length(travel);
-    const bool fast = distance_moved > shape_kind(body.shape.type).smallest_dimension(body.shape) /
-                                           Fixed::from_int(2);
+    const Geometry* g = s.geometry(body.shape);
+    const bool fast =
+        distance_moved >
+        shape_kind(body.shape.type).smallest_dimension(body.shape, g) / Fixed::from_int(2);
     if (!body.ccd && !fast) continue;
     const Sweep sweep{d.start_position, body.position, d.start_orientation, body.orientation,
                       body.orientation != d.start_orientation};
     // The travel plus the rim speed. Normalised lerp turns at a varying rate, at most twice its
     // mean for any angle up to pi, so the rim term is doubled.
-    const Fixed rim = sweep.turns ? angle_bound(sweep.q0, sweep.q1) * bounding_radius(body.shape) *
-                                        Fixed::from_int(2)
+    const Fixed rim = sweep.turns ? angle_bound(sweep.q0, sweep.q1) *
+                                        bounding_radius(body.shape, g) * Fixed::from_int(2)
                                   : Fixed::zero();
     if (distance_moved + rim == Fixed::zero()) continue;
     out.push_back({i, sweep, travel, rim});
@@ -194,7 +199,8 @@ void continuous(WorldState& s) {
   boxes.reserve(n);
   for (std::size_t k = 0, m = 0; k < n; ++k) {
     const ShapeKind& kind = shape_kind(s.bodies[k].shape.type);
-    reach[k] = kind.bounded ? kind.bounding_radius(s.bodies[k].shape) : -Fixed::one();
+    reach[k] = kind.bounded ? kind.bounding_radius(s.bodies[k].shape, s.geometry(s.bodies[k].shape))
+                            : -Fixed::one();
     if (s.bodies[k].sensor) continue;
     if (!kind.bounded) {
       planes.push_back(static_cast<std::uint32_t>(k));
@@ -229,7 +235,8 @@ void continuous(WorldState& s) {
     for (std::size_t m = 0; m < movers_now.size(); ++m)
       mover_of[movers_now[m].index] = static_cast<std::uint32_t>(m);
   }
-  std::vector<std::uint32_t> near;  // the current sweep's candidates, ascending
+  std::vector<std::uint32_t> near;   // the current sweep's candidates, ascending
+  std::vector<SubManifold> scratch;  // the narrowphase's output, reused
   std::size_t next_pair = 0;
   for (const Mover& mover : movers_now) {
     const std::size_t i = mover.index;
@@ -279,14 +286,14 @@ void continuous(WorldState& s) {
       if (pair_bound == Fixed::zero()) continue;
       const Fixed pair_beyond = pair_bound + target + r;
       // Already touching at the start: the contact solver has it; a sweep would only stick.
-      if (distance(body.shape, sweep.at(Fixed::zero()), other.shape, other_sweep.at(Fixed::zero()),
-                   pair_beyond) <= target)
+      if (distance(s, body.shape, sweep.at(Fixed::zero()), other.shape,
+                   other_sweep.at(Fixed::zero()), pair_beyond, scratch) <= target)
         continue;
       Fixed t = Fixed::zero();
       bool stop = true;  // a touch, or out of iterations: t is then the last safe time
       for (int k = 0; k < max_iterations; ++k) {
-        const Fixed gap =
-            distance(body.shape, sweep.at(t), other.shape, other_sweep.at(t), pair_beyond);
+        const Fixed gap = distance(s, body.shape, sweep.at(t), other.shape, other_sweep.at(t),
+                                   pair_beyond, scratch);
         if (gap <= target) break;
         // A safe advance that aims for half the target gap, so the loop ends near the surface.
         t += (gap - target / Fixed::from_int(2)) / pair_bound;

@@ -15,6 +15,8 @@
 
 #include "collide.hpp"
 #include "collide_util.hpp"
+#include "geometry/convex.hpp"
+#include "geometry/geometry.hpp"
 
 namespace detsim::sim_detail {
 
@@ -500,28 +502,67 @@ namespace {
 
 using namespace narrow;
 
-using PairFunction = Manifold (*)(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb,
-                                  Fixed margin) noexcept;
+using PairFunction = Manifold (*)(const PosedShape& a, const PosedShape& b, Fixed margin) noexcept;
+
+/// A pair function of two primitives (their fields are the whole shape) as a PairFunction.
+using PrimitivePair = Manifold (*)(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb,
+                                   Fixed margin) noexcept;
+template <PrimitivePair F>
+Manifold primitive(const PosedShape& a, const PosedShape& b, Fixed margin) noexcept {
+  return F(a.shape, a.pose, b.shape, b.pose, margin);
+}
 
 /// One row per pair of shape types that can touch, with a.type <= b.type: a new shape type adds
 /// its rows here (and its pair functions). Pairs without a row have no manifold: two planes, which
-/// are static and unbounded.
+/// are static and unbounded. Shapes with sub-shapes (compounds, surfaces) are taken apart before
+/// this table (collide_parts.cpp).
 struct PairRow {
   ShapeType a;
   ShapeType b;
   PairFunction collide;
 };
 
+// The generic convex narrowphase (geometry/convex.hpp) for the pairs with a cylinder or a convex
+// hull: one view over every convex shape.
+ConvexView view_of(const PosedShape& s) noexcept {
+  return s.geometry != nullptr ? ConvexView::of_hull(s.geometry->hull()) : ConvexView::of(s.shape);
+}
+
+Manifold convex_pair(const PosedShape& a, const PosedShape& b, Fixed margin) noexcept {
+  return collide_convex(view_of(a), a.pose, view_of(b), b.pose, margin);
+}
+
+// The plane is a (its type is below the cylinder's and the hull's): convex_plane's manifold,
+// mirrored.
+Manifold plane_convex(const PosedShape& a, const PosedShape& b, Fixed margin) noexcept {
+  Manifold m = convex_plane(view_of(b), b.pose, a.pose, margin);
+  m.normal = -m.normal;
+  for (std::uint8_t i = 0; i < m.count; ++i)
+    m.points[i].feature = mirror_feature(m.points[i].feature);
+  return m;
+}
+
 constexpr PairRow kPairs[] = {
-    {ShapeType::sphere, ShapeType::sphere, sphere_sphere},
-    {ShapeType::sphere, ShapeType::box, sphere_box},
-    {ShapeType::sphere, ShapeType::capsule, sphere_capsule},
-    {ShapeType::sphere, ShapeType::plane, sphere_plane},
-    {ShapeType::box, ShapeType::box, box_box},
-    {ShapeType::box, ShapeType::capsule, box_capsule},
-    {ShapeType::box, ShapeType::plane, box_plane},
-    {ShapeType::capsule, ShapeType::capsule, capsule_capsule},
-    {ShapeType::capsule, ShapeType::plane, capsule_plane},
+    {ShapeType::sphere, ShapeType::sphere, primitive<sphere_sphere>},
+    {ShapeType::sphere, ShapeType::box, primitive<sphere_box>},
+    {ShapeType::sphere, ShapeType::capsule, primitive<sphere_capsule>},
+    {ShapeType::sphere, ShapeType::plane, primitive<sphere_plane>},
+    {ShapeType::box, ShapeType::box, primitive<box_box>},
+    {ShapeType::box, ShapeType::capsule, primitive<box_capsule>},
+    {ShapeType::box, ShapeType::plane, primitive<box_plane>},
+    {ShapeType::capsule, ShapeType::capsule, primitive<capsule_capsule>},
+    {ShapeType::capsule, ShapeType::plane, primitive<capsule_plane>},
+    {ShapeType::sphere, ShapeType::cylinder, convex_pair},
+    {ShapeType::box, ShapeType::cylinder, convex_pair},
+    {ShapeType::capsule, ShapeType::cylinder, convex_pair},
+    {ShapeType::plane, ShapeType::cylinder, plane_convex},
+    {ShapeType::cylinder, ShapeType::cylinder, convex_pair},
+    {ShapeType::sphere, ShapeType::convex, convex_pair},
+    {ShapeType::box, ShapeType::convex, convex_pair},
+    {ShapeType::capsule, ShapeType::convex, convex_pair},
+    {ShapeType::plane, ShapeType::convex, plane_convex},
+    {ShapeType::cylinder, ShapeType::convex, convex_pair},
+    {ShapeType::convex, ShapeType::convex, convex_pair},
 };
 
 /// kPairs as a table indexed by the two type values, which stay below kTypeLimit.
@@ -549,20 +590,19 @@ constexpr PairTable kPairTable;
 
 }  // namespace
 
-Manifold collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
-                 Fixed margin) noexcept {
-  const auto ta = static_cast<std::size_t>(a.type);
-  const auto tb = static_cast<std::size_t>(b.type);
+Manifold collide(const PosedShape& a, const PosedShape& b, Fixed margin) noexcept {
+  const auto ta = static_cast<std::size_t>(a.shape.type);
+  const auto tb = static_cast<std::size_t>(b.shape.type);
   if (ta >= kTypeLimit || tb >= kTypeLimit) return {};
   if (ta <= tb) {
     const PairFunction f = kPairTable.at[ta][tb];
-    return f != nullptr ? f(a, pose_a, b, pose_b, margin) : Manifold{};
+    return f != nullptr ? f(a, b, margin) : Manifold{};
   }
   // The pair function sees (b, a): mirror its manifold. Points and separations are symmetric; the
   // normal flips and each feature ID swaps its halves, so the low half still names a's feature.
   const PairFunction f = kPairTable.at[tb][ta];
   if (f == nullptr) return {};
-  Manifold m = f(b, pose_b, a, pose_a, margin);
+  Manifold m = f(b, a, margin);
   m.normal = -m.normal;
   for (std::uint8_t i = 0; i < m.count; ++i) {
     m.points[i].feature = mirror_feature(m.points[i].feature);

@@ -16,6 +16,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include <detsim/fixed/mat3.hpp>
 #include <detsim/fixed/vec3.hpp>
@@ -42,10 +43,46 @@ struct Manifold {
   std::array<ContactPoint, 4> points{};
 };
 
-/// The contact manifold of shape `a` at `pose_a` against shape `b` at `pose_b`, with every point
-/// whose separation is at most `margin` (>= 0). `count` is 0 when the shapes are farther apart than
-/// `margin`, and always 0 for a plane against a plane.
-[[nodiscard]] Manifold collide(const Shape& a, const Pose& pose_a, const Shape& b,
-                               const Pose& pose_b, Fixed margin) noexcept;
+struct Geometry;
+
+/// A shape placed for the narrowphase: the shape, the geometry it refers to (nullptr for a
+/// primitive; see geometry/geometry.hpp) and its pose.
+struct PosedShape {
+  const Shape& shape;
+  const Geometry* geometry;
+  const Pose& pose;
+};
+
+/// The contact manifold of shape `a` against shape `b`, with every point whose separation is at
+/// most `margin` (>= 0). `count` is 0 when the shapes are farther apart than `margin`, and always
+/// 0 for a plane against a plane.
+[[nodiscard]] Manifold collide(const PosedShape& a, const PosedShape& b, Fixed margin) noexcept;
+
+/// A manifold between a sub-shape of a and one of b: a compound's part or a surface's triangle,
+/// by index (0 for a whole shape).
+struct SubManifold {
+  std::uint32_t sub_a = 0;
+  std::uint32_t sub_b = 0;
+  Manifold manifold;
+};
+
+/// How many sub-shapes a shape has: a compound's parts, a surface's triangles, else 1.
+[[nodiscard]] std::uint32_t sub_shape_count(const Shape& shape, const Geometry* g) noexcept;
+
+/// Whether a shape has sub-shapes (a compound, a mesh, a heightfield): its pairs may make several
+/// manifolds, one per pair of sub-shapes in touch.
+[[nodiscard]] bool has_sub_shapes(const PosedShape& s) noexcept;
+
+/// Every manifold with points between a sub-shape of `a` and one of `b` (margin as collide()),
+/// ascending by (sub_a, sub_b), into `out` (cleared first). For two whole shapes it is collide()'s
+/// manifold, as sub-shapes (0, 0), when it has points.
+void collide_all(const PosedShape& a, const PosedShape& b, Fixed margin,
+                 std::vector<SubManifold>& out);
+
+/// collide() for two primitives (shapes without geometry).
+[[nodiscard]] inline Manifold collide(const Shape& a, const Pose& pose_a, const Shape& b,
+                                      const Pose& pose_b, Fixed margin) noexcept {
+  return collide(PosedShape{a, nullptr, pose_a}, PosedShape{b, nullptr, pose_b}, margin);
+}
 
 }  // namespace detsim::sim_detail

@@ -37,12 +37,9 @@ Fixed contact_margin(const WorldState& s, std::size_t ia, std::size_t ib) {
   return s.def.speculative_distance + min(closing * s.def.dt, cap);
 }
 
-// Recomputes the manifold of `c` and carries the impulses of points whose features persist.
-void collide_one(WorldState& s, Contact& c, std::size_t ia, std::size_t ib) {
-  const BodyState& a = s.bodies[ia];
-  const BodyState& b = s.bodies[ib];
-  c.manifold =
-      collide(a.shape, s.derived[ia].pose, b.shape, s.derived[ib].pose, contact_margin(s, ia, ib));
+// Sets the manifold of `c` and carries the impulses of points whose features persist.
+void take_manifold(Contact& c, const Manifold& m) {
+  c.manifold = m;
   std::array<CachedPoint, 4> next{};
   for (std::size_t k = 0; k < c.manifold.count; ++k) {
     next[k].feature = c.manifold.points[k].feature;
@@ -58,6 +55,100 @@ void collide_one(WorldState& s, Contact& c, std::size_t ia, std::size_t ib) {
   c.touching = c.point_count > 0;
   c.collided = true;
   c.pushed = false;  // set by the solver if a point pushes
+}
+
+PosedShape posed(const WorldState& s, std::size_t i) {
+  return {s.bodies[i].shape, s.geometry(s.bodies[i].shape), s.derived[i].pose};
+}
+
+// Recomputes the manifold of `c`, a pair of two whole shapes.
+void collide_one(WorldState& s, Contact& c, std::size_t ia, std::size_t ib) {
+  take_manifold(c, collide(posed(s, ia), posed(s, ib), contact_margin(s, ia, ib)));
+}
+
+// Whether the group of the contact at `i` (its body pair) has sub-shapes on either side.
+bool group_has_sub_shapes(const WorldState& s, const Contact& c) {
+  return has_sub_shapes(posed(s, c.index_a)) || has_sub_shapes(posed(s, c.index_b));
+}
+
+// Recomputes the group [first, last) of s.contacts, a body pair with sub-shapes, into `out`: one
+// contact per sub-manifold with points, ascending by sub-shapes, each carrying the impulses of
+// the group's contact of the same sub-shapes (matched by feature, as for whole shapes); with no
+// points anywhere, one empty contact of sub-shapes (0, 0), which keeps the pair until its boxes
+// part. Every contact of the group keeps the pair's reported flag.
+void collide_group(WorldState& s, std::size_t first, std::size_t last, std::vector<Contact>& out,
+                   std::vector<SubManifold>& scratch) {
+  const Contact& head = s.contacts[first];
+  const std::size_t ia = head.index_a;
+  const std::size_t ib = head.index_b;
+  collide_all(posed(s, ia), posed(s, ib), contact_margin(s, ia, ib), scratch);
+  std::size_t old = first;
+  const auto fresh = [&head] {
+    Contact c;
+    c.a = head.a;
+    c.b = head.b;
+    c.index_a = head.index_a;
+    c.index_b = head.index_b;
+    c.reported = head.reported;
+    return c;
+  };
+  for (const SubManifold& m : scratch) {
+    while (old < last && (s.contacts[old].sub_a < m.sub_a ||
+                          (s.contacts[old].sub_a == m.sub_a && s.contacts[old].sub_b < m.sub_b)))
+      ++old;
+    Contact c = old < last && s.contacts[old].sub_a == m.sub_a && s.contacts[old].sub_b == m.sub_b
+                    ? s.contacts[old]
+                    : fresh();
+    c.sub_a = m.sub_a;
+    c.sub_b = m.sub_b;
+    take_manifold(c, m.manifold);
+    out.push_back(c);
+  }
+  if (scratch.empty()) {
+    Contact c = fresh();
+    take_manifold(c, Manifold{});
+    out.push_back(c);
+  }
+}
+
+// The narrowphase over the contact list: every pair in which something moves (`only_new`: only
+// the pairs not yet collided this step). Pairs of two whole shapes are updated in place; when a
+// pair has sub-shapes, the list is rebuilt, as its contacts come and go with its parts' touches.
+void narrowphase(WorldState& s, bool only_new) {
+  const auto wanted = [&](const Contact& c) {
+    if (only_new) return !c.collided;
+    return moving(s.bodies[c.index_a]) || moving(s.bodies[c.index_b]);
+  };
+  bool parts = false;
+  for (const Contact& c : s.contacts)
+    parts = parts || (wanted(c) && group_has_sub_shapes(s, c));
+  if (!parts) {
+    for (Contact& c : s.contacts) {
+      if (wanted(c)) collide_one(s, c, c.index_a, c.index_b);
+    }
+    return;
+  }
+  std::vector<Contact> next;
+  next.reserve(s.contacts.size() + 8);
+  std::vector<SubManifold> scratch;
+  for (std::size_t first = 0; first < s.contacts.size();) {
+    std::size_t last = first + 1;
+    while (last < s.contacts.size() && s.contacts[last].a == s.contacts[first].a &&
+           s.contacts[last].b == s.contacts[first].b)
+      ++last;
+    const Contact& head = s.contacts[first];
+    if (!wanted(head)) {
+      next.insert(next.end(), s.contacts.begin() + static_cast<std::ptrdiff_t>(first),
+                  s.contacts.begin() + static_cast<std::ptrdiff_t>(last));
+    } else if (group_has_sub_shapes(s, head)) {
+      collide_group(s, first, last, next, scratch);
+    } else {
+      next.push_back(head);
+      collide_one(s, next.back(), head.index_a, head.index_b);
+    }
+    first = last;
+  }
+  s.contacts = std::move(next);
 }
 
 struct UnionFind {
@@ -114,14 +205,9 @@ void each_joint(const WorldState& s, F&& f) {
 
 }  // namespace
 
+// A pair where nothing moves keeps its manifold and impulses as they were.
 void collide_contacts(WorldState& s) {
-  for (Contact& c : s.contacts) {
-    const std::size_t ia = c.index_a;
-    const std::size_t ib = c.index_b;
-    // A pair where nothing moves keeps its manifold and impulses as they were.
-    if (!moving(s.bodies[ia]) && !moving(s.bodies[ib])) continue;
-    collide_one(s, c, ia, ib);
-  }
+  narrowphase(s, false);
 }
 
 void wake_touched_islands(WorldState& s) {
@@ -161,9 +247,7 @@ void wake_touched_islands(WorldState& s) {
   // The pairs of bodies that just woke were skipped by collide_contacts: collide them now, with
   // every other pair it skipped. The pairs it collided would come out the same again (same poses
   // and speeds, and matching the cache by feature twice is matching it once).
-  for (Contact& c : s.contacts) {
-    if (!c.collided) collide_one(s, c, c.index_a, c.index_b);
-  }
+  narrowphase(s, true);
 }
 
 void report_end(WorldState& s, const Contact& c) {
@@ -174,11 +258,19 @@ void report_end(WorldState& s, const Contact& c) {
 }
 
 void report_contacts(WorldState& s) {
-  for (Contact& c : s.contacts) {
-    if (!c.collided) continue;  // neither body moved: the pair is as it was
-    c.collided = false;
-    const BodyState& a = s.bodies[c.index_a];
-    const BodyState& b = s.bodies[c.index_b];
+  // One event per body pair: its group of contacts (one per pair of sub-shapes) is in touch when
+  // any of them is, and all of them carry the pair's flag.
+  for (std::size_t first = 0; first < s.contacts.size();) {
+    std::size_t last = first + 1;
+    while (last < s.contacts.size() && s.contacts[last].a == s.contacts[first].a &&
+           s.contacts[last].b == s.contacts[first].b)
+      ++last;
+    const std::size_t group_first = first;
+    first = last;
+    Contact& head = s.contacts[group_first];
+    if (!head.collided) continue;  // neither body moved: the pair is as it was
+    const BodyState& a = s.bodies[head.index_a];
+    const BodyState& b = s.bodies[head.index_b];
     // A solid pair is in touch when a point began the step within the speculative distance, or
     // when the solver pushed on it (a fast body that met the surface and bounced within the step
     // never shows a small gap at a step's boundary). The contact margin also holds points that a
@@ -186,13 +278,19 @@ void report_contacts(WorldState& s) {
     // while the shapes overlap.
     const bool sensor = a.sensor || b.sensor;
     const Fixed reach = sensor ? Fixed::zero() : s.def.speculative_distance;
-    bool touch = !sensor && c.pushed;
-    for (std::size_t k = 0; k < c.manifold.count; ++k)
-      touch = touch || c.manifold.points[k].separation <= reach;
-    if (touch == c.reported) continue;
-    c.reported = touch;
-    s.events.push_back({touch ? ContactEvent::Kind::begin : ContactEvent::Kind::end, BodyId{c.a},
-                        BodyId{c.b}, sensor});
+    bool touch = false;
+    for (std::size_t i = group_first; i < last; ++i) {
+      Contact& c = s.contacts[i];
+      c.collided = false;
+      touch = touch || (!sensor && c.pushed);
+      for (std::size_t k = 0; k < c.manifold.count; ++k)
+        touch = touch || c.manifold.points[k].separation <= reach;
+    }
+    if (touch == head.reported) continue;
+    for (std::size_t i = group_first; i < last; ++i)
+      s.contacts[i].reported = touch;
+    s.events.push_back({touch ? ContactEvent::Kind::begin : ContactEvent::Kind::end, BodyId{head.a},
+                        BodyId{head.b}, sensor});
   }
   // Ends of vanished pairs were found first, by the broadphase; the order reported is by pair. A
   // pair changes at most once per step, so the order is total.

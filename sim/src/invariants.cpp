@@ -21,7 +21,8 @@ std::string validate_world(const WorldState& s) {
     if (b.id.value == 0 || b.id.value >= s.next_id)
       return body(b.id.value) + "ID outside 1.." + std::to_string(s.next_id - 1);
     if (i > 0 && s.bodies[i - 1].id >= b.id) return body(b.id.value) + "IDs are not ascending";
-    if (auto e = check_shape(b.shape, b.type); !e.empty()) return body(b.id.value) + e;
+    if (auto e = check_shape(s.geometries, b.shape, b.type); !e.empty())
+      return body(b.id.value) + e;
     if (auto e = check_orientation(b.orientation); !e.empty()) return body(b.id.value) + e;
     if (b.sleep_time < Fixed::zero()) return body(b.id.value) + "negative sleep time";
     if (b.type == BodyType::static_body && b.awake) return body(b.id.value) + "static and awake";

@@ -62,13 +62,15 @@ Ray make_ray(Vec3 origin, Vec3 translation) noexcept {
 
 /// The ray against one body: the bounding-sphere cull, the containment test, then the exact test
 /// on a ray restarted at t0 (see the file comment).
-std::optional<RayHit> cast_body(const BodyState& b, const Ray& ray) noexcept {
+std::optional<RayHit> cast_body(const sim_detail::WorldState& s, const BodyState& b,
+                                const Ray& ray) noexcept {
   const sim_detail::ShapeKind& kind = sim_detail::shape_kind(b.shape.type);
+  const sim_detail::Geometry* g = s.geometry(b.shape);
   const Mat3 rotation = to_mat3(b.orientation);
   const Vec3 offset = b.position - ray.origin;
   Fixed t0 = Fixed::zero();
   if (kind.bounded) {
-    const Fixed bound = bounding_radius(b.shape);
+    const Fixed bound = kind.bounding_radius(b.shape, g);
     const Fixed along = dot(offset, ray.direction);
     const Fixed nearest = clamp(along, Fixed::zero(), ray.length);
     if (length(offset - ray.direction * nearest) > bound + cull_slack(along)) return std::nullopt;
@@ -77,11 +79,11 @@ std::optional<RayHit> cast_body(const BodyState& b, const Ray& ray) noexcept {
     t0 = max(along - bound - Fixed::one(), Fixed::zero());
   }
   const Vec3 p = to_local(rotation, ray.direction * t0 - offset);
-  if (t0 == Fixed::zero() && kind.contains(b.shape, p)) {
+  if (t0 == Fixed::zero() && kind.contains(b.shape, g, p)) {
     return RayHit{b.id, ray.origin, Vec3::zero(), Fixed::zero()};
   }
   if (ray.length == Fixed::zero()) return std::nullopt;  // a point: only containment can hit
-  const auto hit = kind.ray(b.shape, p, to_local(rotation, ray.direction));
+  const auto hit = kind.ray(b.shape, g, p, to_local(rotation, ray.direction));
   if (!hit || hit->t > ray.length - t0) return std::nullopt;
   const Fixed t = t0 + hit->t;
   return RayHit{b.id, b.position + rotation * hit->point,
@@ -107,7 +109,7 @@ std::optional<RayHit> World::raycast_closest(Vec3 origin, Vec3 translation,
   std::optional<RayHit> best;
   for (const BodyState& b : s_->bodies) {
     if (!passes(b, filter)) continue;
-    const auto hit = cast_body(b, ray);
+    const auto hit = cast_body(*s_, b, ray);
     if (hit && (!best || hit->fraction < best->fraction)) best = hit;
   }
   return best;
@@ -119,7 +121,7 @@ std::vector<RayHit> World::raycast_all(Vec3 origin, Vec3 translation,
   std::vector<RayHit> hits;
   for (const BodyState& b : s_->bodies) {
     if (!passes(b, filter)) continue;
-    if (const auto hit = cast_body(b, ray)) hits.push_back(*hit);
+    if (const auto hit = cast_body(*s_, b, ray)) hits.push_back(*hit);
   }
   // (fraction, ID) is a total order (IDs are unique), so the sort has no ties to leave open.
   std::sort(hits.begin(), hits.end(), [](const RayHit& x, const RayHit& y) {
@@ -133,21 +135,27 @@ std::vector<BodyId> World::overlap(const Shape& shape, Vec3 position, Quat orien
   std::vector<BodyId> ids;
   // The query shape follows the rules of a moving body's shape (so never a plane) and the
   // orientation those of create_body; anything else matches nothing.
-  if (!sim_detail::check_shape(shape, BodyType::dynamic).empty() ||
+  if (!sim_detail::check_shape(s_->geometries, shape, BodyType::dynamic).empty() ||
       !sim_detail::check_orientation(orientation).empty()) {
     return ids;
   }
   const Pose query{position, to_mat3(orientation)};
-  const Fixed reach = bounding_radius(shape);
+  const sim_detail::Geometry* shape_geometry = s_->geometry(shape);
+  const Fixed reach = bounding_radius(shape, shape_geometry);
+  std::vector<sim_detail::SubManifold> manifolds;
   for (const BodyState& b : s_->bodies) {
     if (!passes(b, filter)) continue;
     if (sim_detail::shape_kind(b.shape.type).bounded) {
       const Fixed gap = distance(b.position, position);
-      if (gap > reach + bounding_radius(b.shape) + cull_slack(gap)) continue;
+      if (gap > reach + bounding_radius(b.shape, s_->geometry(b.shape)) + cull_slack(gap)) continue;
     }
     // collide() accepts its shapes in either order (it swaps them into its canonical one); the
     // normal's direction, the only thing the order changes, does not matter here.
-    if (touches(sim_detail::collide(shape, query, b.shape, pose_of(b), Fixed::zero()))) {
+    const Pose pose = pose_of(b);
+    sim_detail::collide_all({shape, shape_geometry, query}, {b.shape, s_->geometry(b.shape), pose},
+                            Fixed::zero(), manifolds);
+    if (std::any_of(manifolds.begin(), manifolds.end(),
+                    [](const sim_detail::SubManifold& m) { return touches(m.manifold); })) {
       ids.push_back(b.id);
     }
   }

@@ -43,15 +43,15 @@ struct Formulas {
   }
 };
 
-Fixed bounding_radius(const Shape& s) noexcept {
+Fixed bounding_radius(const Shape& s, const Geometry*) noexcept {
   return length(s.half_extents);
 }
 
-Fixed smallest_dimension(const Shape& s) noexcept {
+Fixed smallest_dimension(const Shape& s, const Geometry*) noexcept {
   return min(s.half_extents.x, min(s.half_extents.y, s.half_extents.z));
 }
 
-Vec3 aabb_extent(const Shape& s, const Mat3& r) noexcept {
+Vec3 aabb_extent(const Shape& s, const Geometry*, const Mat3& r) noexcept {
   const Vec3 h = s.half_extents;
   const auto row = [&h](Vec3 m) { return abs(m.x) * h.x + abs(m.y) * h.y + abs(m.z) * h.z; };
   return {row(r.rows[0]), row(r.rows[1]), row(r.rows[2])};
@@ -61,7 +61,7 @@ Vec3 aabb_extent(const Shape& s, const Mat3& r) noexcept {
 /// exits] over the three axes. The entry face is the axis of the largest entry, ties to the lower
 /// axis. A ray parallel to a slab (v_i == 0 exactly) is inside it for every t or for none; tiny
 /// nonzero v_i need no special case, as the quotients saturate to +-max() like infinities.
-std::optional<LocalHit> ray(const Shape& s, Vec3 p, Vec3 v) noexcept {
+std::optional<LocalHit> ray(const Shape& s, const Geometry*, Vec3 p, Vec3 v) noexcept {
   const Vec3 h = s.half_extents;
   Fixed enter = Fixed::min();
   Fixed exit = Fixed::max();
@@ -98,7 +98,7 @@ std::optional<LocalHit> ray(const Shape& s, Vec3 p, Vec3 v) noexcept {
   return LocalHit{enter, q, axis_vector(face_axis, entering_positive_face)};
 }
 
-bool contains(const Shape& s, Vec3 p) noexcept {
+bool contains(const Shape& s, const Geometry*, Vec3 p) noexcept {
   return abs(p.x) <= s.half_extents.x && abs(p.y) <= s.half_extents.y &&
          abs(p.z) <= s.half_extents.z;
 }
@@ -112,7 +112,7 @@ Shape read(ByteReader& r) {
 }
 
 /// The eight corners; corner i has local coordinate k at +h_k when bit k of i is set.
-void outline(const Shape& s, Vec3 position, Quat orientation, ShapeOutline& out) {
+void outline(const Shape& s, const Geometry*, Vec3 position, Quat orientation, ShapeOutline& out) {
   const Vec3 h = s.half_extents;
   out.points.clear();
   for (const int i : {0, 1, 2, 3, 4, 5, 6, 7}) {
@@ -141,6 +141,7 @@ const ShapeKind box_kind{ShapeType::box,
                          box_shape::contains,
                          box_shape::write,
                          box_shape::read,
-                         box_shape::outline};
+                         box_shape::outline,
+                         std::nullopt};
 
 }  // namespace detsim::sim_detail

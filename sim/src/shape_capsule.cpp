@@ -57,15 +57,15 @@ struct Formulas {
   }
 };
 
-Fixed bounding_radius(const Shape& s) noexcept {
+Fixed bounding_radius(const Shape& s, const Geometry*) noexcept {
   return s.radius + s.half_height;
 }
 
-Fixed smallest_dimension(const Shape& s) noexcept {
+Fixed smallest_dimension(const Shape& s, const Geometry*) noexcept {
   return s.radius;
 }
 
-Vec3 aabb_extent(const Shape& s, const Mat3& r) noexcept {
+Vec3 aabb_extent(const Shape& s, const Geometry*, const Mat3& r) noexcept {
   const Vec3 axis = r.column(1);  // the core segment's direction
   const Fixed h = s.half_height;
   return {abs(axis.x) * h + s.radius, abs(axis.y) * h + s.radius, abs(axis.z) * h + s.radius};
@@ -77,7 +77,7 @@ Vec3 aabb_extent(const Shape& s, const Mat3& r) noexcept {
 /// within the core's height. Candidates are taken side, bottom, top, each replacing only an
 /// earlier one strictly: ties at the seams go the same way everywhere. half_height == 0 gives two
 /// equal balls and a side of zero height: a sphere.
-std::optional<LocalHit> ray(const Shape& s, Vec3 p, Vec3 v) noexcept {
+std::optional<LocalHit> ray(const Shape& s, const Geometry*, Vec3 p, Vec3 v) noexcept {
   const Fixed r = s.radius;
   const Fixed half_height = s.half_height;
   std::optional<LocalHit> best;
@@ -106,7 +106,7 @@ std::optional<LocalHit> ray(const Shape& s, Vec3 p, Vec3 v) noexcept {
   return best;
 }
 
-bool contains(const Shape& s, Vec3 p) noexcept {
+bool contains(const Shape& s, const Geometry*, Vec3 p) noexcept {
   const Fixed y = clamp(p.y, -s.half_height, s.half_height);
   return length(Vec3{p.x, p.y - y, p.z}) <= s.radius;
 }
@@ -121,7 +121,7 @@ Shape read(ByteReader& r) {
   return Shape::capsule(radius, r.var_fixed("capsule half height"));
 }
 
-void outline(const Shape& s, Vec3 position, Quat orientation, ShapeOutline& out) {
+void outline(const Shape& s, const Geometry*, Vec3 position, Quat orientation, ShapeOutline& out) {
   const Vec3 axis = rotate(orientation, Vec3{Fixed::zero(), s.half_height, Fixed::zero()});
   out.points = {position - axis, position + axis};
   out.radius = s.radius;
@@ -145,6 +145,7 @@ const ShapeKind capsule_kind{ShapeType::capsule,
                              capsule_shape::contains,
                              capsule_shape::write,
                              capsule_shape::read,
-                             capsule_shape::outline};
+                             capsule_shape::outline,
+                             std::nullopt};
 
 }  // namespace detsim::sim_detail

@@ -14,28 +14,28 @@ std::string check(const Shape&) {
   return {};
 }
 
-Fixed zero(const Shape&) noexcept {
+Fixed zero(const Shape&, const Geometry*) noexcept {
   return Fixed::zero();
 }
 
-MassProperties mass_properties(const Shape&, Fixed) noexcept {
+MassProperties mass_properties(const Shape&, const Geometry*, Fixed) noexcept {
   return {};
 }
 
-Checked checked_zero(const Shape&) noexcept {
+Checked checked_zero(const Shape&, const Geometry*) noexcept {
   return {};
 }
 
-std::array<Checked, 3> checked_inertia(const Shape&, Fixed) noexcept {
+std::array<Checked, 3> checked_inertia(const Shape&, const Geometry*, Fixed) noexcept {
   return {};
 }
 
-Vec3 aabb_extent(const Shape&, const Mat3&) noexcept {
+Vec3 aabb_extent(const Shape&, const Geometry*, const Mat3&) noexcept {
   return {};
 }
 
 /// The solid half-space y <= 0.
-std::optional<LocalHit> ray(const Shape&, Vec3 p, Vec3 v) noexcept {
+std::optional<LocalHit> ray(const Shape&, const Geometry*, Vec3 p, Vec3 v) noexcept {
   if (v.y >= Fixed::zero()) return std::nullopt;  // parallel or leaving
   const Fixed t = p.y / -v.y;                     // saturates for nearly parallel rays
   Vec3 q = p + v * t;
@@ -43,7 +43,7 @@ std::optional<LocalHit> ray(const Shape&, Vec3 p, Vec3 v) noexcept {
   return LocalHit{t, q, Vec3::unit_y()};
 }
 
-bool contains(const Shape&, Vec3 p) noexcept {
+bool contains(const Shape&, const Geometry*, Vec3 p) noexcept {
   return p.y <= Fixed::zero();
 }
 
@@ -53,7 +53,7 @@ Shape read(ByteReader&) {
   return Shape::plane();
 }
 
-void outline(const Shape&, Vec3 position, Quat orientation, ShapeOutline& out) {
+void outline(const Shape&, const Geometry*, Vec3 position, Quat orientation, ShapeOutline& out) {
   out.half_space = true;
   out.points = {position};
   out.radius = Fixed::zero();
@@ -78,6 +78,7 @@ const ShapeKind plane_kind{ShapeType::plane,
                            plane_shape::contains,
                            plane_shape::write,
                            plane_shape::read,
-                           plane_shape::outline};
+                           plane_shape::outline,
+                           std::nullopt};
 
 }  // namespace detsim::sim_detail

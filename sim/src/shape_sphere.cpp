@@ -58,19 +58,19 @@ struct Formulas {
   }
 };
 
-Fixed radius(const Shape& s) noexcept {
+Fixed radius(const Shape& s, const Geometry*) noexcept {
   return s.radius;
 }
 
-Vec3 aabb_extent(const Shape& s, const Mat3&) noexcept {
+Vec3 aabb_extent(const Shape& s, const Geometry*, const Mat3&) noexcept {
   return {s.radius, s.radius, s.radius};
 }
 
-std::optional<LocalHit> ray(const Shape& s, Vec3 p, Vec3 v) noexcept {
+std::optional<LocalHit> ray(const Shape& s, const Geometry*, Vec3 p, Vec3 v) noexcept {
   return ray_ball(p, v, s.radius);
 }
 
-bool contains(const Shape& s, Vec3 p) noexcept {
+bool contains(const Shape& s, const Geometry*, Vec3 p) noexcept {
   return length(p) <= s.radius;
 }
 
@@ -82,7 +82,7 @@ Shape read(ByteReader& r) {
   return Shape::sphere(r.var_fixed("sphere radius"));
 }
 
-void outline(const Shape& s, Vec3 position, Quat, ShapeOutline& out) {
+void outline(const Shape& s, const Geometry*, Vec3 position, Quat, ShapeOutline& out) {
   out.points = {position};
   out.radius = s.radius;
 }
@@ -105,6 +105,7 @@ const ShapeKind sphere_kind{ShapeType::sphere,
                             sphere_shape::contains,
                             sphere_shape::write,
                             sphere_shape::read,
-                            sphere_shape::outline};
+                            sphere_shape::outline,
+                            std::nullopt};
 
 }  // namespace detsim::sim_detail

@@ -14,8 +14,9 @@ namespace sim_detail {
 namespace {
 
 /// Every kind, ascending by type: a new shape type is a row here.
-constexpr std::array<const ShapeKind*, 4> kKinds = {&sphere_kind, &box_kind, &capsule_kind,
-                                                    &plane_kind};
+constexpr std::array<const ShapeKind*, 9> kKinds = {
+    &sphere_kind, &box_kind,  &capsule_kind,     &plane_kind,   &cylinder_kind,
+    &convex_kind, &mesh_kind, &heightfield_kind, &compound_kind};
 
 }  // namespace
 
@@ -36,12 +37,25 @@ std::string check_positive_size(const char* what, Fixed x) {
   return {};
 }
 
-std::string check_shape(const Shape& shape, BodyType type) {
+std::string check_shape(const GeometryTable& geometries, const Shape& shape, BodyType type) {
   const ShapeKind* kind = find_shape_kind(shape.type);
   if (kind == nullptr)
     return "unknown shape type " + std::to_string(static_cast<unsigned>(shape.type));
   if (kind->static_only && type != BodyType::static_body)
     return std::string("a ") + kind->name + " shape needs a static body";
+  if (kind->geometry) {
+    const Geometry* g = find_geometry(geometries, shape.geometry);
+    if (g == nullptr)
+      return std::string("a ") + kind->name + " shape's geometry ID " +
+             std::to_string(shape.geometry.value) + " is not registered with this world (" +
+             std::to_string(geometries.size()) + " geometries)";
+    if (g->type != *kind->geometry)
+      return std::string("a ") + kind->name + " shape's geometry ID " +
+             std::to_string(shape.geometry.value) + " is a " + geometry_type_name(g->type);
+  } else if (!shape.geometry.is_null()) {
+    return std::string("a ") + kind->name + " shape has no geometry, got geometry ID " +
+           std::to_string(shape.geometry.value);
+  }
   return kind->check(shape);
 }
 
@@ -49,19 +63,20 @@ std::string check_shape(const Shape& shape, BodyType type) {
 
 Fixed volume(const Shape& shape) noexcept {
   const sim_detail::ShapeKind* kind = sim_detail::find_shape_kind(shape.type);
-  return kind != nullptr ? kind->volume(shape) : Fixed::zero();
+  return kind != nullptr && !kind->geometry ? kind->volume(shape, nullptr) : Fixed::zero();
 }
 
 MassProperties mass_properties(const Shape& shape, Fixed mass) noexcept {
   if (mass <= Fixed::zero()) return {};
   const sim_detail::ShapeKind* kind = sim_detail::find_shape_kind(shape.type);
-  return kind != nullptr ? kind->mass_properties(shape, mass) : MassProperties{};
+  return kind != nullptr && !kind->geometry ? kind->mass_properties(shape, nullptr, mass)
+                                            : MassProperties{};
 }
 
 ShapeOutline shape_outline(const Shape& shape, Vec3 position, Quat orientation) {
   ShapeOutline out;
-  if (const sim_detail::ShapeKind* kind = sim_detail::find_shape_kind(shape.type))
-    kind->outline(shape, position, orientation, out);
+  const sim_detail::ShapeKind* kind = sim_detail::find_shape_kind(shape.type);
+  if (kind != nullptr && !kind->geometry) kind->outline(shape, nullptr, position, orientation, out);
   return out;
 }
 

@@ -1,12 +1,13 @@
 // One home per shape type. Internal to detsim::sim.
 //
 // Everything the library does with a shape that depends on its type lives in that type's file
-// (shape_sphere.cpp, shape_box.cpp, shape_capsule.cpp, shape_plane.cpp) as one ShapeKind: its
-// checks, mass properties, bounds, ray and containment tests, canonical encoding and outline. The
-// rest of the library asks the kind (shape_kind(type)) and never switches on ShapeType, so a new
-// type is its file, a row in shapes.cpp's table and its rows in the collision pair table
-// (collide.cpp) — docs/ARCHITECTURE.md has the checklist. Pair functions, which belong to two
-// types, stay in the narrowphase files.
+// (shape_sphere.cpp, shape_box.cpp, shape_capsule.cpp, shape_plane.cpp, shape_cylinder.cpp,
+// shape_convex.cpp, shape_mesh.cpp for meshes and heightfields, shape_compound.cpp) as one
+// ShapeKind: its checks, mass properties, bounds, ray and containment tests, canonical encoding and
+// outline. The rest of the library asks the kind (shape_kind(type)) and never switches on
+// ShapeType, so a new type is its file, a row in shapes.cpp's table and its rows in the collision
+// pair table (collide.cpp) — docs/ARCHITECTURE.md has the checklist. Pair functions, which belong
+// to two types, stay in the narrowphase files.
 //
 // Precision rules shared by every kind: sizes are at most 10^4 m (check), so squares and products
 // of sizes stay far inside the Fixed range; each function keeps its own precision argument.
@@ -27,6 +28,7 @@
 #include <detsim/sim/shape.hpp>
 #include <detsim/sim/shape_outline.hpp>
 
+#include "geometry/geometry.hpp"
 #include "limits.hpp"
 
 namespace detsim::sim_detail {
@@ -45,21 +47,25 @@ struct LocalHit {
 /// and z), for N = Fixed (what the simulation uses) and N = Checked (the limits, the same bits).
 template <class Formulas>
 struct MassEntries {
-  static Fixed volume(const Shape& s) noexcept { return Formulas::template volume<Fixed>(s); }
-  static MassProperties mass_properties(const Shape& s, Fixed mass) noexcept {
+  static Fixed volume(const Shape& s, const Geometry*) noexcept {
+    return Formulas::template volume<Fixed>(s);
+  }
+  static MassProperties mass_properties(const Shape& s, const Geometry*, Fixed mass) noexcept {
     const std::array<Fixed, 3> i = Formulas::template inertia<Fixed>(s, mass);
     return {mass, {i[0], i[1], i[2]}};
   }
-  static Checked checked_volume(const Shape& s) noexcept {
+  static Checked checked_volume(const Shape& s, const Geometry*) noexcept {
     return Formulas::template volume<Checked>(s);
   }
-  static std::array<Checked, 3> checked_inertia(const Shape& s, Fixed mass) noexcept {
+  static std::array<Checked, 3> checked_inertia(const Shape& s, const Geometry*,
+                                                Fixed mass) noexcept {
     return Formulas::template inertia<Checked>(s, mass);
   }
 };
 
 /// What the library does with one type of shape. Every function takes a shape of this type that
-/// `check` has accepted, except `check` itself and `read`.
+/// `check` has accepted, except `check` itself and `read`, and the geometry it refers to
+/// (shape_geometry: nullptr for the primitives, which ignore it).
 struct ShapeKind {
   ShapeType type;
   const char* name;  ///< "sphere": in messages and the encoding's description
@@ -69,35 +75,48 @@ struct ShapeKind {
   /// The shape's own fields (sizes); "" when valid, else a message naming the field and value.
   std::string (*check)(const Shape& shape);
   /// m^3 (0 for an unbounded shape).
-  Fixed (*volume)(const Shape& shape) noexcept;
+  Fixed (*volume)(const Shape& shape, const Geometry* g) noexcept;
   /// Mass properties of the solid with total mass `mass` > 0 spread uniformly.
-  MassProperties (*mass_properties)(const Shape& shape, Fixed mass) noexcept;
+  MassProperties (*mass_properties)(const Shape& shape, const Geometry* g, Fixed mass) noexcept;
   /// `volume` in Checked arithmetic (the same formula, the same bits): whether any step of it
   /// leaves the limits of limits.hpp.
-  Checked (*checked_volume)(const Shape& shape) noexcept;
+  Checked (*checked_volume)(const Shape& shape, const Geometry* g) noexcept;
   /// The moments of inertia of `mass_properties` (about x, y, z) in Checked arithmetic.
-  std::array<Checked, 3> (*checked_inertia)(const Shape& shape, Fixed mass) noexcept;
-  /// The radius of a ball about the body's origin that holds the shape (0 when unbounded).
-  Fixed (*bounding_radius)(const Shape& shape) noexcept;
+  std::array<Checked, 3> (*checked_inertia)(const Shape& shape, const Geometry* g,
+                                            Fixed mass) noexcept;
+  /// The radius of a ball about the body's origin that holds the shape, and no smaller than any
+  /// point's distance from the centre of mass (the two agree for the primitives, centred on the
+  /// origin); 0 when unbounded.
+  Fixed (*bounding_radius)(const Shape& shape, const Geometry* g) noexcept;
   /// The smallest distance across the shape from its centre (continuous collision's "fast").
-  Fixed (*smallest_dimension)(const Shape& shape) noexcept;
-  /// Half extents of the world-space bounding box of the shape under `rotation` (bounded only).
-  Vec3 (*aabb_extent)(const Shape& shape, const Mat3& rotation) noexcept;
+  Fixed (*smallest_dimension)(const Shape& shape, const Geometry* g) noexcept;
+  /// Half extents of a world-space box about the body's origin that holds the shape under
+  /// `rotation` (bounded only).
+  Vec3 (*aabb_extent)(const Shape& shape, const Geometry* g, const Mat3& rotation) noexcept;
   /// The first hit of the ray p + v t from a point p outside the shape (shape frame).
-  std::optional<LocalHit> (*ray)(const Shape& shape, Vec3 p, Vec3 v) noexcept;
+  std::optional<LocalHit> (*ray)(const Shape& shape, const Geometry* g, Vec3 p, Vec3 v) noexcept;
   /// Whether the closed shape contains p (shape frame; surfaces included).
-  bool (*contains)(const Shape& shape, Vec3 p) noexcept;
+  bool (*contains)(const Shape& shape, const Geometry* g, Vec3 p) noexcept;
   /// The canonical encoding of the shape's fields (the type byte is written by the caller).
   void (*write)(const Shape& shape, ByteWriter& w);
   Shape (*read)(ByteReader& r);
   /// What a viewer draws (detsim/sim/shape_outline.hpp), placed at position and orientation.
-  void (*outline)(const Shape& shape, Vec3 position, Quat orientation, ShapeOutline& out);
+  void (*outline)(const Shape& shape, const Geometry* g, Vec3 position, Quat orientation,
+                  ShapeOutline& out);
+  /// The type of geometry its shapes refer to (Shape::geometry), or none: a primitive, whose
+  /// fields are the whole shape and whose geometry ID is null.
+  std::optional<GeometryType> geometry;
 };
 
 extern const ShapeKind sphere_kind;
 extern const ShapeKind box_kind;
 extern const ShapeKind capsule_kind;
 extern const ShapeKind plane_kind;
+extern const ShapeKind cylinder_kind;
+extern const ShapeKind convex_kind;
+extern const ShapeKind mesh_kind;
+extern const ShapeKind heightfield_kind;
+extern const ShapeKind compound_kind;
 
 /// Every kind, ascending by type.
 [[nodiscard]] std::span<const ShapeKind* const> shape_kinds() noexcept;
@@ -109,8 +128,8 @@ extern const ShapeKind plane_kind;
 }
 
 /// The radius of a ball about the body's origin that holds a checked shape (0 when unbounded).
-[[nodiscard]] inline Fixed bounding_radius(const Shape& shape) noexcept {
-  return shape_kind(shape.type).bounding_radius(shape);
+[[nodiscard]] inline Fixed bounding_radius(const Shape& shape, const Geometry* g) noexcept {
+  return shape_kind(shape.type).bounding_radius(shape, g);
 }
 
 // Ray pieces shared by the round kinds (shape_sphere.cpp).

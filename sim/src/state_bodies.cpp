@@ -212,8 +212,8 @@ void read_properties(ByteReader& r, BodyState& b) {
 // Semantic checks of a property set read from bytes; "" when valid. The limits are the API's
 // (limits.hpp, docs/SIM.md "What is refused") for what a step never changes: a restored world
 // holds nothing that create_body would have refused.
-std::string check_properties(const BodyState& p) {
-  if (auto e = check_shape(p.shape, p.type); !e.empty()) return e;
+std::string check_properties(const GeometryTable& geometries, const BodyState& p) {
+  if (auto e = check_shape(geometries, p.shape, p.type); !e.empty()) return e;
   if (p.mass < Fixed::zero()) return "mass must be >= 0";
   if (p.type == BodyType::dynamic && (p.mass <= Fixed::zero() || p.inertia.x <= Fixed::zero() ||
                                       p.inertia.y <= Fixed::zero() || p.inertia.z <= Fixed::zero()))
@@ -230,6 +230,12 @@ std::string check_properties(const BodyState& p) {
   if (p.friction < Fixed::zero() || p.restitution < Fixed::zero() || p.restitution > Fixed::one() ||
       p.linear_damping < Fixed::zero() || p.angular_damping < Fixed::zero())
     return "material or damping out of range";
+  // The centre of mass lies in the shape (sizes are at most 10^4 m), and the principal axes are a
+  // rotation, as mass_properties makes them.
+  if (beyond(p.center_of_mass.x, max_shape_size) || beyond(p.center_of_mass.y, max_shape_size) ||
+      beyond(p.center_of_mass.z, max_shape_size))
+    return "centre of mass components must be within +-" + to_string(max_shape_size) + " m";
+  if (auto e = check_orientation(p.inertia_axes); !e.empty()) return "inertia axes: " + e;
   return {};
 }
 
@@ -356,7 +362,7 @@ bool read_bodies(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState&
     read_properties(r, p);
     if (!r.ok()) break;
     const std::string where = "property set " + std::to_string(i) + ": ";
-    if (auto e = check_properties(p); !e.empty()) return failed_at(at, where + e);
+    if (auto e = check_properties(s.geometries, p); !e.empty()) return failed_at(at, where + e);
     const std::string_view set_bytes(reinterpret_cast<const char*>(bytes.data() + at),
                                      r.offset() - at);
     if (!seen.insert(set_bytes).second) return failed_at(at, where + "the same as an earlier set");

@@ -16,6 +16,8 @@
 
 #include <detsim/core/hash.hpp>
 
+#include "collide.hpp"
+#include "shapes.hpp"
 #include "state_io.hpp"
 
 namespace detsim {
@@ -30,9 +32,11 @@ constexpr std::uint32_t kVersion = state_encoding_version;
 // Smallest encoding of a contact, to bound the count by the bytes that remain before allocating.
 constexpr std::size_t kMinContactBytes = 1 + 1 + 1;
 
-// A contact's point byte: the count in bits 0-2, then the reported flag.
+// A contact's point byte: the count in bits 0-2, the reported flag, and whether the contact's
+// sub-shapes follow (they do when either is not 0).
 constexpr std::uint8_t kPointCountMask = 7;
 constexpr std::uint8_t kReported = 8;
+constexpr std::uint8_t kSubShapes = 16;
 
 void write_def(const WorldDef& d, ByteWriter& w) {
   w.vec3(d.gravity);
@@ -78,14 +82,17 @@ WorldDef read_def(ByteReader& r) {
 
 // ---- Contacts ----
 
-// A feature (collide_util.hpp: kind << 8 | index, kind < 4) is written as index * 4 + kind.
+// A feature (collide_util.hpp and geometry/convex.hpp: index bits 0-7, kind in bits 8-9, index
+// bits 8-13 in bits 10-15) is written as index * 4 + kind.
 std::uint32_t pack_feature(std::uint32_t f) noexcept {
-  return ((f & 0xFFU) << 2) | ((f >> 8) & 3U);
+  const std::uint32_t index = (f & 0xFFU) | ((f >> 10) << 8);
+  return (index << 2) | ((f >> 8) & 3U);
 }
 std::uint32_t unpack_feature(std::uint32_t v) noexcept {
-  return ((v & 3U) << 8) | (v >> 2);
+  const std::uint32_t index = v >> 2;
+  return (index & 0xFFU) | ((v & 3U) << 8) | ((index >> 8) << 10);
 }
-constexpr std::uint32_t kMaxPackedFeature = (0xFFU << 2) | 3U;
+constexpr std::uint32_t kMaxPackedFeature = (0x3FFFU << 2) | 3U;
 
 Contact read_contact(ByteReader& r, std::uint32_t previous_a) {
   Contact c;
@@ -101,17 +108,25 @@ Contact read_contact(ByteReader& r, std::uint32_t previous_a) {
   c.b = c.a + b_step;
   const std::size_t points_at = r.offset();
   const std::uint8_t points = r.u8("contact points");
-  if ((points & ~(kPointCountMask | kReported)) != 0 || (points & kPointCountMask) > 4)
-    r.fail_at(points_at, "contact points", "a count of 0-4 in bits 0-2 and bit 3 (reported)");
+  if ((points & ~(kPointCountMask | kReported | kSubShapes)) != 0 || (points & kPointCountMask) > 4)
+    r.fail_at(points_at, "contact points",
+              "a count of 0-4 in bits 0-2, bit 3 (reported) and bit 4 (sub-shapes follow)");
   c.point_count = points & kPointCountMask;
   c.touching = c.point_count > 0;
   c.reported = (points & kReported) != 0;
+  if ((points & kSubShapes) != 0) {
+    c.sub_a = r.var32("contact sub-shape a");
+    const std::size_t sub_b_at = r.offset();
+    c.sub_b = r.var32("contact sub-shape b");
+    if (r.ok() && c.sub_a == 0 && c.sub_b == 0)
+      r.fail_at(sub_b_at, "contact sub-shapes", "not both 0 when bit 4 says they follow");
+  }
   for (std::size_t p = 0; p < c.point_count && r.ok(); ++p) {
     std::uint32_t feature = 0;
     for (int side = 0; side < 2; ++side) {
       const std::size_t at = r.offset();
       const std::uint32_t v = r.var32("contact feature");
-      if (v > kMaxPackedFeature) r.fail_at(at, "contact feature", "index * 4 + kind, index < 256");
+      if (v > kMaxPackedFeature) r.fail_at(at, "contact feature", "index * 4 + kind, index < 2^14");
       feature |= unpack_feature(v) << (16 * side);
     }
     c.cached[p].feature = feature;
@@ -133,7 +148,13 @@ void write_globals(const WorldState& s, ByteWriter& w) {
 void write_contact(const Contact& c, std::uint32_t previous_a, ByteWriter& w) {
   w.var(c.a - previous_a);
   w.var(c.b - c.a);
-  w.u8(static_cast<std::uint8_t>(c.point_count | (c.reported ? kReported : 0U)));
+  const bool subs = c.sub_a != 0 || c.sub_b != 0;
+  w.u8(static_cast<std::uint8_t>(c.point_count | (c.reported ? kReported : 0U) |
+                                 (subs ? kSubShapes : 0U)));
+  if (subs) {
+    w.var(c.sub_a);
+    w.var(c.sub_b);
+  }
   for (std::size_t p = 0; p < c.point_count; ++p) {
     const std::uint32_t f = c.cached[p].feature;
     w.var(pack_feature(f & 0xFFFFU));
@@ -194,6 +215,19 @@ bool read_rng(std::span<const std::uint8_t>, ByteReader& r, WorldState& s, std::
   return r.ok();
 }
 
+// A contact's sub-shapes name parts that its bodies' shapes have ("" when they do).
+std::string check_sub_shapes(const WorldState& s, const Contact& c) {
+  for (const auto& [id, sub] : {std::pair{c.a, c.sub_a}, std::pair{c.b, c.sub_b}}) {
+    const BodyState& body = s.bodies[static_cast<std::size_t>(s.find(id))];
+    const std::uint32_t count = sub_shape_count(body.shape, s.geometry(body.shape));
+    if (sub >= count)
+      return "sub-shape " + std::to_string(sub) + " of body " + std::to_string(id) + ", whose " +
+             shape_kind(body.shape.type).name + " has " + std::to_string(count) +
+             (count == 1 ? " (the whole shape: 0)" : "");
+  }
+  return {};
+}
+
 bool read_contacts(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
                    std::string& error) {
   const auto failed_at = [&](std::size_t at, const std::string& message) {
@@ -216,8 +250,13 @@ bool read_contacts(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
         "contact (" + std::to_string(c.a) + ", " + std::to_string(c.b) + "): ";
     if (s.find(c.a) < 0 || s.find(c.b) < 0)
       return failed_at(at, where + "names a body that does not exist");
-    if (!s.contacts.empty() && c.a == s.contacts.back().a && c.b <= s.contacts.back().b)
-      return failed_at(at, where + "pairs must be unique and ascending");
+    if (!s.contacts.empty() && !contact_before(s.contacts.back(), c))
+      return failed_at(at, where + "contacts must be unique and ascending by (a, b, sub_a, sub_b)");
+    const bool same_pair =
+        !s.contacts.empty() && c.a == s.contacts.back().a && c.b == s.contacts.back().b;
+    if (same_pair && c.reported != s.contacts.back().reported)
+      return failed_at(at, where + "the contacts of one body pair must share its reported flag");
+    if (auto e = check_sub_shapes(s, c); !e.empty()) return failed_at(at, where + e);
     if (c.reported && !c.touching)
       return failed_at(at, where + "reported as touching without contact points");
     s.contacts.push_back(c);
@@ -240,9 +279,9 @@ struct WorldSection {
 /// The World's sections, in the order a state lists them: a new kind of state (joints, particle
 /// groups, controllers) is a row here, after the bodies it refers to.
 constexpr WorldSection kSections[] = {
-    {"globals", 1, write_globals, read_globals}, {"rng", 1, write_rng_section, read_rng},
-    {"bodies", 1, write_bodies, read_bodies},    {"contacts", 1, write_contacts, read_contacts},
-    {"joints", 1, write_joints, read_joints},
+    {"globals", 1, write_globals, read_globals},    {"rng", 1, write_rng_section, read_rng},
+    {"geometry", 1, write_geometry, read_geometry}, {"bodies", 2, write_bodies, read_bodies},
+    {"contacts", 2, write_contacts, read_contacts}, {"joints", 1, write_joints, read_joints},
 };
 constexpr std::size_t kSectionCount = std::size(kSections);
 
@@ -417,6 +456,9 @@ std::vector<std::uint8_t> World::save() const {
 
 Status World::restore(std::span<const std::uint8_t> bytes) {
   auto scratch = std::make_unique<sim_detail::WorldState>();
+  // The geometry is the world's definition, not the state's: the state names it by hash, and
+  // read_geometry checks it against this world's.
+  scratch->geometries = s_->geometries;
   std::string error;
   if (!sim_detail::read_state(bytes, *scratch, error)) return Status::error(error);
   s_ = std::move(scratch);

@@ -14,6 +14,9 @@
 namespace detsim::sim_detail {
 
 /// The "bodies" section's payload.
+void write_geometry(const WorldState& s, ByteWriter& w);
+bool read_geometry(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState& s,
+                   std::string& error);
 void write_bodies(const WorldState& s, ByteWriter& w);
 /// Reads the "bodies" payload into s.bodies (s.next_id already read), validating every field;
 /// on failure returns false with `error` set ("byte N: ...") or the reader failed.

@@ -46,20 +46,31 @@ void prepare_body(WorldState& s, std::size_t i) {
   const BodyState& b = s.bodies[i];
   Derived& d = s.derived[i];
   d.pose = {b.position, to_mat3(b.orientation)};
+  // A zero centre of mass (every primitive) leaves the position as it is: the same bits as
+  // world_center(), without its rotation.
+  d.center = b.center_of_mass == Vec3{} ? b.position : b.world_center();
   const bool moving = b.type == BodyType::dynamic && b.awake;
   d.inverse_mass = moving ? inverse_or_zero(b.mass) : Fixed::zero();
-  d.inverse_inertia_world =
-      moving ? rotate_inertia(d.pose.rotation, Mat3::diagonal(inverse_or_zero(b.inertia.x),
-                                                              inverse_or_zero(b.inertia.y),
-                                                              inverse_or_zero(b.inertia.z)))
-             : Mat3::zero();
+  if (moving) {
+    // R I^-1 R^T in the principal frame, turned by the body's orientation. Principal axes that
+    // are the body's (the identity) turn nothing: the body's rotation, bit for bit.
+    const Mat3 principal = b.inertia_axes == Quat::identity()
+                               ? d.pose.rotation
+                               : to_mat3(b.orientation * b.inertia_axes);
+    d.inverse_inertia_world = rotate_inertia(
+        principal, Mat3::diagonal(inverse_or_zero(b.inertia.x), inverse_or_zero(b.inertia.y),
+                                  inverse_or_zero(b.inertia.z)));
+  } else {
+    d.inverse_inertia_world = Mat3::zero();
+  }
   const ShapeKind& shape = shape_kind(b.shape.type);
+  const Geometry* g = s.geometry(b.shape);
   d.infinite = !shape.bounded;
   // length(0) * r is exactly 0: most bodies at rest skip the two square roots.
   d.rim_speed = b.angular_velocity == Vec3{}
                     ? Fixed::zero()
-                    : length(b.angular_velocity) * shape.bounding_radius(b.shape);
-  const Vec3 e = shape.aabb_extent(b.shape, d.pose.rotation) + margin;
+                    : length(b.angular_velocity) * shape.bounding_radius(b.shape, g);
+  const Vec3 e = shape.aabb_extent(b.shape, g, d.pose.rotation) + margin;
   d.aabb_min = b.position - e;
   d.aabb_max = b.position + e;
   // A moving body's box also covers where its velocity takes it this step, so that speculative

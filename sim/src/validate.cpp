@@ -65,14 +65,15 @@ std::string check_position(Vec3 p) {
   return check_components("position", p, max_position, "m");
 }
 
-std::string check_angular_velocity(const Shape& shape, Vec3 w, const char* what) {
+std::string check_angular_velocity(const Shape& shape, const Geometry* g, Vec3 w,
+                                   const char* what) {
   if (auto e = check_components(what, w, max_velocity, "rad/s"); !e.empty()) return e;
   // What prepare_body computes for the contact margins, before any speed limit applies.
-  const Checked rim = Checked(length(w)) * bounding_radius(shape);
+  const Fixed radius = bounding_radius(shape, g);
+  const Checked rim = Checked(length(w)) * radius;
   if (rim.over())
-    return above_limit(
-        "rim speed (|angular velocity| * bounding radius " + str(bounding_radius(shape)) + " m)",
-        rim, max_quantity, "m/s");
+    return above_limit("rim speed (|angular velocity| * bounding radius " + str(radius) + " m)",
+                       rim, max_quantity, "m/s");
   return {};
 }
 
@@ -87,12 +88,12 @@ std::string product_text(Fixed a, Fixed b) {
   return std::to_string(p.hi + (p.lo >> 63));  // round half up: display only
 }
 
-std::string check_mass_properties(const BodyDef& def) {
+std::string check_mass_properties(const Geometry* g, const BodyDef& def) {
   const ShapeKind& kind = shape_kind(def.shape.type);
   // The same arithmetic as body_mass, checked at every step.
   Checked mass = def.mass;
   if (def.mass <= Fixed::zero()) {
-    const Checked volume = kind.checked_volume(def.shape);
+    const Checked volume = kind.checked_volume(def.shape, g);
     if (volume.over())
       return above_limit(std::string("volume of the ") + kind.name, volume, max_quantity, "m^3");
     mass = Checked(def.density) * volume;
@@ -106,7 +107,7 @@ std::string check_mass_properties(const BodyDef& def) {
   } else if (mass.over()) {
     return above_limit("mass", mass, max_quantity, "kg");
   }
-  const std::array<Checked, 3> inertia = kind.checked_inertia(def.shape, mass.value());
+  const std::array<Checked, 3> inertia = kind.checked_inertia(def.shape, g, mass.value());
   const char* axes[] = {"x", "y", "z"};
   for (std::size_t i = 0; i < 3; ++i) {
     if (inertia[i].over())
@@ -135,18 +136,19 @@ std::string check_orientation(Quat q) {
   return {};
 }
 
-std::string check_body_def(const BodyDef& def) {
+std::string check_body_def(const WorldState& s, const BodyDef& def) {
   if (def.type != BodyType::static_body && def.type != BodyType::kinematic &&
       def.type != BodyType::dynamic)
     return "unknown body type " + std::to_string(static_cast<unsigned>(def.type));
-  if (auto e = check_shape(def.shape, def.type); !e.empty()) return e;
+  if (auto e = check_shape(s.geometries, def.shape, def.type); !e.empty()) return e;
+  const Geometry* g = s.geometry(def.shape);
   if (auto e = check_orientation(def.orientation); !e.empty()) return e;
   if (auto e = check_position(def.position); !e.empty()) return e;
   if (def.type != BodyType::static_body) {  // a static body's velocities are ignored (zero)
     if (auto e = check_components("linear velocity", def.linear_velocity, max_velocity, "m/s");
         !e.empty())
       return e;
-    if (auto e = check_angular_velocity(def.shape, def.angular_velocity, "angular velocity");
+    if (auto e = check_angular_velocity(def.shape, g, def.angular_velocity, "angular velocity");
         !e.empty())
       return e;
   }
@@ -158,9 +160,9 @@ std::string check_body_def(const BodyDef& def) {
     return "restitution must be <= 1, got " + str(def.restitution);
   if (auto e = non_negative("linear damping", def.linear_damping); !e.empty()) return e;
   if (auto e = non_negative("angular damping", def.angular_damping); !e.empty()) return e;
-  if (auto e = check_mass_properties(def); !e.empty()) return e;
+  if (auto e = check_mass_properties(g, def); !e.empty()) return e;
   if (def.type == BodyType::dynamic) {
-    const MassProperties m = body_mass(def);
+    const MassProperties m = body_mass(s, def);
     if (m.mass <= Fixed::zero())
       return "a dynamic body needs a positive mass: mass is 0 and density * volume rounds to " +
              str(m.mass);
@@ -274,9 +276,12 @@ std::string check_world_def(const WorldDef& def) {
   return {};
 }
 
-MassProperties body_mass(const BodyDef& def) noexcept {
-  const Fixed mass = def.mass > Fixed::zero() ? def.mass : def.density * volume(def.shape);
-  return mass_properties(def.shape, mass);
+MassProperties body_mass(const WorldState& s, const BodyDef& def) noexcept {
+  const ShapeKind& kind = shape_kind(def.shape.type);
+  const Geometry* g = s.geometry(def.shape);
+  const Fixed mass = def.mass > Fixed::zero() ? def.mass : def.density * kind.volume(def.shape, g);
+  if (mass <= Fixed::zero()) return {};
+  return kind.mass_properties(def.shape, g, mass);
 }
 
 Fixed inverse_or_zero(Fixed x) noexcept {

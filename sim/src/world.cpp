@@ -91,9 +91,9 @@ const Rng& World::rng() const noexcept {
 
 Expected<BodyId> World::create_body(const BodyDef& def) {
   if (s_->next_id == 0xFFFFFFFFU) return Status::error("body IDs exhausted (2^32 - 1 created)");
-  if (auto e = sim_detail::check_body_def(def); !e.empty())
+  if (auto e = sim_detail::check_body_def(*s_, def); !e.empty())
     return Status::error("invalid body definition: " + e);
-  const MassProperties m = sim_detail::body_mass(def);
+  const MassProperties m = sim_detail::body_mass(*s_, def);
   BodyState b;
   b.id = BodyId{s_->next_id};
   b.type = def.type;
@@ -106,6 +106,8 @@ Expected<BodyId> World::create_body(const BodyDef& def) {
   }
   b.mass = m.mass;
   b.inertia = m.inertia;
+  b.center_of_mass = m.center;
+  b.inertia_axes = m.inertia_axes;
   b.friction = def.friction;
   b.restitution = def.restitution;
   b.linear_damping = def.linear_damping;
@@ -135,8 +137,12 @@ Status World::destroy_body(BodyId id) {
       }
     }
   }
-  for (const sim_detail::Contact& c : s_->contacts) {
-    if (c.a == id.value || c.b == id.value) sim_detail::report_end(*s_, c);
+  // One end event per body pair (its first contact: a pair's contacts share the reported flag).
+  for (std::size_t k = 0; k < s_->contacts.size(); ++k) {
+    const sim_detail::Contact& c = s_->contacts[k];
+    const bool first_of_pair =
+        k == 0 || s_->contacts[k - 1].a != c.a || s_->contacts[k - 1].b != c.b;
+    if (first_of_pair && (c.a == id.value || c.b == id.value)) sim_detail::report_end(*s_, c);
   }
   std::erase_if(s_->contacts,
                 [id](const sim_detail::Contact& c) { return c.a == id.value || c.b == id.value; });
@@ -176,6 +182,8 @@ std::vector<ContactState> World::contacts() const {
     ContactState v;
     v.a = BodyId{c.a};
     v.b = BodyId{c.b};
+    v.sub_a = c.sub_a;
+    v.sub_b = c.sub_b;
     v.touching = c.touching;
     v.reported = c.reported;
     v.point_count = c.point_count;
@@ -224,13 +232,14 @@ Fixed component(Vec3 v, int i) {
 // r x f for a point given in world space, or a refusal when the lever arm or the moment leaves
 // the limits (limits.hpp).
 std::string moment(const BodyState& b, Vec3 point, Vec3 f, Vec3& out) {
-  const Vec3 r = point - b.position;
+  const Vec3 center = b.world_center();
+  const Vec3 r = point - center;
   out = cross(r, f);
   for (int i = 0; i < 3; ++i) {
-    const Checked arm = Checked(component(point, i)) - component(b.position, i);
+    const Checked arm = Checked(component(point, i)) - component(center, i);
     if (arm.over())
-      return sim_detail::above_limit(std::string("lever arm (point - position) ") + kAxes[i], arm,
-                                     sim_detail::max_quantity, "m");
+      return sim_detail::above_limit(std::string("lever arm (point - centre of mass) ") + kAxes[i],
+                                     arm, sim_detail::max_quantity, "m");
   }
   for (int i = 0; i < 3; ++i) {
     if (const Checked m = component(out, i); m.over())
@@ -288,7 +297,8 @@ std::string accumulate(const BodyState& b, Vec3 force, Vec3 torque, Vec3& f_out,
 // with the world-space inverse inertia of its current orientation; or a refusal when a step of
 // that leaves the limits (the new velocities within max_velocity, the rim speed within
 // max_quantity). Other bodies keep their velocities.
-std::string impulse(const BodyState& b, Vec3 linear, Vec3 angular, Vec3& v_out, Vec3& w_out) {
+std::string impulse(const sim_detail::WorldState& s, const BodyState& b, Vec3 linear, Vec3 angular,
+                    Vec3& v_out, Vec3& w_out) {
   using sim_detail::max_quantity;
   using sim_detail::max_velocity;
   v_out = b.linear_velocity;
@@ -296,7 +306,8 @@ std::string impulse(const BodyState& b, Vec3 linear, Vec3 angular, Vec3& v_out, 
   if (b.type != BodyType::dynamic) return {};
   const Vec3 dv = linear / b.mass;
   v_out = b.linear_velocity + dv;
-  const Mat3 r = to_mat3(b.orientation);
+  // The principal frame: the body's, turned by its inertia axes (the identity for primitives).
+  const Mat3 r = to_mat3(b.orientation * b.inertia_axes);
   const Vec3 local = transpose(r) * angular;
   const Vec3 local_dw{local.x / b.inertia.x, local.y / b.inertia.y, local.z / b.inertia.z};
   const Vec3 dw = r * local_dw;
@@ -320,7 +331,8 @@ std::string impulse(const BodyState& b, Vec3 linear, Vec3 angular, Vec3& v_out, 
                                          str(inertia[i]) + " kg m^2 about body " + kAxes[i] + ")",
                                      body_frame.over() ? body_frame : w, max_velocity, "rad/s");
   }
-  return sim_detail::check_angular_velocity(b.shape, w_out, "angular velocity after the impulse");
+  return sim_detail::check_angular_velocity(b.shape, s.geometry(b.shape), w_out,
+                                            "angular velocity after the impulse");
 }
 
 }  // namespace
@@ -337,7 +349,9 @@ Status World::set_type(BodyId id, BodyType type) {
       return Status::error("body " + std::to_string(id.value) +
                            " has no mass (it was created with zero mass and density)");
     if (type == BodyType::dynamic) {
-      if (auto e = sim_detail::check_dynamic_mass({b.mass, b.inertia}); !e.empty())
+      if (auto e =
+              sim_detail::check_dynamic_mass({b.mass, b.inertia, b.center_of_mass, b.inertia_axes});
+          !e.empty())
         return refuse("body " + std::to_string(id.value) + " cannot become dynamic: " + e);
     }
     if (type == BodyType::static_body) {
@@ -375,7 +389,8 @@ Status World::set_linear_velocity(BodyId id, Vec3 velocity) {
 Status World::set_angular_velocity(BodyId id, Vec3 velocity) {
   return with_body(*s_, id, true, [&](BodyState& b) {
     if (b.type == BodyType::static_body) return Status::error("a static body cannot move");
-    if (auto e = sim_detail::check_angular_velocity(b.shape, velocity, "angular velocity");
+    if (auto e = sim_detail::check_angular_velocity(b.shape, s_->geometry(b.shape), velocity,
+                                                    "angular velocity");
         !e.empty())
       return refuse(e);
     b.angular_velocity = velocity;
@@ -420,7 +435,7 @@ Status World::apply_linear_impulse(BodyId id, Vec3 linear) {
   return with_body(*s_, id, true, [&](BodyState& b) {
     Vec3 v;
     Vec3 w;
-    if (auto e = impulse(b, linear, {}, v, w); !e.empty()) return refuse(e);
+    if (auto e = impulse(*s_, b, linear, {}, v, w); !e.empty()) return refuse(e);
     b.linear_velocity = v;
     b.angular_velocity = w;
     return ok();
@@ -433,7 +448,7 @@ Status World::apply_impulse_at_point(BodyId id, Vec3 linear, Vec3 point) {
     if (auto e = moment(b, point, linear, m); !e.empty()) return refuse(e);
     Vec3 v;
     Vec3 w;
-    if (auto e = impulse(b, linear, m, v, w); !e.empty()) return refuse(e);
+    if (auto e = impulse(*s_, b, linear, m, v, w); !e.empty()) return refuse(e);
     b.linear_velocity = v;
     b.angular_velocity = w;
     return ok();
@@ -444,7 +459,7 @@ Status World::apply_angular_impulse(BodyId id, Vec3 angular) {
   return with_body(*s_, id, true, [&](BodyState& b) {
     Vec3 v;
     Vec3 w;
-    if (auto e = impulse(b, {}, angular, v, w); !e.empty()) return refuse(e);
+    if (auto e = impulse(*s_, b, {}, angular, v, w); !e.empty()) return refuse(e);
     b.linear_velocity = v;
     b.angular_velocity = w;
     return ok();

@@ -19,6 +19,7 @@
 #include <detsim/sim/world.hpp>
 
 #include "collide.hpp"
+#include "geometry/geometry.hpp"
 
 namespace detsim::sim_detail {
 
@@ -33,12 +34,19 @@ struct CachedPoint {
   friend constexpr bool operator==(const CachedPoint&, const CachedPoint&) noexcept = default;
 };
 
-/// A pair of bodies whose bounding boxes overlap, a < b. `manifold` is the current geometry
+/// A pair of bodies whose bounding boxes overlap, a < b, and of their sub-shapes: `sub_a` and
+/// `sub_b` name a compound's part or a surface's triangle (0 for a shape that has none), so that a
+/// body pair may hold several contacts, each with its own normal (a box on a stair's tread and
+/// riser, a chair's four legs). A pair of two whole shapes has exactly one, of sub-shapes (0, 0).
+/// Contacts are ordered by (a, b, sub_a, sub_b); the contacts of one body pair are its *group*,
+/// and share the pair's `reported` flag. `manifold` is the current geometry
 /// (recomputed every step while either body is awake; not saved — a sleeping pair's manifold is
 /// recomputed on waking before it is used); `cached` is saved.
 struct Contact {
   std::uint32_t a = 0;
   std::uint32_t b = 0;
+  std::uint32_t sub_a = 0;
+  std::uint32_t sub_b = 0;
   std::uint8_t point_count = 0;  ///< points in `cached` (and in `manifold` after collide)
   bool touching = false;         ///< had at least one point at the last collide
   /// In touch as contact events report it (docs/SIM.md): some point within the speculative
@@ -56,9 +64,21 @@ struct Contact {
   Manifold manifold;
 };
 
+/// Whether contact x comes before contact y: ascending (a, b, sub_a, sub_b).
+[[nodiscard]] constexpr bool contact_before(const Contact& x, const Contact& y) noexcept {
+  if (x.a != y.a) return x.a < y.a;
+  if (x.b != y.b) return x.b < y.b;
+  if (x.sub_a != y.sub_a) return x.sub_a < y.sub_a;
+  return x.sub_b < y.sub_b;
+}
+
 /// Per-body data rebuilt at the start of each step (parallel to WorldState::bodies).
 struct Derived {
   Pose pose;
+  /// The centre of mass in world space (BodyState::world_center): what the solver's lever arms
+  /// start from. The sub-steps move it, and the body's position follows from it; for a body whose
+  /// centre is its origin (every primitive) it is the position, bit for bit.
+  Vec3 center;
   Fixed inverse_mass;
   Mat3 inverse_inertia_world;  ///< R I^-1 R^T; zero unless dynamic
   Vec3 aabb_min;
@@ -76,6 +96,8 @@ struct Derived {
 
 struct WorldState {
   WorldDef def;
+  /// Registered geometry (part of the definition; the "geometry" section lists it by hash).
+  GeometryTable geometries;
   std::uint64_t frame = 0;
   std::uint32_t next_id = 1;
   Rng rng;
@@ -99,6 +121,10 @@ struct WorldState {
   /// The same for joints: breaks in the last step, then joints destroy_body removed since.
   std::vector<JointEvent> joint_events;
 
+  /// The geometry a shape of this world refers to (nullptr for the primitives).
+  [[nodiscard]] const Geometry* geometry(const Shape& shape) const noexcept {
+    return shape_geometry(geometries, shape);
+  }
   /// Index of body `id` in `bodies`, or -1.
   [[nodiscard]] std::ptrdiff_t find(std::uint32_t id) const noexcept;
   /// Index of joint `id` in `joints`, or -1.
@@ -107,11 +133,12 @@ struct WorldState {
 
 /// Definition checks shared by World::create, create_body and restore. Empty string: valid.
 [[nodiscard]] std::string check_world_def(const WorldDef& def);
-[[nodiscard]] std::string check_shape(const Shape& shape, BodyType type);
+[[nodiscard]] std::string check_shape(const GeometryTable& geometries, const Shape& shape,
+                                      BodyType type);
 [[nodiscard]] std::string check_orientation(Quat q);
 /// "<what> must be a unit vector ..." unless | |v|^2 - 1 | <= 2^-20 (the orientations' tolerance).
 [[nodiscard]] std::string check_unit_vector(const char* what, Vec3 v);
-[[nodiscard]] std::string check_body_def(const BodyDef& def);
+[[nodiscard]] std::string check_body_def(const WorldState& s, const BodyDef& def);
 /// A joint definition against the world's bodies (validate.cpp): "" when valid.
 [[nodiscard]] std::string check_joint_def(const WorldState& s, const JointDef& def);
 /// check_joint_def without "at most one body static": what a saved joint must satisfy (set_type
@@ -124,12 +151,13 @@ struct WorldState {
 [[nodiscard]] std::string check_components(const char* what, Vec3 v, Fixed limit, const char* unit);
 [[nodiscard]] std::string check_position(Vec3 p);
 /// Components within max_velocity, and the rim speed |w| * bounding radius within max_quantity.
-[[nodiscard]] std::string check_angular_velocity(const Shape& shape, Vec3 w, const char* what);
+[[nodiscard]] std::string check_angular_velocity(const Shape& shape, const Geometry* g, Vec3 w,
+                                                 const char* what);
 /// What a dynamic body's mass and moments need beyond being positive: inverses that fit.
 [[nodiscard]] std::string check_dynamic_mass(const MassProperties& m);
 
 /// Mass and inertia of a body of this definition (what it has whenever it is dynamic).
-[[nodiscard]] MassProperties body_mass(const BodyDef& def) noexcept;
+[[nodiscard]] MassProperties body_mass(const WorldState& s, const BodyDef& def) noexcept;
 /// 1 / x for x > 0, else 0.
 [[nodiscard]] Fixed inverse_or_zero(Fixed x) noexcept;
 

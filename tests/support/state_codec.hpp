@@ -1,19 +1,22 @@
-// An independent codec of the v4 world-state layout (docs/STATE.md), for the world-state tests
+// An independent codec of the v5 world-state layout (docs/STATE.md), for the world-state tests
 // (support/state_helpers.hpp includes it).
 //
 // Written from docs/STATE.md, not from state_io.cpp, so that the two can disagree. In brief:
-//   "DSIM" u32 version=4 | var section count (5) | five sections, each: var name length, name,
-//   var section version (1), u32 payload length, payload. The payloads, in this order:
-//   globals: u64 frame | u32 next ID | definition (fixed width);  rng: 4 x u64;
+//   "DSIM" u32 version=5 | var section count (6) | six sections, each: var name length, name,
+//   var section version (bodies 2, the others 1), u32 payload length, payload. The payloads, in
+//   this order: globals: u64 frame | u32 next ID | definition (fixed width);  rng: 4 x u64;
+//   geometry: var count, then per geometry u8 type (1 convex hull, 2 triangle mesh, 3 heightfield,
+//   4 compound), u64 content hash;
 //   bodies: u32 property-set count, sets in first-use order | u32 body count, bodies ascending by
 //   ID;  contacts: u32 contact count, contacts ascending by (a, b);  joints: u32 next joint ID,
 //   u32 joint count, joints ascending by ID.
 // `var` is canonical LEB128 (at most 5 bytes for a 32-bit field, 10 for a 64-bit one); `vfixed` a
-// var of the zigzag raw value. A set: type u8, shape (type u8, then its vfixed sizes), mass,
-// inertia, friction, restitution, linear and angular damping (vfixed), layer u32, mask u32, flags
-// u8 (sensor, CCD). A body: ID step var, set index var, flags u8 (awake, user data, force, torque
-// follow), position, orientation, velocities, sleep time (vfixed), then the flagged values. A
-// contact: a step var, b - a var, point byte (count in bits 0-2, reported in bit 3), then per
+// var of the zigzag raw value. A set: type u8, shape (type u8, then its vfixed sizes, or a convex
+// hull's, mesh's or heightfield's geometry ID var), mass, inertia, centre of mass (vec3), inertia
+// axes (quat), friction, restitution, linear and angular damping (vfixed), layer u32, mask u32,
+// flags u8 (sensor, CCD). A body: ID step var, set index var, flags u8 (awake, user data, force,
+// torque follow), position, orientation, velocities, sleep time (vfixed), then the flagged values.
+// A contact: a step var, b - a var, point byte (count in bits 0-2, reported in bit 3), then per
 // point: feature on a, feature on b (var: index * 4 + kind), three impulses (vfixed). A joint: ID
 // step var, type u8 (0-5), body a var, body b var, flags u8 (limit enabled, motor enabled, collide
 // connected, broken, user data follows), anchor, axis (vec3), eleven definition numbers (vfixed),
@@ -47,11 +50,19 @@ namespace detsim::state_test {
 using Bytes = std::vector<std::uint8_t>;
 
 inline constexpr std::uint32_t kStateMagic = 0x4D495344U;
-inline constexpr std::uint32_t kStateVersion = 4;
-/// A World's sections, in their order, each at version 1.
-inline constexpr const char* kSectionNames[] = {"globals", "rng", "bodies", "contacts", "joints"};
-inline constexpr std::size_t kSectionCount = 5;
-inline constexpr std::uint32_t kSectionVersion = 1;
+inline constexpr std::uint32_t kStateVersion = 5;
+/// A World's sections, in their order, and their versions.
+inline constexpr const char* kSectionNames[] = {"globals", "rng",      "geometry",
+                                                "bodies",  "contacts", "joints"};
+inline constexpr std::size_t kSectionCount = 6;
+inline constexpr std::uint32_t kSectionVersions[] = {1, 1, 1, 2, 2, 1};
+// Each section's index in the lists above.
+inline constexpr std::size_t kGlobals = 0;
+inline constexpr std::size_t kRngSection = 1;
+inline constexpr std::size_t kGeometry = 2;
+inline constexpr std::size_t kBodies = 3;
+inline constexpr std::size_t kContacts = 4;
+inline constexpr std::size_t kJoints = 5;
 
 // Body flags.
 inline constexpr std::uint8_t kAwake = 1;
@@ -64,6 +75,7 @@ inline constexpr std::uint8_t kCcd = 2;
 // A contact's point byte.
 inline constexpr std::uint8_t kPointCountBits = 7;
 inline constexpr std::uint8_t kReported = 8;
+inline constexpr std::uint8_t kSubShapes = 16;  // the contact's sub-shapes follow
 // Joint flags.
 inline constexpr std::uint8_t kLimitEnabled = 1;
 inline constexpr std::uint8_t kMotorEnabled = 2;
@@ -158,6 +170,8 @@ struct DecodedSet {
   Shape shape{};
   Fixed mass{};
   Vec3 inertia{};
+  Vec3 center_of_mass{};
+  Quat inertia_axes{};
   Fixed friction{};
   Fixed restitution{};
   Fixed linear_damping{};
@@ -173,6 +187,7 @@ struct DecodedSet {
 
 inline bool same_properties(const DecodedSet& a, const DecodedSet& b) {
   return a.type == b.type && a.shape == b.shape && a.mass == b.mass && a.inertia == b.inertia &&
+         a.center_of_mass == b.center_of_mass && a.inertia_axes == b.inertia_axes &&
          a.friction == b.friction && a.restitution == b.restitution &&
          a.linear_damping == b.linear_damping && a.angular_damping == b.angular_damping &&
          a.layer == b.layer && a.mask == b.mask && a.flags == b.flags;
@@ -218,6 +233,8 @@ struct DecodedContact {
   std::uint64_t a_step = 0;     // a minus the previous contact's a
   std::uint64_t b_minus_a = 0;  // b minus a, at least 1
   std::uint8_t points_byte = 0;
+  std::uint64_t sub_a = 0;  // written when points_byte has kSubShapes
+  std::uint64_t sub_b = 0;
   std::vector<DecodedPoint> points;  // encode() writes all of them, whatever points_byte says
   // Filled by decode(), ignored by encode():
   std::uint32_t a = 0;
@@ -268,6 +285,13 @@ struct DecodedJoint {
   std::size_t end = 0;
 };
 
+/// A geometry entry: its type byte and content hash.
+struct DecodedGeometry {
+  std::uint8_t type = 1;
+  std::uint64_t hash = 0;
+  std::size_t at = 0;  // filled by decode()
+};
+
 struct Decoded {
   bool ok = false;
   std::string error;  // "byte N: what", the first error
@@ -277,6 +301,7 @@ struct Decoded {
   std::uint32_t next_id = 1;
   WorldDef def;
   Rng::State rng{};
+  std::vector<DecodedGeometry> geometries;
   std::vector<DecodedSet> sets;
   std::vector<DecodedBody> bodies;
   std::vector<DecodedContact> contacts;
@@ -291,6 +316,7 @@ struct Decoded {
   std::size_t next_id_at = 0;
   std::size_t def_at = 0;
   std::size_t rng_at = 0;
+  std::size_t geometry_count_at = 0;
   std::size_t property_count_at = 0;
   std::size_t body_count_at = 0;
   std::size_t contact_count_at = 0;
@@ -432,17 +458,26 @@ inline DecodedSet read_set(StateReader& r) {
       s.shape.half_extents = r.vvec3("half extents");
       break;
     case ShapeType::capsule:
+    case ShapeType::cylinder:
       s.shape.radius = r.vfixed("radius");
       s.shape.half_height = r.vfixed("half height");
       break;
     case ShapeType::plane:
       break;
+    case ShapeType::convex:
+    case ShapeType::mesh:
+    case ShapeType::heightfield:
+    case ShapeType::compound:
+      s.shape.geometry = GeometryId{static_cast<std::uint32_t>(r.var("geometry ID", 32))};
+      break;
     default:
-      r.fail(shape_at, "shape type: not 1 to 4");
+      r.fail(shape_at, "shape type: not 1 to 9");
   }
   s.mass_at = r.at();
   s.mass = r.vfixed("mass");
   s.inertia = r.vvec3("inertia");
+  s.center_of_mass = r.vvec3("centre of mass");
+  s.inertia_axes = r.vquat("inertia axes");
   s.friction = r.vfixed("friction");
   s.restitution = r.vfixed("restitution");
   s.linear_damping = r.vfixed("linear damping");
@@ -512,7 +547,8 @@ inline bool has_body(const Decoded& d, std::uint64_t id) {
 }
 
 inline void read_contact(StateReader& r, Decoded& d, std::uint64_t& previous_a,
-                         std::uint64_t& previous_b) {
+                         std::uint64_t& previous_b, std::uint64_t& previous_sub_a,
+                         std::uint64_t& previous_sub_b) {
   DecodedContact c;
   c.at = r.at();
   c.a_step = r.var("contact a step", 32);
@@ -521,17 +557,29 @@ inline void read_contact(StateReader& r, Decoded& d, std::uint64_t& previous_a,
   const std::uint64_t a = previous_a + c.a_step;
   const std::uint64_t b = a + c.b_minus_a;
   if (r.ok() && c.b_minus_a == 0) r.fail(c.b_at, "contact b - a: zero");
-  if (r.ok() && !d.contacts.empty() && a == previous_a && b <= previous_b)
-    r.fail(c.at, "contact: not in ascending (a, b) order");
   if (r.ok() && (!has_body(d, a) || !has_body(d, b))) r.fail(c.at, "contact: no such body");
-  previous_a = a;
-  previous_b = b;
   c.a = static_cast<std::uint32_t>(a);
   c.b = static_cast<std::uint32_t>(b);
   c.points_at = r.at();
   c.points_byte = r.u8("contact points");
-  if ((c.points_byte & ~(kPointCountBits | kReported)) != 0)
+  if ((c.points_byte & ~(kPointCountBits | kReported | kSubShapes)) != 0)
     r.fail(c.points_at, "contact points: an unknown bit");
+  if ((c.points_byte & kSubShapes) != 0) {
+    c.sub_a = r.var("contact sub-shape a", 32);
+    c.sub_b = r.var("contact sub-shape b", 32);
+    if (r.ok() && c.sub_a == 0 && c.sub_b == 0) r.fail(c.points_at, "contact sub-shapes: both 0");
+  }
+  // Ascending (a, b, sub_a, sub_b), each once.
+  const auto key = [](std::uint64_t x, std::uint64_t y, std::uint64_t u, std::uint64_t v) {
+    return std::array<std::uint64_t, 4>{x, y, u, v};
+  };
+  if (r.ok() && !d.contacts.empty() &&
+      key(a, b, c.sub_a, c.sub_b) <= key(previous_a, previous_b, previous_sub_a, previous_sub_b))
+    r.fail(c.at, "contact: not in ascending (a, b, sub_a, sub_b) order");
+  previous_a = a;
+  previous_b = b;
+  previous_sub_a = c.sub_a;
+  previous_sub_b = c.sub_b;
   if (c.point_count() > 4) r.fail(c.points_at, "contact points: more than four");
   if (c.reported() && c.point_count() == 0)
     r.fail(c.points_at, "contact points: reported without points");
@@ -539,10 +587,10 @@ inline void read_contact(StateReader& r, Decoded& d, std::uint64_t& previous_a,
     DecodedPoint point;
     point.at = r.at();
     point.feature_a = r.var("feature on a", 32);
-    if (point.feature_a > 1023) r.fail(point.at, "feature on a: beyond 1023");
+    if (point.feature_a > 65535) r.fail(point.at, "feature on a: beyond 65535");
     point.feature_b_at = r.at();
     point.feature_b = r.var("feature on b", 32);
-    if (point.feature_b > 1023) r.fail(point.feature_b_at, "feature on b: beyond 1023");
+    if (point.feature_b > 65535) r.fail(point.feature_b_at, "feature on b: beyond 65535");
     point.normal_impulse_at = r.at();
     point.normal_impulse = r.vfixed("normal impulse");
     point.tangent_impulse_1 = r.vfixed("tangent impulse 1");
@@ -600,7 +648,7 @@ inline void read_joint(StateReader& r, Decoded& d, std::uint64_t& previous_id) {
   d.joints.push_back(j);
 }
 
-/// Decodes a whole v4 state; `ok` is false and `error` names the first problem otherwise (what was
+/// Decodes a whole v5 state; `ok` is false and `error` names the first problem otherwise (what was
 /// decoded up to there is kept).
 inline Decoded decode(std::span<const std::uint8_t> bytes) {
   Decoded d;
@@ -611,7 +659,7 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
   if (r.ok() && d.version != kStateVersion) r.fail(4, "version");
   const std::size_t count_at = r.at();
   const std::uint64_t sections = r.var("section count", 64);
-  if (r.ok() && sections != kSectionCount) r.fail(count_at, "section count: not 5");
+  if (r.ok() && sections != kSectionCount) r.fail(count_at, "section count: not 6");
   for (std::size_t i = 0; i < kSectionCount && r.ok(); ++i) {
     // The section's record: its name, its version, its payload's length; the payload must end
     // exactly where the length says.
@@ -623,7 +671,7 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
     if (r.ok() && name != kSectionNames[i])
       r.fail(d.section_at[i], std::string("section name: not ") + kSectionNames[i]);
     const std::size_t version_at = r.at();
-    if (r.var("section version", 32) != kSectionVersion && r.ok())
+    if (r.var("section version", 32) != kSectionVersions[i] && r.ok())
       r.fail(version_at, "section version");
     d.section_length_at[i] = r.at();
     const std::uint32_t length = r.u32("section length");
@@ -643,7 +691,20 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
         for (std::uint64_t& word : d.rng)
           word = r.u64("rng");
         break;
-      case 2: {
+      case kGeometry: {
+        d.geometry_count_at = r.at();
+        const std::uint64_t count = r.var("geometry count", 64);
+        for (std::uint64_t k = 0; k < count && r.ok(); ++k) {
+          DecodedGeometry g;
+          g.at = r.at();
+          g.type = r.u8("geometry type");
+          if (r.ok() && (g.type < 1 || g.type > 4)) r.fail(g.at, "geometry type: not 1 to 4");
+          g.hash = r.u64("geometry hash");
+          d.geometries.push_back(g);
+        }
+        break;
+      }
+      case kBodies: {
         d.property_count_at = r.at();
         const std::uint32_t set_count = r.u32("property-set count");
         for (std::uint32_t k = 0; k < set_count && r.ok(); ++k) {
@@ -662,7 +723,7 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
         if (r.ok() && used != d.sets.size()) r.fail(d.property_count_at, "property set: unused");
         break;
       }
-      case 4: {
+      case kJoints: {
         d.next_joint_id_at = r.at();
         d.next_joint_id = r.u32("next joint ID");
         if (r.ok() && d.next_joint_id == 0) r.fail(d.next_joint_id_at, "next joint ID: zero");
@@ -678,8 +739,10 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
         const std::uint32_t contact_count = r.u32("contact count");
         std::uint64_t previous_a = 0;
         std::uint64_t previous_b = 0;
+        std::uint64_t previous_sub_a = 0;
+        std::uint64_t previous_sub_b = 0;
         for (std::uint32_t k = 0; k < contact_count && r.ok(); ++k)
-          read_contact(r, d, previous_a, previous_b);
+          read_contact(r, d, previous_a, previous_b, previous_sub_a, previous_sub_b);
         break;
       }
     }
@@ -739,14 +802,21 @@ inline void write_set(StateWriter& w, const DecodedSet& s) {
       w.vvec3(s.shape.half_extents);
       break;
     case ShapeType::capsule:
+    case ShapeType::cylinder:
       w.vfixed(s.shape.radius);
       w.vfixed(s.shape.half_height);
+      break;
+    case ShapeType::convex:
+    case ShapeType::compound:
+      w.var(s.shape.geometry.value);
       break;
     default:
       break;
   }
   w.vfixed(s.mass);
   w.vvec3(s.inertia);
+  w.vvec3(s.center_of_mass);
+  w.vquat(s.inertia_axes);
   w.vfixed(s.friction);
   w.vfixed(s.restitution);
   w.vfixed(s.linear_damping);
@@ -774,6 +844,10 @@ inline void write_contact(StateWriter& w, const DecodedContact& c) {
   w.var(c.a_step);
   w.var(c.b_minus_a);
   w.u8(c.points_byte);
+  if ((c.points_byte & kSubShapes) != 0) {
+    w.var(c.sub_a);
+    w.var(c.sub_b);
+  }
   for (const DecodedPoint& p : c.points) {
     w.var(p.feature_a);
     w.var(p.feature_b);
@@ -807,7 +881,7 @@ inline void write_joint(StateWriter& w, const DecodedJoint& j) {
   if ((j.flags & kJointHasUserData) != 0) w.var(j.user_data);
 }
 
-/// The v4 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
+/// The v5 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
 /// sizes of the vectors, the section lengths those of the payloads written).
 inline Bytes encode(const Decoded& d) {
   StateWriter payloads[kSectionCount];
@@ -831,20 +905,25 @@ inline Bytes encode(const Decoded& d) {
   globals.fixed(def.sleep_angular_speed);
   globals.fixed(def.time_to_sleep);
   for (const std::uint64_t word : d.rng)
-    payloads[1].u64(word);
-  payloads[2].u32(static_cast<std::uint32_t>(d.sets.size()));
+    payloads[kRngSection].u64(word);
+  payloads[kGeometry].var(d.geometries.size());
+  for (const DecodedGeometry& g : d.geometries) {
+    payloads[kGeometry].u8(g.type);
+    payloads[kGeometry].u64(g.hash);
+  }
+  payloads[kBodies].u32(static_cast<std::uint32_t>(d.sets.size()));
   for (const DecodedSet& s : d.sets)
-    write_set(payloads[2], s);
-  payloads[2].u32(static_cast<std::uint32_t>(d.bodies.size()));
+    write_set(payloads[kBodies], s);
+  payloads[kBodies].u32(static_cast<std::uint32_t>(d.bodies.size()));
   for (const DecodedBody& b : d.bodies)
-    write_body(payloads[2], b);
-  payloads[3].u32(static_cast<std::uint32_t>(d.contacts.size()));
+    write_body(payloads[kBodies], b);
+  payloads[kContacts].u32(static_cast<std::uint32_t>(d.contacts.size()));
   for (const DecodedContact& c : d.contacts)
-    write_contact(payloads[3], c);
-  payloads[4].u32(d.next_joint_id);
-  payloads[4].u32(static_cast<std::uint32_t>(d.joints.size()));
+    write_contact(payloads[kContacts], c);
+  payloads[kJoints].u32(d.next_joint_id);
+  payloads[kJoints].u32(static_cast<std::uint32_t>(d.joints.size()));
   for (const DecodedJoint& j : d.joints)
-    write_joint(payloads[4], j);
+    write_joint(payloads[kJoints], j);
 
   StateWriter w;
   w.u32(d.magic);
@@ -855,7 +934,7 @@ inline Bytes encode(const Decoded& d) {
     w.var(name.size());
     for (const char c : name)
       w.u8(static_cast<std::uint8_t>(c));
-    w.var(kSectionVersion);
+    w.var(kSectionVersions[i]);
     const Bytes payload = payloads[i].take();
     w.u32(static_cast<std::uint32_t>(payload.size()));
     for (const std::uint8_t b : payload)

@@ -26,6 +26,19 @@ namespace detsim::sim_detail {
 inline constexpr std::size_t max_hull_points = 4096;
 inline constexpr std::size_t max_hull_vertices = 256;
 
+/// The thinnest cloud that makes a hull: 2^-10 m (about a millimetre). Points all within this of
+/// one line or one plane (measured from the line or plane through the cloud's most spread points)
+/// are refused as flat: such a solid's volume and inertia would be mostly rounding.
+inline constexpr Fixed hull_min_thickness = Fixed::from_raw(Fixed::one_raw >> 10);
+
+/// The builder's tolerance for a hull whose points span `extent` (the largest side of their
+/// bounding box): 2^-20 m (about a micrometre) plus 2^-26 of the extent. A point within it of a
+/// face's plane is on the face; triangles whose corners are within it of one plane are merged;
+/// a point within it outside the hull may be left out (the hull is then that much smaller).
+[[nodiscard]] constexpr Fixed hull_tolerance(Fixed extent) noexcept {
+  return Fixed::from_raw(Fixed::one_raw >> 20) + (extent >> 26);
+}
+
 /// One face: a convex polygon, its outward unit normal and plane offset (dot(normal, x) = offset
 /// for x on the plane), and its vertices, counter-clockwise seen from outside, as the slice
 /// [first, first + count) of Hull::face_vertices. Coplanar triangles are merged into one face.
@@ -36,7 +49,8 @@ struct HullFace {
   std::uint16_t count = 0;
 };
 
-/// One edge, each stored once: vertices a < b, and the faces on either side.
+/// One edge, each stored once: vertices a < b, and the faces on either side: face_0's loop runs
+/// a -> b, face_1's runs b -> a.
 struct HullEdge {
   std::uint16_t a = 0;
   std::uint16_t b = 0;
@@ -68,10 +82,18 @@ struct Hull {
   Fixed inner_radius;     ///< the smallest distance from the centroid to a face plane
 };
 
+/// The volume, centroid and inertia of the solid bounded by `hull`'s faces (its vertices, faces
+/// and face_vertices must be filled), by the divergence theorem (hull_mass.cpp). Refuses a solid
+/// whose volume or moments would leave the Fixed range (a hull more than ~1290 m across).
+[[nodiscard]] Expected<SolidProperties> solid_properties(const Hull& hull);
+
 /// Builds the hull of `points` (at most max_hull_points; components within +-10^4 m). Duplicate,
 /// coplanar and interior points are fine. Refuses, with a message naming what is wrong: too many
-/// points, fewer than 4 points that are not coplanar (a flat or degenerate cloud, including one
-/// thinner than about a millimetre), or a hull with more than max_hull_vertices corners.
+/// points, a component beyond +-10^4 m, fewer than 4 points that are not coplanar (a flat or
+/// degenerate cloud, including one thinner than hull_min_thickness), a hull with more than
+/// max_hull_vertices corners, or a solid too large for solid_properties. Every vertex of the
+/// result is one of the points and a true corner (on at least three faces); every point is inside
+/// the hull or within hull_tolerance of it.
 [[nodiscard]] Expected<Hull> build_hull(std::span<const Vec3> points);
 
 /// The point of `hull` farthest along `direction` (any length, not zero); ties go to the lowest

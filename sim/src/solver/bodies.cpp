@@ -151,11 +151,18 @@ void SolverBodies::integrate_positions() {
       angular += clamp_speed(p.angular, s.def.max_angular_speed);
       p = {};
     }
-    b.position += dp;
+    // The centre of mass moves; the body turns about it, and its origin follows. A body whose
+    // centre is its origin moves its position by the same dp (the same bits, no rotation).
+    d.center += dp;
     d.delta_position += dp;
     if (angular != Vec3{}) {
       b.orientation = integrate(b.orientation, angular, h);
       d.delta_angle += angular * h;
+    }
+    if (b.center_of_mass == Vec3{}) {
+      b.position += dp;
+    } else {
+      b.position = d.center - rotate(b.orientation, b.center_of_mass);
     }
   }
 }

@@ -125,9 +125,9 @@ void ContactSolver::prepare_constraint(std::size_t ci) {
   for (std::size_t p = 0; p < c.point_count; ++p) {
     const ContactPoint& mp = c.manifold.points[p];
     SolverPoint& sp = k.points[p];
-    // The contact point relative to each body's centre at the start of the step.
-    const Vec3 anchor_a = mp.point - a.position;
-    const Vec3 anchor_b = mp.point - b.position;
+    // The contact point relative to each body's centre of mass at the start of the step.
+    const Vec3 anchor_a = mp.point - da.center;
+    const Vec3 anchor_b = mp.point - db.center;
     sp.base_separation = mp.separation;
     sp.separation = mp.separation;
     sp.normal = make_row(da, db, anchor_a, anchor_b, normal);

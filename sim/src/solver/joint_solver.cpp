@@ -252,9 +252,11 @@ void JointSolver::update_geometry(JointConstraint& k, bool held) {
   const BodyState& b = s_.bodies[k.bodies.b];
   const Derived& da = s_.derived[k.bodies.a];
   const Derived& db = s_.derived[k.bodies.b];
-  k.anchor_a = rotate(a.orientation, j.local_anchor_a);
-  k.anchor_b = rotate(b.orientation, j.local_anchor_b);
-  const Vec3 separation = (b.position + k.anchor_b) - (a.position + k.anchor_a);
+  // The anchors relative to each body's centre of mass (the lever arms); local anchors are kept
+  // relative to the origin, which is the centre for every primitive (x - 0 = x exactly).
+  k.anchor_a = rotate(a.orientation, j.local_anchor_a - a.center_of_mass);
+  k.anchor_b = rotate(b.orientation, j.local_anchor_b - b.center_of_mass);
+  const Vec3 separation = (db.center + k.anchor_b) - (da.center + k.anchor_a);
   // The twist (hinge motor and limit, swing-twist's twist range) and the swing (swing-twist's
   // cone) at the present poses.
   const bool twists =

@@ -2,7 +2,7 @@
 // writes, and that replays, desync reports, diff and bisect read without knowing what each section
 // holds.
 //
-//   u32 magic "DSIM", u32 encoding version (3), var section count, then each section:
+//   u32 magic "DSIM", u32 encoding version (5), var section count, then each section:
 //   var name length, the name (1..32 bytes of a-z 0-9 _ .), var section version, u32 payload
 //   length, the payload.
 //
@@ -23,7 +23,7 @@ namespace detsim {
 
 /// The version of the canonical state encoding that World::save() writes and World::restore()
 /// reads. Replays record it: a keyframe can be restored only by a build that reads it.
-inline constexpr std::uint32_t state_encoding_version = 4;
+inline constexpr std::uint32_t state_encoding_version = 5;
 
 /// The longest section name.
 inline constexpr std::size_t max_section_name = 32;

@@ -16,8 +16,12 @@
 
 #include <detsim/core/rng.hpp>
 #include <detsim/core/status.hpp>
+#include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
+#include <detsim/sim/geometry.hpp>
 #include <detsim/sim/joint.hpp>
+#include <detsim/sim/mass.hpp>
+#include <detsim/sim/shape_outline.hpp>
 #include <detsim/sim/state_sections.hpp>
 #include <detsim/sim/world_def.hpp>
 
@@ -35,10 +39,15 @@ struct BodyState {
   Shape shape{};
   Vec3 position{};
   Quat orientation{};
-  Vec3 linear_velocity{};
+  Vec3 linear_velocity{};   ///< of the centre of mass (the origin, for the primitives)
   Vec3 angular_velocity{};  ///< world space
   Fixed mass{};    ///< kg: what the body weighs while dynamic (kept while kinematic or static)
-  Vec3 inertia{};  ///< principal moments in the body frame, kg m^2, like mass
+  Vec3 inertia{};  ///< principal moments, kg m^2, like mass (about inertia_axes)
+  /// The centre of mass in the body frame (m): what the body rotates about. Zero for the
+  /// primitives; world_center() gives it in world space. Set from the shape, like mass.
+  Vec3 center_of_mass{};
+  /// The principal axes of inertia in the body frame (MassProperties::inertia_axes).
+  Quat inertia_axes{};
   Fixed friction{};
   Fixed restitution{};
   Fixed linear_damping{};
@@ -52,6 +61,10 @@ struct BodyState {
   Fixed sleep_time{};  ///< seconds the body has been slow enough to sleep
   Vec3 force{};        ///< accumulated for the next step, then cleared
   Vec3 torque{};
+
+  /// The centre of mass in world space: position + orientation * center_of_mass. linear_velocity
+  /// is this point's velocity.
+  [[nodiscard]] Vec3 world_center() const noexcept;
 
   friend constexpr bool operator==(const BodyState&, const BodyState&) noexcept = default;
 };
@@ -94,6 +107,10 @@ struct ContactPointState {
 struct ContactState {
   BodyId a{};  ///< the lower ID
   BodyId b{};
+  /// The sub-shapes in touch: a compound's part or a surface's triangle (0 for a whole shape). A
+  /// body pair has one contact per pair of sub-shapes, ascending (a, b, sub_a, sub_b).
+  std::uint32_t sub_a = 0;
+  std::uint32_t sub_b = 0;
   bool touching = false;  ///< had at least one point at the last narrowphase
   bool reported = false;  ///< in touch as contact events report it
   std::uint8_t point_count = 0;
@@ -150,6 +167,51 @@ class World {
   /// Steps taken since creation (restored by restore()).
   [[nodiscard]] std::uint64_t frame() const noexcept;
 
+  // ---- Geometry: immutable, registered once, referred to by ID (docs/SIM.md, "Shapes") ----
+
+  /// Registers the convex hull of `points` (body frame, metres): duplicate, coplanar and interior
+  /// points are fine, and their order does not matter. Refused, with a message naming what is
+  /// wrong: more than 4096 points, a component beyond +-10^4 m, fewer than 4 points that are not
+  /// coplanar (a flat or degenerate cloud), or a hull of more than 256 corners.
+  Expected<GeometryId> create_convex_hull(std::span<const Vec3> points);
+  /// Registers a triangle mesh (body frame, metres) for static bodies (Shape::mesh): `indices`
+  /// read as triples into `vertices`, each counter-clockwise seen from the side its normal points
+  /// to (a mesh is two-sided: rays hit either side). Degenerate triangles (repeated indices, zero
+  /// area, or too small for a reliable normal: every component of twice the area vector below
+  /// 2^-24 m^2) are dropped and counted (mesh_dropped_triangles); the others keep
+  /// their input order, which is the order of triangle indices. Refused, with a message naming what
+  /// is wrong and registering nothing: an index count not divisible by 3; more than 2^20 triangles
+  /// or vertices; a vertex component beyond +-10^4 m; an index out of range ("invalid mesh:
+  /// triangle 7: index 3 is 12, but there are 10 vertices"); no triangle left.
+  Expected<GeometryId> create_mesh(std::span<const Vec3> vertices,
+                                   std::span<const std::uint32_t> indices);
+  /// Registers a heightfield (HeightfieldDef: a grid of heights in the local x-z plane) for static
+  /// bodies (Shape::heightfield). Refused, with a message naming the field and registering
+  /// nothing: rows or columns outside 2..4096, a heights count other than rows * columns, a cell
+  /// size below 2^-10 m or a grid wider than 10^4 m, a height beyond +-10^4 m.
+  Expected<GeometryId> create_heightfield(const HeightfieldDef& def);
+  /// How many of the triangles given to create_mesh were dropped as degenerate. Not part of the
+  /// content hash: two inputs that differ only by degenerate triangles are the same mesh. An error
+  /// for an unknown ID or a geometry that is not a triangle mesh.
+  [[nodiscard]] Expected<std::uint32_t> mesh_dropped_triangles(GeometryId id) const;
+  /// Registers a compound of `children` (1 to 64): spheres, boxes, capsules, cylinders and convex
+  /// hulls of this world, each placed by its position (metres) and unit orientation in the
+  /// compound's frame (Shape::compound). The parts must not overlap: mass properties treat the
+  /// compound as their sum, one density throughout, so the centre of mass is wherever the parts
+  /// put it. Refused, with a message naming the child and what is wrong: no children, more than
+  /// 64, a shape that is not one of those (a plane, a mesh, a heightfield, a compound, or an
+  /// invalid size or geometry ID), a non-unit orientation, a position component beyond +-10^4 m,
+  /// or a volume or moment of inertia per unit mass above the limits (2^31 - 1).
+  Expected<GeometryId> create_compound(std::span<const CompoundChild> children);
+  /// Registered geometries, 0 .. n-1 being IDs 1 .. n (geometry is never removed).
+  [[nodiscard]] std::size_t geometry_count() const noexcept;
+  /// The content hash of a geometry (XXH3-64 of its canonical encoding, docs/STATE.md): equal
+  /// for equal geometry in any world, on any machine. An error for an unknown ID.
+  [[nodiscard]] Expected<std::uint64_t> geometry_hash(GeometryId id) const;
+  /// The mass properties that a dynamic body of `shape` and the given mass would have (mass > 0;
+  /// the same as detsim::mass_properties for a primitive); an error for an invalid shape.
+  [[nodiscard]] Expected<MassProperties> mass_properties(const Shape& shape, Fixed mass) const;
+
   // ---- Bodies ----
 
   /// Creates a body; its ID is the next in sequence. An invalid definition (non-positive size or
@@ -166,6 +228,10 @@ class World {
   [[nodiscard]] std::vector<BodyId> body_ids() const;
   /// A copy of a body's state, or an error for an unknown ID.
   [[nodiscard]] Expected<BodyState> body(BodyId id) const;
+  /// What a viewer draws for a body (detsim/sim/shape_outline.hpp) at its current pose: the same
+  /// as shape_outline for a primitive, and also for the shapes whose geometry is registered with
+  /// the world (convex hulls, meshes, heightfields). An error for an unknown ID.
+  [[nodiscard]] Expected<ShapeOutline> body_outline(BodyId id) const;
 
   /// Switches between kinematic and dynamic (either way, keeping the velocity) or to/from static
   /// (velocity zeroed). A dynamic body gets its mass back from its shape and definition.

@@ -1,0 +1,166 @@
+// The narrowphase of shapes with sub-shapes (collide.hpp, collide_all): a compound's parts and a
+// surface's triangles each make their own manifold, so that a body pair can touch with several
+// normals at once (a box on a stair's tread and riser, a chair's four legs on uneven ground).
+//
+// - Two shapes without sub-shapes: collide()'s one manifold, as sub-shapes (0, 0).
+// - Compounds: every pair of parts (a whole shape is its own single part) whose bounding balls
+//   come within the margin, through collide(), ascending by (part of a, part of b).
+// - A surface (mesh, heightfield; static, so never both sides): each part of the other shape
+//   against the triangles under its bounding box (the surface's overlap query, ascending), through
+//   collide_triangle, which is one-sided and gives internal edges the face normal.
+// Everything is in ascending index order, so the list depends only on the shapes and their poses.
+#include <algorithm>
+
+#include <detsim/fixed/math.hpp>
+
+#include "collide.hpp"
+#include "collide_util.hpp"
+#include "geometry/convex.hpp"
+#include "geometry/geometry.hpp"
+#include "shapes.hpp"
+
+namespace detsim::sim_detail {
+
+namespace {
+
+bool is_surface(const Geometry* g) noexcept {
+  return g != nullptr && (g->type == GeometryType::mesh || g->type == GeometryType::heightfield);
+}
+
+bool is_compound(const Geometry* g) noexcept {
+  return g != nullptr && g->type == GeometryType::compound;
+}
+
+// One part placed in the world: a whole shape is its own part 0.
+struct PlacedPart {
+  const Shape* shape;
+  const Geometry* geometry;
+  Pose pose;
+  std::uint32_t index;
+};
+
+// The parts of a shape that is not a surface, placed by its pose.
+void parts_of(const PosedShape& s, std::vector<PlacedPart>& out) {
+  out.clear();
+  if (!is_compound(s.geometry)) {
+    out.push_back({&s.shape, s.geometry, s.pose, 0});
+    return;
+  }
+  const Compound& c = s.geometry->compound();
+  for (std::size_t i = 0; i < c.parts.size(); ++i) {
+    const CompoundPart& part = c.parts[i];
+    out.push_back({&part.child.shape, part.geometry.get(),
+                   Pose{s.pose.position + s.pose.rotation * part.child.position,
+                        s.pose.rotation * part.rotation},
+                   static_cast<std::uint32_t>(i)});
+  }
+}
+
+Fixed part_radius(const PlacedPart& p) noexcept {
+  return shape_kind(p.shape->type).bounding_radius(*p.shape, p.geometry);
+}
+
+ConvexView view_of_part(const PlacedPart& p) noexcept {
+  return p.geometry != nullptr ? ConvexView::of_hull(p.geometry->hull()) : ConvexView::of(*p.shape);
+}
+
+void mirror(Manifold& m) noexcept {
+  m.normal = -m.normal;
+  for (std::uint8_t i = 0; i < m.count; ++i)
+    m.points[i].feature = narrow::mirror_feature(m.points[i].feature);
+}
+
+// Every part of `x` against the triangles of `surface` near it: (part, triangle) manifolds.
+void against_surface(const PosedShape& x, const PosedShape& surface, Fixed margin,
+                     std::vector<SubManifold>& out) {
+  std::vector<PlacedPart> parts;
+  parts_of(x, parts);
+  const Mat3 to_surface = transpose(surface.pose.rotation);
+  const Geometry& g = *surface.geometry;
+  const bool mesh = g.type == GeometryType::mesh;
+  std::vector<std::uint32_t> triangles;
+  for (const PlacedPart& part : parts) {
+    // The part's world box, in the surface's frame: its centre moved in, its extent turned.
+    const ShapeKind& kind = shape_kind(part.shape->type);
+    const Vec3 e = kind.aabb_extent(*part.shape, part.geometry, part.pose.rotation) +
+                   Vec3{margin, margin, margin};
+    const Vec3 c = to_surface * (part.pose.position - surface.pose.position);
+    const auto row = [&e](Vec3 m) { return abs(m.x) * e.x + abs(m.y) * e.y + abs(m.z) * e.z; };
+    const Vec3 extent{row(to_surface.rows[0]), row(to_surface.rows[1]), row(to_surface.rows[2])};
+    triangles.clear();
+    if (mesh) {
+      overlap(g.mesh(), c - extent, c + extent, triangles);
+    } else {
+      overlap(g.heightfield(), c - extent, c + extent, triangles);
+    }
+    const ConvexView view = view_of_part(part);
+    for (const std::uint32_t t : triangles) {
+      const TriangleData tri = mesh ? triangle(g.mesh(), t) : triangle(g.heightfield(), t);
+      const Manifold m = collide_triangle(view, part.pose, tri, surface.pose, margin);
+      if (m.count > 0) out.push_back({part.index, t, m});
+    }
+  }
+}
+
+}  // namespace
+
+std::uint32_t sub_shape_count(const Shape&, const Geometry* g) noexcept {
+  if (g == nullptr) return 1;
+  switch (g->type) {
+    case GeometryType::convex_hull:
+      return 1;
+    case GeometryType::mesh:
+      return triangle_count(g->mesh());
+    case GeometryType::heightfield:
+      return triangle_count(g->heightfield());
+    case GeometryType::compound:
+      return static_cast<std::uint32_t>(g->compound().parts.size());
+  }
+  return 1;
+}
+
+bool has_sub_shapes(const PosedShape& s) noexcept {
+  return is_surface(s.geometry) || is_compound(s.geometry);
+}
+
+void collide_all(const PosedShape& a, const PosedShape& b, Fixed margin,
+                 std::vector<SubManifold>& out) {
+  out.clear();
+  if (!has_sub_shapes(a) && !has_sub_shapes(b)) {
+    const Manifold m = collide(a, b, margin);
+    if (m.count > 0) out.push_back({0, 0, m});
+    return;
+  }
+  if (is_surface(b.geometry)) {
+    if (is_surface(a.geometry)) return;  // two static surfaces never touch
+    against_surface(a, b, margin, out);
+    return;
+  }
+  if (is_surface(a.geometry)) {
+    against_surface(b, a, margin, out);
+    for (SubManifold& m : out) {
+      std::swap(m.sub_a, m.sub_b);
+      mirror(m.manifold);
+    }
+    std::sort(out.begin(), out.end(), [](const SubManifold& x, const SubManifold& y) {
+      return x.sub_a != y.sub_a ? x.sub_a < y.sub_a : x.sub_b < y.sub_b;
+    });
+    return;
+  }
+  // Compounds: part against part, culled by bounding balls.
+  std::vector<PlacedPart> parts_a;
+  std::vector<PlacedPart> parts_b;
+  parts_of(a, parts_a);
+  parts_of(b, parts_b);
+  for (const PlacedPart& pa : parts_a) {
+    const Fixed ra = part_radius(pa);
+    for (const PlacedPart& pb : parts_b) {
+      if (distance(pa.pose.position, pb.pose.position) > ra + part_radius(pb) + margin) continue;
+      const Manifold m =
+          collide({*pa.shape, pa.geometry, pa.pose}, {*pb.shape, pb.geometry, pb.pose}, margin);
+      if (m.count > 0) out.push_back({pa.index, pb.index, m});
+    }
+  }
+}
+
+}  // namespace detsim::sim_detail
