@@ -74,7 +74,7 @@ Expected<SolidProperties> solid_properties(const Hull& hull) {
   detail::ProductSum six_volume;
   std::array<detail::ProductSum, 3> first;   // sum of det * s_i          (24 first moment)
   std::array<detail::ProductSum, 6> second;  // sum of det * X_ij        (120 second moment)
-  constexpr std::array<std::array<std::size_t, 2>, 6> kPairs{
+  constexpr std::array<std::array<std::size_t, 2>, 6> kMomentPairs{
       {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
   for (const HullFace& face : hull.faces) {
     const std::uint16_t* loop = hull.face_vertices.data() + face.first;
@@ -87,9 +87,9 @@ Expected<SolidProperties> solid_properties(const Hull& hull) {
       six_volume.add_product(det.raw(), Fixed::one().raw());
       for (std::size_t i = 0; i < 3; ++i)
         first[i].add_product(det.raw(), component(sum, i).raw());
-      for (std::size_t e = 0; e < kPairs.size(); ++e) {
-        const std::size_t i = kPairs[e][0];
-        const std::size_t j = kPairs[e][1];
+      for (std::size_t e = 0; e < kMomentPairs.size(); ++e) {
+        const std::size_t i = kMomentPairs[e][0];
+        const std::size_t j = kMomentPairs[e][1];
         detail::ProductSum x;
         for (const Vec3 v : {a, b, c, sum})
           x.add_product(component(v, i).raw(), component(v, j).raw());
@@ -105,9 +105,9 @@ Expected<SolidProperties> solid_properties(const Hull& hull) {
   const Vec3 centroid{first[0].to_fixed() / four_v6, first[1].to_fixed() / four_v6,
                       first[2].to_fixed() / four_v6};
   std::array<Fixed, 6> cov{};  // about the centroid: E[x_i x_j] - c_i c_j
-  for (std::size_t e = 0; e < kPairs.size(); ++e) {
-    const Fixed ci = component(centroid, kPairs[e][0]);
-    const Fixed cj = component(centroid, kPairs[e][1]);
+  for (std::size_t e = 0; e < kMomentPairs.size(); ++e) {
+    const Fixed ci = component(centroid, kMomentPairs[e][0]);
+    const Fixed cj = component(centroid, kMomentPairs[e][1]);
     cov[e] = second[e].to_fixed() / twenty_v6 - ci * cj;
   }
   // Inertia per unit mass: trace(cov) E - cov.
