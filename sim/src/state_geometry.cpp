@@ -67,7 +67,7 @@ bool read_geometry(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
               " geometries): register the same geometry, in the same order, before restoring";
       return false;
     }
-    const Geometry& have = *s.geometries[i];
+    const Geometry& have = *s.geometries[static_cast<std::size_t>(i)];
     if (have.type != t || have.hash != hash) {
       error = "byte " + std::to_string(at) + ": the state needs " + named + ", but this world's " +
               id + " is a " + geometry_type_name(have.type) + " of content hash " + hex(have.hash) +
