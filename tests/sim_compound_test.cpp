@@ -445,5 +445,47 @@ TEST(Compound, ASpinningDumbbellKeepsItsMomentum) {
               worst_centre, worst_momentum);
 }
 
+TEST(Compound, RestsOnAPlaneOnItsLowestParts) {
+  // A stool of a seat and four legs of different kinds (box, capsule, cylinder, hull, each
+  // reaching y = 0 in the body's frame) dropped from 0.5 m onto a plane, and onto a plane turned
+  // 0.3 rad: every part meets a plane (a plane is unbounded: no bounding ball can cull it), and
+  // the stool comes to rest on its four feet at the plane's height (within the contact slop, 1 cm)
+  // and upright. On the slope its centre of mass (0.35 m up) leans 0.35 tan 0.3 = 0.11 m downhill,
+  // inside the feet's 0.2 m: it stands.
+  for (const Fixed tilt : {0_fx, 0.3_fx}) {
+    World w = make_world();
+    const Quat ground_turn = from_axis_angle(Vec3::unit_z(), tilt);
+    BodyDef ground;
+    ground.type = BodyType::static_body;
+    ground.shape = Shape::plane();
+    ground.orientation = ground_turn;
+    ground.friction = 1_fx;  // tan 0.3 < 1: the stool does not slide on the turned plane
+    add(w, ground);
+    const auto hull = w.create_convex_hull(box_corners({0.03_fx, 0.25_fx, 0.03_fx}));
+    ASSERT_TRUE(hull.ok()) << hull.message();
+    const GeometryId g =
+        compound(w, {{Shape::box({0.3_fx, 0.03_fx, 0.3_fx}), {0_fx, 0.53_fx, 0_fx}, kNone},
+                     {Shape::box({0.03_fx, 0.25_fx, 0.03_fx}), {-0.2_fx, 0.25_fx, -0.2_fx}, kNone},
+                     {Shape::capsule(0.03_fx, 0.22_fx), {0.2_fx, 0.25_fx, -0.2_fx}, kNone},
+                     {Shape::cylinder(0.03_fx, 0.25_fx), {-0.2_fx, 0.25_fx, 0.2_fx}, kNone},
+                     {Shape::convex(*hull), {0.2_fx, 0.25_fx, 0.2_fx}, kNone}});
+    BodyDef d;
+    d.shape = Shape::compound(g);
+    d.orientation = ground_turn;
+    d.position = rotate(ground_turn, Vec3{0_fx, 0.5_fx, 0_fx});
+    const BodyId id = add(w, d);
+    for (int f = 0; f < 180; ++f)
+      w.step();
+    const BodyState b = state(w, id);
+    // The feet are the body's frame's y = 0: the origin's height above the turned plane.
+    const Vec3 up = rotate(ground_turn, Vec3::unit_y());
+    const Fixed height = dot(b.position, up);
+    EXPECT_GT(height, -0.01_fx) << "tilt " << to_string(tilt) << ": " << to_string(height);
+    EXPECT_LT(height, 0.01_fx) << "tilt " << to_string(tilt) << ": " << to_string(height);
+    EXPECT_GT(dot(rotate(b.orientation, Vec3::unit_y()), up), 0.999_fx) << to_string(tilt);
+    EXPECT_LT(length(b.linear_velocity), 0.01_fx) << to_string(tilt);
+  }
+}
+
 }  // namespace
 }  // namespace detsim

@@ -147,7 +147,8 @@ void collide_all(const PosedShape& a, const PosedShape& b, Fixed margin,
     });
     return;
   }
-  // Compounds: part against part, culled by bounding balls.
+  // Compounds: part against part, culled by bounding balls (an unbounded shape, a plane, has
+  // radius 0 and is never culled).
   std::vector<PlacedPart> parts_a;
   std::vector<PlacedPart> parts_b;
   parts_of(a, parts_a);
@@ -155,7 +156,9 @@ void collide_all(const PosedShape& a, const PosedShape& b, Fixed margin,
   for (const PlacedPart& pa : parts_a) {
     const Fixed ra = part_radius(pa);
     for (const PlacedPart& pb : parts_b) {
-      if (distance(pa.pose.position, pb.pose.position) > ra + part_radius(pb) + margin) continue;
+      const Fixed rb = part_radius(pb);
+      const bool bounded = ra > Fixed::zero() && rb > Fixed::zero();
+      if (bounded && distance(pa.pose.position, pb.pose.position) > ra + rb + margin) continue;
       const Manifold m =
           collide({*pa.shape, pa.geometry, pa.pose}, {*pb.shape, pb.geometry, pb.pose}, margin);
       if (m.count > 0) out.push_back({pa.index, pb.index, m});
