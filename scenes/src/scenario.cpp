@@ -60,6 +60,18 @@ constexpr std::array entries{
     Entry{{"dominoes", "30 dominoes in a row; the first is tipped over", 600, 0, 0, 0, 0, 0, false},
           scenes_detail::build_dominoes,
           nullptr},
+    Entry{{"furniture",
+           "N sets of compounds with offset centres of mass (default 4): a chair tipped back, a "
+           "hammer leaning towards its head, an upright chair",
+           600, 0, 0, 0, 4, 200, false, "sets"},
+          scenes_detail::build_furniture,
+          nullptr},
+    Entry{{"level",
+           "N each (default 8) of boxes, convex rocks, capsules and compound tables onto a "
+           "triangle-mesh level with a ramp and stairs",
+           600, 0, 0, 0, 8, 16, true, "bodies of each kind"},
+          scenes_detail::build_level,
+          nullptr},
     Entry{{"motors",
            "two cars driven by four hinge motors each: one on sphere wheels, one on capsule wheels",
            600, 0, 0, 0, 0, 0, false},
@@ -91,6 +103,12 @@ constexpr std::array entries{
            "stairs",
            600, 0, 0, 0, 4, 100, true, "ragdolls"},
           scenes_detail::build_ragdolls,
+          nullptr},
+    Entry{{"rocks",
+           "N random convex hulls (default 500; 12 RNG points each) dropped onto a heightfield of "
+           "rolling hills",
+           600, 0, 0, 0, 500, 5000, true, "rocks"},
+          scenes_detail::build_rocks,
           nullptr},
     Entry{
         {"slope", "boxes of friction 0.2 to 1.0 on a 30-degree slope: those with tan 30 > mu slide",

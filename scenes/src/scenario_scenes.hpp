@@ -32,6 +32,10 @@ void build_ragdolls(World& w, const ScenarioParams& p);
 void build_bridge(World& w, const ScenarioParams& p);
 void build_wrecking_ball(World& w, const ScenarioParams& p);
 void build_motors(World& w, const ScenarioParams& p);
+// The scenes of registered geometry (scenario_shapes.cpp).
+void build_rocks(World& w, const ScenarioParams& p);
+void build_level(World& w, const ScenarioParams& p);
+void build_furniture(World& w, const ScenarioParams& p);
 
 // Per-frame logic, run before each step. Reads only the World and the inputs.
 void control_spray(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
