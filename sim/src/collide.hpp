@@ -73,9 +73,19 @@ struct SubManifold {
 /// manifolds, one per pair of sub-shapes in touch.
 [[nodiscard]] bool has_sub_shapes(const PosedShape& s) noexcept;
 
+/// Whether a shape is a static surface of triangles (a mesh, a heightfield).
+[[nodiscard]] bool has_triangles(const PosedShape& s) noexcept;
+
+/// Manifolds of one part against a surface's triangles whose normals agree within this cosine
+/// (about 1.3 degrees) are one patch of one face: collide_all merges them into one manifold, and
+/// the narrowphase carries a patch's impulses from triangle to triangle by its normal.
+inline constexpr Fixed surface_patch_cos = Fixed::from_raw(Fixed::one_raw - (Fixed::one_raw >> 12));
+
 /// Every manifold with points between a sub-shape of `a` and one of `b` (margin as collide()),
 /// ascending by (sub_a, sub_b), into `out` (cleared first). For two whole shapes it is collide()'s
-/// manifold, as sub-shapes (0, 0), when it has points.
+/// manifold, as sub-shapes (0, 0), when it has points. Against a surface, each part's triangle
+/// manifolds of one normal (surface_patch_cos) are merged into one of at most four points, keyed
+/// by the patch's lowest triangle: a body on a floor of many triangles touches it as a plane.
 void collide_all(const PosedShape& a, const PosedShape& b, Fixed margin,
                  std::vector<SubManifold>& out);
 

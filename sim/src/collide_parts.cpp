@@ -10,12 +10,14 @@
 //   collide_triangle, which is one-sided and gives internal edges the face normal.
 // Everything is in ascending index order, so the list depends only on the shapes and their poses.
 #include <algorithm>
+#include <span>
 
 #include <detsim/fixed/math.hpp>
 
 #include "collide.hpp"
 #include "collide_util.hpp"
 #include "geometry/convex.hpp"
+#include "geometry/convex_internal.hpp"
 #include "geometry/geometry.hpp"
 #include "shapes.hpp"
 
@@ -70,7 +72,57 @@ void mirror(Manifold& m) noexcept {
     m.points[i].feature = narrow::mirror_feature(m.points[i].feature);
 }
 
-// Every part of `x` against the triangles of `surface` near it: (part, triangle) manifolds.
+// The triangle half of a merged point's feature: the patch's face, whatever triangle holds it.
+constexpr std::uint16_t kPatchFace = narrow::feature(narrow::Kind::face, 0);
+
+// Merges the (part, triangle) manifolds `tri` of one part, ascending by triangle, into `out`: the
+// manifolds whose normals agree with the first of a patch (the lowest triangle) become one
+// manifold of that normal, keyed by that triangle, of at most four of their points (reduce_into:
+// the deepest, the farthest, the most area), each named by the part's feature alone. So a box on
+// a floor of many triangles has the four points it has on a plane, and they keep their impulses
+// as it slides from triangle to triangle (collide_group matches a patch by its normal); the
+// snapshot does not grow with the number of triangles under a body.
+void merge_patches(std::span<const SubManifold> tri, Vec3 origin, std::vector<SubManifold>& out) {
+  std::vector<bool> taken(tri.size(), false);
+  std::vector<convex::Candidate> candidates;
+  for (std::size_t i = 0; i < tri.size(); ++i) {
+    if (taken[i]) continue;
+    const Vec3 n = tri[i].manifold.normal;
+    std::size_t members = 0;
+    candidates.clear();
+    for (std::size_t j = i; j < tri.size(); ++j) {
+      if (taken[j] || dot(tri[j].manifold.normal, n) < surface_patch_cos) continue;
+      taken[j] = true;
+      ++members;
+      const Manifold& m = tri[j].manifold;
+      for (std::uint8_t k = 0; k < m.count; ++k) {
+        const ContactPoint& p = m.points[k];
+        candidates.push_back(
+            {p.point - origin, p.separation,
+             narrow::pair_feature(static_cast<std::uint16_t>(p.feature & 0xFFFFU), kPatchFace)});
+      }
+    }
+    if (members == 1) {
+      out.push_back(tri[i]);
+      continue;
+    }
+    // Points of two triangles on their shared edge or vertex are one point: keep the first.
+    std::vector<convex::Candidate> unique;
+    for (const convex::Candidate& c : candidates) {
+      const bool seen = std::any_of(unique.begin(), unique.end(), [&c](const convex::Candidate& u) {
+        return u.point == c.point;
+      });
+      if (!seen) unique.push_back(c);
+    }
+    SubManifold merged{tri[i].sub_a, tri[i].sub_b, Manifold{}};
+    merged.manifold.normal = n;
+    convex::reduce_into(unique, n, origin, merged.manifold);
+    out.push_back(merged);
+  }
+}
+
+// Every part of `x` against the triangles of `surface` near it: (part, triangle) manifolds, each
+// part's merged into patches of one normal (merge_patches).
 void against_surface(const PosedShape& x, const PosedShape& surface, Fixed margin,
                      std::vector<SubManifold>& out) {
   std::vector<PlacedPart> parts;
@@ -79,6 +131,7 @@ void against_surface(const PosedShape& x, const PosedShape& surface, Fixed margi
   const Geometry& g = *surface.geometry;
   const bool mesh = g.type == GeometryType::mesh;
   std::vector<std::uint32_t> triangles;
+  std::vector<SubManifold> per_triangle;
   for (const PlacedPart& part : parts) {
     // The part's world box, in the surface's frame: its centre moved in, its extent turned.
     const ShapeKind& kind = shape_kind(part.shape->type);
@@ -94,11 +147,13 @@ void against_surface(const PosedShape& x, const PosedShape& surface, Fixed margi
       overlap(g.heightfield(), c - extent, c + extent, triangles);
     }
     const ConvexView view = view_of_part(part);
+    per_triangle.clear();
     for (const std::uint32_t t : triangles) {
       const TriangleData tri = mesh ? triangle(g.mesh(), t) : triangle(g.heightfield(), t);
       const Manifold m = collide_triangle(view, part.pose, tri, surface.pose, margin);
-      if (m.count > 0) out.push_back({part.index, t, m});
+      if (m.count > 0) per_triangle.push_back({part.index, t, m});
     }
+    merge_patches(per_triangle, part.pose.position, out);
   }
 }
 
@@ -117,6 +172,10 @@ std::uint32_t sub_shape_count(const Shape&, const Geometry* g) noexcept {
       return static_cast<std::uint32_t>(g->compound().parts.size());
   }
   return 1;
+}
+
+bool has_triangles(const PosedShape& s) noexcept {
+  return is_surface(s.geometry);
 }
 
 bool has_sub_shapes(const PosedShape& s) noexcept {

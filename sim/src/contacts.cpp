@@ -92,13 +92,28 @@ void collide_group(WorldState& s, std::size_t first, std::size_t last, std::vect
     c.reported = head.reported;
     return c;
   };
+  // Against a surface, a part's patch of one face moves from triangle to triangle (its key, the
+  // lowest triangle, changes): a manifold whose key is new takes the impulses of the old contact of
+  // the same part with the same normal, where there is one.
+  const bool surface = has_triangles(posed(s, ia)) || has_triangles(posed(s, ib));
+  const auto same_face = [&](const SubManifold& m) {
+    for (std::size_t j = first; j < last; ++j) {
+      const Contact& o = s.contacts[j];
+      if (o.sub_a == m.sub_a && o.point_count > 0 &&
+          dot(o.manifold.normal, m.manifold.normal) >= surface_patch_cos)
+        return j;
+    }
+    return last;
+  };
   for (const SubManifold& m : scratch) {
     while (old < last && (s.contacts[old].sub_a < m.sub_a ||
                           (s.contacts[old].sub_a == m.sub_a && s.contacts[old].sub_b < m.sub_b)))
       ++old;
-    Contact c = old < last && s.contacts[old].sub_a == m.sub_a && s.contacts[old].sub_b == m.sub_b
-                    ? s.contacts[old]
-                    : fresh();
+    std::size_t match =
+        old < last && s.contacts[old].sub_a == m.sub_a && s.contacts[old].sub_b == m.sub_b ? old
+                                                                                           : last;
+    if (match == last && surface) match = same_face(m);
+    Contact c = match < last ? s.contacts[match] : fresh();
     c.sub_a = m.sub_a;
     c.sub_b = m.sub_b;
     take_manifold(c, m.manifold);

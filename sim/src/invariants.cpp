@@ -5,6 +5,9 @@
 // sleep as a whole. (A sleeping or static body with a velocity is accepted by restore, and
 // fault injection makes one on purpose, so it is not an invariant.) Each check reads; none
 // changes the world. A failure names the body or pair and what is wrong.
+#include <string>
+#include <tuple>
+
 #include <detsim/core/assert.hpp>
 
 #include "world_state.hpp"
@@ -31,9 +34,12 @@ std::string validate_world(const WorldState& s) {
     const Contact& c = s.contacts[k];
     const std::string pair = "contact (" + std::to_string(c.a) + ", " + std::to_string(c.b) + "): ";
     if (c.a >= c.b) return pair + "a is not below b";
-    if (k > 0 &&
-        (s.contacts[k - 1].a > c.a || (s.contacts[k - 1].a == c.a && s.contacts[k - 1].b >= c.b)))
-      return pair + "the cache is not in ascending (a, b) order";
+    if (k > 0) {
+      const Contact& p = s.contacts[k - 1];
+      const auto key = [](const Contact& x) { return std::tuple(x.a, x.b, x.sub_a, x.sub_b); };
+      if (key(p) >= key(c))
+        return pair + "the cache is not in strictly ascending (a, b, sub_a, sub_b) order";
+    }
     if (s.find(c.a) < 0 || s.find(c.b) < 0) return pair + "names a body that does not exist";
     if (c.point_count > 4) return pair + "more than 4 points";
     if (c.touching != (c.point_count > 0)) return pair + "touching disagrees with its points";
