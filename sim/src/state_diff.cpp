@@ -6,6 +6,7 @@
 #include <detsim/sim/state_diff.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 
 #include <detsim/core/bytes.hpp>
@@ -129,8 +130,13 @@ void diff_body(Collector& c, const BodyState& a, const BodyState& b) {
   }
 }
 
+// "contact[B]" for whole shapes; "contact[B/SUB_A/SUB_B]" between sub-shapes: the body is the
+// pair's lower ID, so this is the form --inject takes with BODY = a (inject.hpp).
 std::string contact_name(const ContactState& c) {
-  return "contact[" + std::to_string(c.b.value) + "]";
+  std::string name = "contact[" + std::to_string(c.b.value);
+  if (c.sub_a != 0 || c.sub_b != 0)
+    name += "/" + std::to_string(c.sub_a) + "/" + std::to_string(c.sub_b);
+  return name + "]";
 }
 
 void diff_contact(Collector& c, const ContactState& a, const ContactState& b) {
@@ -152,11 +158,12 @@ void diff_contact(Collector& c, const ContactState& a, const ContactState& b) {
   }
 }
 
-// A merge of both contact lists, ascending (a, b); a pair on one side only is "present".
+// A merge of both contact lists, ascending (a, b, sub_a, sub_b); a contact on one side only is
+// "present".
 void diff_contacts(Collector& c, const std::vector<ContactState>& ca,
                    const std::vector<ContactState>& cb) {
   const auto key = [](const ContactState& x) {
-    return (std::uint64_t{x.a.value} << 32) | x.b.value;
+    return std::array<std::uint32_t, 4>{x.a.value, x.b.value, x.sub_a, x.sub_b};
   };
   std::size_t i = 0;
   std::size_t j = 0;

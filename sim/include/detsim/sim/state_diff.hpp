@@ -24,9 +24,12 @@ struct FieldDiff {
   std::uint32_t body = 0;
   /// e.g. "position.y", "orientation.w", "angular_velocity.x", "sleep_time", "frame", "state[2]";
   /// "present" when the body exists on one side only; for a contact of `body` with body 23:
-  /// "contact[23].point[0].normal_impulse", "contact[23].touching", "contact[23].present"; for
-  /// joint 7: "joint[7].linear_impulse.x", "joint[7].broken", "joint[7].present"; for the geometry
-  /// that the state names (registered geometry 3): "geometry[3]", with the values as the type and
+  /// "contact[23].point[0].normal_impulse", "contact[23].touching", "contact[23].present"; a
+  /// contact between sub-shapes (a compound's part, a surface's triangle) other than 0 and 0 names
+  /// them after the other body: "contact[23/2/0].touching" (sub-shape 2 of `body` against
+  /// sub-shape 0 of body 23), the syntax --inject takes (inject.hpp); for joint 7:
+  /// "joint[7].linear_impulse.x", "joint[7].broken", "joint[7].present"; for the geometry that
+  /// the state names (registered geometry 3): "geometry[3]", with the values as the type and
   /// content hash ("convex hull, content hash 0x..." or "absent").
   std::string field;
   std::string a;  ///< the value in A: decimal, then the raw bits ("0.5 (0x0000000080000000)")
