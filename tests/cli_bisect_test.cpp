@@ -3,6 +3,7 @@
 // reports, the faulty one reports the flagged frame, bisect names the frame, body and field) for
 // every field class, the other outcomes (identical, different runs, different inputs), the HTML
 // report, and bad usage.
+#include <optional>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -110,6 +111,77 @@ TEST(CliBisect, AJointsFieldIsNamedLikeABodysField) {
   r = detsim_cli("run --scenario chain --frames 100 --inject 50:0:joint[999].motor_speed:1");
   EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
   EXPECT_TRUE(has(r.err, "no joint with ID 999")) << r.err;
+}
+
+/// A scene of registered geometry (level: a triangle mesh, convex rocks, compound tables) end to
+/// end: a contact between sub-shapes is injected under the name diff gives it
+/// (contact[OTHER/S/T]); bisect restores both reports against the scenario's geometry, names that
+/// contact exactly, and its HTML draws the mesh, the hulls and the compounds.
+TEST(CliBisect, AGeometrySceneIsBisectedToTheSubShapeContact) {
+  Scenario level = Scenario::create("level", {.seed = 1, .count = 2}).value();
+  std::optional<ContactState> pick;
+  while (!pick && level.world().frame() < 200) {
+    level.step();
+    for (const ContactState& c : level.world().contacts())
+      if (!pick && c.point_count > 0 && c.sub_a != 0) pick = c;
+  }
+  ASSERT_TRUE(pick.has_value()) << "no contact with a sub-shape by frame 200";
+  const std::string frame = std::to_string(level.world().frame());
+  const std::string field = "contact[" + std::to_string(pick->b.value) + "/" +
+                            std::to_string(pick->sub_a) + "/" + std::to_string(pick->sub_b) +
+                            "].point[0].normal_impulse";
+  const std::string inject = frame + ":" + std::to_string(pick->a.value) + ":" + field + ":0.25";
+  SCOPED_TRACE("--inject " + inject);
+
+  TempFile faulty("faulty.dsr");
+  TempFile healthy_report("healthy.dsd");
+  TempFile faulty_report("faulty.dsd");
+  TempFile html("bisect.html");
+  auto r = detsim_cli("run --scenario level --count 2 --frames 250 --record " + faulty.path() +
+                      " --inject " + inject);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = detsim_cli("verify " + faulty.path() + " --report " + healthy_report.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "first_mismatch"), frame) << r.out;
+  r = detsim_cli("verify " + faulty.path() + " --inject " + inject + " --report " +
+                 faulty_report.path() + " --at " + frame);
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = detsim_cli("bisect " + healthy_report.path() + " " + faulty_report.path() +
+                 " --json --html " + html.path());
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "first_divergent_frame"), frame) << r.out;
+  EXPECT_TRUE(has(r.out, R"("diffs":[{"subsystem":"contacts","body":)" +
+                             std::to_string(pick->a.value) + R"(,"field":")" + field + "\""))
+      << r.out;
+  EXPECT_TRUE(has(r.out, R"(}],"diffs_omitted":0)")) << "exactly one difference: " << r.out;
+  // The faulty replay against the healthy report: this machine re-simulates the scenario, with
+  // its geometry, and agrees with the report.
+  r = detsim_cli("bisect " + faulty.path() + " " + healthy_report.path());
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "DIVERGED at frame " + frame)) << r.out;
+  EXPECT_TRUE(has(r.out, "this machine's re-simulation agrees with: B")) << r.out;
+
+  // Every body is drawn: the mesh as its triangles, rocks as polygons, tables as their parts.
+  const std::string page = read_text(html.path());
+  for (const BodyId id : level.world().body_ids()) {
+    const ShapeType type = level.world().body(id).value().shape.type;
+    const std::string title = "<title>body " + std::to_string(id.value) + " (";
+    const std::size_t at = page.find(title);
+    ASSERT_NE(at, std::string::npos) << "body " << id.value << " not drawn";
+    const std::string tag = page.substr(page.rfind('<', at - 1), 9);
+    if (type == ShapeType::mesh) {
+      EXPECT_EQ(tag, "<path cla") << id.value;
+    }
+    if (type == ShapeType::convex) {
+      EXPECT_EQ(tag, "<polygon ") << id.value;
+    }
+    if (type == ShapeType::compound) {
+      std::size_t parts = 0;
+      for (std::size_t p = at; p != std::string::npos; p = page.find(title, p + 1))
+        ++parts;
+      EXPECT_GT(parts, 2U) << "a compound's parts, in both panels: body " << id.value;
+    }
+  }
 }
 
 /// Every field class through the commands themselves, at a seeded random frame of a 10,000-frame

@@ -189,6 +189,59 @@ TEST(Cli, DiffNamesTheFieldThatDiffersAndExitsOneOrZero) {
   EXPECT_EQ(bad.out, "");
 }
 
+// States of a scene with registered geometry, written by `run --save-state`: diffed against the
+// scenario's world (--scenario), the field is named; without it, the error says what is missing;
+// states of different geometry name the differing entry by type and content hash.
+TEST(Cli, DiffOfAGeometrySceneNeedsItsScenarioAndNamesDifferingGeometry) {
+  TempFile a("rocks_a.state");
+  TempFile b("rocks_b.state");
+  TempFile other("rocks_seed2.state");
+  const std::string run = "run --scenario rocks --count 30 --frames 40 --save-state ";
+  Result r = detsim_cli(run + a.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "state written to " + a.path())) << r.out;
+  r = detsim_cli(run + b.path() + " --inject 40:7:angular_velocity.z:0.5");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = detsim_cli(run + other.path() + " --seed 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  r = detsim_cli("diff " + a.path() + " " + b.path() + " --scenario rocks --count 30 --json");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  expect_one_json_object(r.out);
+  EXPECT_TRUE(has(r.out, R"("differences":[{"subsystem":"bodies","body":7,)"
+                         R"("field":"angular_velocity.z",)"))
+      << r.out;
+  r = detsim_cli("diff " + a.path() + " " + a.path() + " --scenario rocks --count 30");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, "equal: frame 40")) << r.out;
+
+  r = detsim_cli("diff " + a.path() + " " + b.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, a.path() + ": ")) << r.err;
+  EXPECT_TRUE(has(r.err, "the state needs geometry 1 (heightfield, content hash 0x")) << r.err;
+  EXPECT_TRUE(has(r.err, "--scenario")) << r.err;
+
+  r = detsim_cli("diff " + a.path() + " " + other.path() + " --scenario rocks --count 30");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_TRUE(has(r.out, "geometry     geometry[2]            A convex hull, content hash 0x"))
+      << r.out;
+  EXPECT_TRUE(has(r.out, "note: state B names geometry that the world given does not hold"))
+      << r.out;
+
+  r = detsim_cli("diff " + a.path() + " " + b.path() + " --scenario nowhere");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(has(r.err, "unknown scenario 'nowhere'")) << r.err;
+}
+
+TEST(Cli, HelpNamesTheSubShapeContactSyntaxAndDiffsScenario) {
+  const Result run = detsim_cli("run --help");
+  EXPECT_TRUE(has(run.out, "contact[OTHER/S/T]")) << run.out;
+  EXPECT_TRUE(has(run.out, "--save-state")) << run.out;
+  const Result diff = detsim_cli("diff --help");
+  EXPECT_TRUE(has(diff.out, "--scenario")) << diff.out;
+  EXPECT_TRUE(has(diff.out, "geometry[N]")) << diff.out;
+}
+
 TEST(Cli, SynctestPassesOnEveryKindOfScene) {
   for (const char* scene : {"arena --players 3", "spray", "dominoes"}) {
     const Result r = detsim_cli(std::string("synctest --scenario ") + scene +

@@ -187,6 +187,43 @@ TEST(BisectHtml, SceneDrawsEveryBodyWithItsShape) {
   EXPECT_EQ(body_tag(html, 6), "<circle class=\"d\" cx=\"3\" cy=\"3\" r=\"0.5\">");
 }
 
+// Bodies of registered geometry come with their world's outline (World::body_outline): a surface
+// is drawn as its triangles, a compound as its parts, each part with the body's class and title.
+TEST(BisectHtml, SurfacesAndCompoundsAreDrawnFromTheirOutlines) {
+  BisectResult r = diverged();
+  ScenePose mesh = pose(7, BodyType::static_body, Shape{}, at(0, 0, 0));
+  ShapeOutline surface;
+  surface.triangles = {{at(0, 0, 0), at(4, 0, 0), at(0, 0, 4)},
+                       {at(4, 0, 0), at(4, 1, 4), at(0, 0, 4)}};
+  surface.surface_triangles = 2;
+  surface.points = {at(0, 0, 0), at(4, 1, 4)};
+  mesh.outline = surface;
+  ScenePose table = pose(8, BodyType::dynamic, Shape{}, at(6, 1, 6));
+  ShapeOutline top;
+  top.points = {at(5, 1, 5), at(7, 1, 5), at(7, 1, 7), at(5, 1, 7)};
+  ShapeOutline leg;
+  leg.points = {at(6, 0, 6)};
+  leg.radius = Fixed::half();
+  table.outline = ShapeOutline{};
+  table.outline->parts = {top, leg};
+  table.differs = true;
+  r.scene_a.push_back(mesh);
+  r.scene_a.push_back(table);
+  r.scene_b = r.scene_a;
+  const std::string html = replay::bisect_html(r);
+  EXPECT_EQ(body_tag(html, 7), "<path class=\"s\" d=\"M0,0L4,0L0,4ZM4,0L4,4L0,4Z\">");
+  // The compound: its top as a polygon, then its leg as a circle, both titled body 8.
+  EXPECT_EQ(body_tag(html, 8).rfind("<polygon class=\"d x\" points=\"", 0), 0U)
+      << body_tag(html, 8);
+  EXPECT_TRUE(contains(html, "<circle class=\"d x\" cx=\"6\" cy=\"6\" r=\"0.5\"><title>body 8 ("))
+      << html;
+  std::size_t titles = 0;
+  for (std::size_t at = html.find("<title>body 8 ("); at != std::string::npos;
+       at = html.find("<title>body 8 (", at + 1))
+    ++titles;
+  EXPECT_EQ(titles, 4U) << "two parts in each panel";
+}
+
 TEST(BisectHtml, RotatedBoxFootprint) {
   // Half extents (1, 0.5, 1) turned 45 degrees about y: a diamond of half diagonal sqrt(2).
   const std::string tag = body_tag(replay::bisect_html(diverged()), 2);

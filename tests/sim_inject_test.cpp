@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -120,6 +121,8 @@ TEST(ParseInjection, EveryFieldFormRoundTrips) {
       "18446744073709551615:4294967295:contact[17].point[0].normal_impulse:0.5",
       "7:17:contact[4294967295].point[3].tangent_impulse_1:-2",
       "7:17:contact[3].point[1].tangent_impulse_2:1e2",
+      "7:17:contact[3/0/0].point[1].tangent_impulse_2:1e2",
+      "7:17:contact[3/12/4294967295].point[0].normal_impulse:-0.5",
   };
   for (const char* base : {"position", "linear_velocity", "angular_velocity", "force", "torque"})
     for (const char* c : {"x:0.25", "y:-1.5", "z:1e-3"})
@@ -173,6 +176,12 @@ TEST(ParseInjection, ErrorsNameTheOffendingPart) {
       {"12:3:contact[4294967296].point[0].normal_impulse:1", "unknown field \"contact[42949"},
       {"12:3:contact[3].point[0].impulse:1", "unknown field \"contact[3].point[0].impulse\""},
       {"12:3:contact[3].normal_impulse:1", "unknown field \"contact[3].normal_impulse\""},
+      {"12:3:contact[3/1].point[0].normal_impulse:1", "unknown field \"contact[3/1]"},
+      {"12:3:contact[3/1/2/3].point[0].normal_impulse:1", "unknown field \"contact[3/1/2/3]"},
+      {"12:3:contact[3/x/2].point[0].normal_impulse:1", "unknown field \"contact[3/x/2]"},
+      {"12:3:contact[3//2].point[0].normal_impulse:1", "unknown field \"contact[3//2]"},
+      {"12:3:contact[3/1/4294967296].point[0].normal_impulse:1", "unknown field \"contact[3/1/"},
+      {"12:3:contact[0/1/2].point[0].normal_impulse:1", "unknown field \"contact[0/1/2]"},
       {"12:3:position.y:abc", "DELTA \"abc\""},
       {"12:3:position.y:", "DELTA \"\""},
       {"12:3:position.y:0.1:5", "DELTA \"0.1:5\""},
@@ -305,6 +314,57 @@ TEST(ApplyInjection, AContactPointIsNamedFromEitherBodyOfThePair) {
   for (ContactState& x : want)
     if (x.a == c.a && x.b == c.b) x.points[point].normal_impulse = expected;
   EXPECT_EQ(after, want);
+}
+
+// With registered geometry a body pair has one contact per pair of sub-shapes (a compound's part,
+// a mesh's triangle): diff names each as contact[OTHER/S/T], and that name, given to --inject from
+// either body, changes exactly that contact.
+TEST(ApplyInjection, AContactBetweenSubShapesIsNamedAsDiffPrintsIt) {
+  Scenario level = Scenario::create("level", {.seed = 1, .count = 2}).value();
+  const World geometry = level.world();
+  // The first contact with points between sub-shapes of a pair that has several contacts.
+  std::optional<ContactState> pick;
+  while (!pick && level.world().frame() < 300) {
+    level.step();
+    const std::vector<ContactState> all = level.world().contacts();
+    for (std::size_t i = 0; i + 1 < all.size() && !pick; ++i) {
+      const ContactState& c = all[i];
+      const bool shared = all[i + 1].a == c.a && all[i + 1].b == c.b;
+      if (shared && c.point_count > 0 && (c.sub_a != 0 || c.sub_b != 0)) pick = c;
+    }
+  }
+  ASSERT_TRUE(pick.has_value()) << "no pair with several sub-shape contacts by frame 300";
+  const ContactState c = *pick;
+  const std::string a = std::to_string(c.a.value), b = std::to_string(c.b.value);
+  const std::string sa = std::to_string(c.sub_a), sb = std::to_string(c.sub_b);
+  const std::string field = "contact[" + b + "/" + sa + "/" + sb + "].point[0].normal_impulse";
+  const std::string frame = std::to_string(level.world().frame());
+
+  World from_a = level.world();
+  const std::vector<std::uint8_t> before = from_a.save();
+  ASSERT_TRUE(apply_injection(from_a, spec(frame + ":" + a + ":" + field + ":0.5")).ok());
+  const StateDiff da = diff_states(geometry, before, from_a.save()).value();
+  const FieldDiff f = only_field(da, "contacts", c.a.value, field);
+  EXPECT_EQ(f.a, shown(c.points[0].normal_impulse));
+  EXPECT_EQ(f.b, shown(c.points[0].normal_impulse + dec("0.5")));
+
+  // What diff printed is what --inject takes; from the other body, the sub-shapes swap.
+  World from_b = level.world();
+  const std::string mirrored = "contact[" + a + "/" + sb + "/" + sa + "].point[0].normal_impulse";
+  ASSERT_TRUE(apply_injection(from_b, spec(frame + ":" + b + ":" + mirrored + ":0.5")).ok());
+  EXPECT_EQ(from_a.hashes(), from_b.hashes());
+
+  // Sub-shapes the pair has no contact between: refused, naming the contacts it has.
+  World w = level.world();
+  const Status refused = apply_injection(
+      w, spec(frame + ":" + a + ":contact[" + b + "/99999/99999].point[0].normal_impulse:1"));
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("have no contact (sub-shapes 99999 and 99999)"),
+            std::string::npos)
+      << refused.message();
+  EXPECT_NE(refused.message().find("contact[" + b + "/" + sa + "/" + sb + "]"), std::string::npos)
+      << refused.message();
+  EXPECT_EQ(w.hashes(), level.world().hashes());
 }
 
 TEST(ApplyInjection, PresentMinusOneRemovesTheBodyAndItsContacts) {

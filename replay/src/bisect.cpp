@@ -114,6 +114,14 @@ Status load_replay(Side& side) {
   return Status::success();
 }
 
+/// A world holding the geometry of the record's scenario (what its states are restored against:
+/// a state names its geometry by hash, World::restore needs the world to hold it); a world without
+/// geometry when this build cannot create the scenario (its states restore if they name none).
+World geometry_world(const Fingerprint& fp, const std::string& path) {
+  auto scenario = scenario_of(fp, path);
+  return scenario ? scenario.value().world() : World();
+}
+
 Status load_report(Side& side) {
   auto read = read_desync_report(side.path);
   if (!read) return read.status();
@@ -136,7 +144,7 @@ Status load_report(Side& side) {
   for (FrameState& f : r.intermediate_states)
     side.states[f.frame] = std::move(f.state);
   side.states[r.divergent_frame] = std::move(r.divergent_state);
-  World world;
+  World world = geometry_world(side.fp, side.path);
   for (const auto& [frame, state] : side.states) {
     if (Status s = world.restore(state); !s)
       return Status::error("desync report " + side.path + ": the state of frame " +
@@ -235,14 +243,24 @@ std::vector<AgreementSpan> timeline(const Side& a, const Side& b) {
   return out;
 }
 
-std::vector<ScenePose> scene_of(const State& state, const std::set<std::uint32_t>& differing) {
+// Each body with its outline from the world (World::body_outline), which draws the shapes whose
+// geometry is registered (hulls, meshes, heightfields, compounds) as well as the primitives.
+std::vector<ScenePose> scene_of(const World& geometry, const State& state,
+                                const std::set<std::uint32_t>& differing) {
   std::vector<ScenePose> out;
-  World w;
+  World w(geometry);
   if (!w.restore(state)) return out;
   for (const BodyId id : w.body_ids()) {
     const BodyState b = w.body(id).value();
-    out.push_back(
-        {id.value, b.type, b.shape, b.position, b.orientation, differing.count(id.value) != 0});
+    ScenePose pose;
+    pose.id = id.value;
+    pose.type = b.type;
+    pose.shape = b.shape;
+    pose.position = b.position;
+    pose.orientation = b.orientation;
+    pose.differs = differing.count(id.value) != 0;
+    if (auto outline = w.body_outline(id)) pose.outline = std::move(outline).value();
+    out.push_back(std::move(pose));
   }
   return out;
 }
@@ -325,6 +343,9 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
 
   // This machine's re-simulation from the latest stored state both sides agree on.
   auto scenario = scenario_of(a.fp, a.path);
+  // The geometry that both sides' states are restored against for the diff and the scene (the
+  // fingerprints are equal, so it is the one scenario's).
+  const World geometry = scenario ? scenario.value().world() : World();
   std::optional<Local> local;
   std::uint64_t start = 0;
   if (scenario) {
@@ -428,18 +449,19 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
     if (!sa) continue;
     auto sb = state_of(b, local_is_b, f, source_b);
     if (!sb) continue;
-    auto diff = diff_states(*sa, *sb, options.max_diffs);
+    auto diff = diff_states(geometry, *sa, *sb, options.max_diffs);
     if (!diff) return diff.status();
     r.diff_frame = f;
     r.diff_source_a = source_a;
     r.diff_source_b = source_b;
     r.diffs = std::move(diff.value().fields);
     r.diffs_omitted = diff.value().omitted;
+    if (!diff.value().note.empty()) r.notes.push_back(diff.value().note);
     std::set<std::uint32_t> bodies;
     for (const FieldDiff& d : r.diffs)
       if (d.body != 0) bodies.insert(d.body);  // whatever the section, a field of a body
-    r.scene_a = scene_of(*sa, bodies);
-    r.scene_b = scene_of(*sb, bodies);
+    r.scene_a = scene_of(geometry, *sa, bodies);
+    r.scene_b = scene_of(geometry, *sb, bodies);
     break;
   }
   if (r.diff_frame != divergent) {

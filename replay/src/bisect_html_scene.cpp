@@ -5,6 +5,7 @@
 // are non-scaling, so outlines stay one pixel wide whatever the scene's size. Everything is
 // computed in Fixed and printed with dec3: no floating point.
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -55,16 +56,23 @@ struct Point {
   Fixed z;
 };
 
-/// A body's top-down footprint: a circle (centre a), a capsule (core a..b) or a polygon, drawn
-/// from its shape's outline (detsim/sim/shape_outline.hpp); a half-space is not drawn.
+/// A body's top-down footprint: a circle (centre a), a capsule (core a..b), a polygon, a surface
+/// (its triangles, one path) or a compound (its parts' footprints), drawn from its outline
+/// (detsim/sim/shape_outline.hpp); a half-space is not drawn.
 struct Footprint {
-  enum class Kind : std::uint8_t { circle, capsule, polygon, half_space };
+  enum class Kind : std::uint8_t { circle, capsule, polygon, half_space, surface, compound };
   Kind type = Kind::circle;
   Point a;
   Point b;
   Fixed radius;
   std::vector<Point> polygon;
+  std::vector<std::array<Point, 3>> triangles;  ///< surface
+  std::vector<Footprint> parts;                 ///< compound
 };
+
+/// The most triangles a surface is drawn with (some 60 bytes of markup each); a larger surface is
+/// drawn as the top-down hull of its bounding box.
+constexpr std::size_t kMaxDrawnTriangles = 4096;
 
 Point top_down(Vec3 v) {
   return {v.x, v.z};
@@ -97,13 +105,21 @@ std::vector<Point> convex_hull(std::vector<Point> points) {
   return hull;
 }
 
-Footprint footprint(const ScenePose& body) {
-  const ShapeOutline outline = shape_outline(body.shape, body.position, body.orientation);
+/// The footprint of `outline`, whose centre (for a sphere) is `centre`.
+Footprint outline_footprint(const ShapeOutline& outline, Vec3 centre) {
   Footprint f;
   f.radius = outline.radius;
-  f.a = top_down(body.position);
+  f.a = top_down(outline.points.size() == 1 ? outline.points[0] : centre);
   if (outline.half_space) {
     f.type = Footprint::Kind::half_space;
+  } else if (!outline.parts.empty()) {
+    f.type = Footprint::Kind::compound;
+    for (const ShapeOutline& part : outline.parts)
+      f.parts.push_back(outline_footprint(part, centre));
+  } else if (!outline.triangles.empty() && outline.triangles.size() <= kMaxDrawnTriangles) {
+    f.type = Footprint::Kind::surface;
+    for (const std::array<Vec3, 3>& t : outline.triangles)
+      f.triangles.push_back({top_down(t[0]), top_down(t[1]), top_down(t[2])});
   } else if (outline.points.size() == 2) {
     f.type = Footprint::Kind::capsule;
     f.a = top_down(outline.points[0]);
@@ -113,7 +129,7 @@ Footprint footprint(const ScenePose& body) {
     const Fixed core = hypot(f.b.x - f.a.x, f.b.z - f.a.z);
     if (core == Fixed{} || core <= (f.radius >> 10)) {
       f.type = Footprint::Kind::circle;
-      f.a = top_down(body.position);
+      f.a = {(f.a.x >> 1) + (f.b.x >> 1), (f.a.z >> 1) + (f.b.z >> 1)};
     }
   } else if (outline.points.size() > 2) {
     // The hull's own radius (zero for a box) is too small to see at the plot's scale.
@@ -124,6 +140,12 @@ Footprint footprint(const ScenePose& body) {
     f.polygon = convex_hull(std::move(corners));
   }
   return f;
+}
+
+Footprint footprint(const ScenePose& body) {
+  if (body.outline) return outline_footprint(*body.outline, body.position);
+  return outline_footprint(shape_outline(body.shape, body.position, body.orientation),
+                           body.position);
 }
 
 struct Bounds {
@@ -140,7 +162,14 @@ struct Bounds {
 void add_bounds(Bounds& b, const Footprint& f) {
   for (const Point p : f.polygon)
     b.add(p, Fixed{});
-  if (f.type == Footprint::Kind::half_space) return;
+  for (const std::array<Point, 3>& t : f.triangles)
+    for (const Point p : t)
+      b.add(p, Fixed{});
+  for (const Footprint& part : f.parts)
+    add_bounds(b, part);
+  if (f.type == Footprint::Kind::half_space || f.type == Footprint::Kind::surface ||
+      f.type == Footprint::Kind::compound)
+    return;
   if (f.type != Footprint::Kind::polygon) b.add(f.a, f.radius);
   if (f.type == Footprint::Kind::capsule) b.add(f.b, f.radius);
 }
@@ -149,15 +178,31 @@ std::string point(Point p) {
   return dec3(p.x) + "," + dec3(p.z);
 }
 
-/// One body's element: a few dozen bytes of markup, since scenes can hold thousands of bodies.
-std::string body_svg(const ScenePose& body, const Footprint& f) {
-  const char* type = body.type == BodyType::static_body ? "s"
-                     : body.type == BodyType::kinematic ? "k"
-                                                        : "d";
-  const std::string cls = std::string("class=\"") + type + (body.differs ? " x\"" : "\"");
-  const std::string title = "<title>body " + std::to_string(body.id) + " (" +
-                            dec3(body.position.x) + ", " + dec3(body.position.z) + ")</title>";
+/// One footprint's element(s), each with the body's class and title (a compound: one per part,
+/// so that every element is styled alike and names its body).
+std::string footprint_svg(const std::string& cls, const std::string& title, const Footprint& f) {
   switch (f.type) {
+    case Footprint::Kind::compound: {
+      std::string out;
+      for (const Footprint& part : f.parts)
+        out += footprint_svg(cls, title, part);
+      return out;
+    }
+    case Footprint::Kind::surface: {
+      // One path of all the triangles: a surface is one body, and one element keeps it small.
+      std::string d;
+      for (const std::array<Point, 3>& t : f.triangles)
+        d.append("M")
+            .append(point(t[0]))
+            .append("L")
+            .append(point(t[1]))
+            .append("L")
+            .append(point(t[2]))
+            .append("Z");
+      return "<path " + cls + " d=\"" + d + "\">" + title + "</path>";
+    }
+    case Footprint::Kind::half_space:
+      return "";
     case Footprint::Kind::polygon: {
       std::string points;
       for (const Point p : f.polygon)
@@ -178,6 +223,17 @@ std::string body_svg(const ScenePose& body, const Footprint& f) {
       return "<circle " + cls + " cx=\"" + dec3(f.a.x) + "\" cy=\"" + dec3(f.a.z) + "\" r=\"" +
              dec3(f.radius) + "\">" + title + "</circle>";
   }
+}
+
+/// One body's element: a few dozen bytes of markup, since scenes can hold thousands of bodies.
+std::string body_svg(const ScenePose& body, const Footprint& f) {
+  const char* type = body.type == BodyType::static_body ? "s"
+                     : body.type == BodyType::kinematic ? "k"
+                                                        : "d";
+  const std::string cls = std::string("class=\"") + type + (body.differs ? " x\"" : "\"");
+  const std::string title = "<title>body " + std::to_string(body.id) + " (" +
+                            dec3(body.position.x) + ", " + dec3(body.position.z) + ")</title>";
+  return footprint_svg(cls, title, f);
 }
 
 void scene_panel(std::string& out, const std::string& caption, const std::vector<ScenePose>& scene,

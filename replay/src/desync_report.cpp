@@ -93,13 +93,18 @@ void read_intermediate(ByteReader& r, DesyncReport& report) {
 
 }  // namespace
 
-Expected<std::vector<BodyHash>> body_hashes(std::span<const std::uint8_t> state) {
-  World world;
+Expected<std::vector<BodyHash>> body_hashes(const World& geometry,
+                                            std::span<const std::uint8_t> state) {
+  World world(geometry);
   if (Status s = world.restore(state); !s) return s;
   std::vector<BodyHash> out;
   for (const BodyId id : world.body_ids())
     out.push_back({id.value, world.body_hash(id).value()});
   return out;
+}
+
+Expected<std::vector<BodyHash>> body_hashes(std::span<const std::uint8_t> state) {
+  return body_hashes(World(), state);
 }
 
 Status write_desync_report(const std::string& path, const DesyncReport& report) {

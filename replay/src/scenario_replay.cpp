@@ -35,7 +35,12 @@ class ReportBuilder {
   ReportBuilder(const Fingerprint& fingerprint, bool active)
       : fingerprint_(fingerprint), active_(active) {}
 
-  void remember(const World& world) { world.save(current_); }
+  /// `world`: the scenario's, which also holds the geometry the states name (body_hashes
+  /// restores them against it).
+  void remember(const World& world) {
+    world_ = &world;
+    world.save(current_);
+  }
 
   /// After a frame's step: keeps its inputs and state, returns its hashes.
   StateHashes step(const World& world, std::span<const std::uint8_t> inputs) {
@@ -58,9 +63,10 @@ class ReportBuilder {
     r.confirmed_frames = confirmed_;  // steps 0 .. frame - 1
     r.agreed_state = previous_;
     r.divergent_state = current_;
-    auto agreed = body_hashes(r.agreed_state);
+    const World geometry = world_ != nullptr ? *world_ : World();
+    auto agreed = body_hashes(geometry, r.agreed_state);
     if (!agreed) return agreed.status();
-    auto divergent = body_hashes(r.divergent_state);
+    auto divergent = body_hashes(geometry, r.divergent_state);
     if (!divergent) return divergent.status();
     r.agreed_bodies = std::move(agreed).value();
     r.divergent_bodies = std::move(divergent).value();
@@ -77,6 +83,7 @@ class ReportBuilder {
  private:
   const Fingerprint& fingerprint_;
   bool active_;
+  const World* world_ = nullptr;
   std::vector<std::uint8_t> previous_;
   std::vector<std::uint8_t> current_;
   std::vector<std::uint8_t> confirmed_;

@@ -3,6 +3,8 @@
 
 #include <utility>
 
+#include <detsim/replay/scenario_replay.hpp>
+
 namespace detsim::net {
 
 struct ScenarioRecorder::Impl {
@@ -101,9 +103,12 @@ Expected<replay::DesyncReport> desync_report(const replay::Fingerprint& fingerpr
   r.confirmed_frames = evidence.confirmed_frames;
   r.agreed_state = evidence.agreed_state;
   r.divergent_state = evidence.divergent_state;
-  auto agreed = replay::body_hashes(r.agreed_state);
+  // The states name the scenario's geometry by hash: restore them against the scenario's world.
+  auto scenario = replay::scenario_of(fingerprint, "desync report");
+  const World geometry = scenario ? scenario.value().world() : World();
+  auto agreed = replay::body_hashes(geometry, r.agreed_state);
   if (!agreed) return Status::error("desync report: the agreed state: " + agreed.message());
-  auto divergent = replay::body_hashes(r.divergent_state);
+  auto divergent = replay::body_hashes(geometry, r.divergent_state);
   if (!divergent)
     return Status::error("desync report: the divergent state: " + divergent.message());
   r.agreed_bodies = std::move(agreed).value();

@@ -69,7 +69,8 @@ const std::string& fields_help() {
            " (DELTA an integer, added); present (DELTA -1 removes BODY, +1 adds a static copy of "
            "its shape 1000 m above); rng.state[0..3] (BODY 0, DELTA an integer, added mod 2^64); "
            "contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2 (DELTA a "
-           "decimal); joint[J].FIELD (BODY 0; FIELD a field of the joint as diff names it: " +
+           "decimal; contact[OTHER/S/T] for the contact of BODY's sub-shape S with OTHER's "
+           "sub-shape T); joint[J].FIELD (BODY 0; FIELD a field of the joint as diff names it: " +
            joint_fields_help() + ")";
   }();
   return help;
@@ -81,11 +82,13 @@ enum class DeltaKind { fixed, toggle, integer, presence };
 struct Target {
   DeltaKind kind = DeltaKind::fixed;
   enum class Part { body, rng, contact, joint } part = Part::body;
-  std::string base;         ///< "position", "sleep_time", "normal_impulse", ...
-  int component = -1;       ///< x y z = 0 1 2, w = 3; the RNG word; -1: none
-  std::uint32_t other = 0;  ///< contact: the other body
-  std::size_t point = 0;    ///< contact: the point
-  std::uint32_t joint = 0;  ///< joint: its ID
+  std::string base;             ///< "position", "sleep_time", "normal_impulse", ...
+  int component = -1;           ///< x y z = 0 1 2, w = 3; the RNG word; -1: none
+  std::uint32_t other = 0;      ///< contact: the other body
+  std::uint32_t sub_body = 0;   ///< contact: BODY's sub-shape (compound part, surface triangle)
+  std::uint32_t sub_other = 0;  ///< contact: OTHER's sub-shape
+  std::size_t point = 0;        ///< contact: the point
+  std::uint32_t joint = 0;      ///< joint: its ID
 };
 
 /// A decimal without sign or leading zeros ("0" itself is fine).
@@ -133,9 +136,26 @@ Expected<Target> parse_field(std::string_view field) {
     return t;
   }
   if (field.starts_with("contact[")) {
-    std::string_view rest;
-    auto other = indexed(field, "contact", rest);
+    // contact[OTHER] or contact[OTHER/SUB_BODY/SUB_OTHER] (what diff prints for sub-shapes).
+    const std::size_t close = field.find(']');
+    if (close == std::string_view::npos) return unknown();
+    std::string_view inside = field.substr(8, close - 8);
+    const std::string_view rest = field.substr(close + 1);
+    std::optional<std::uint64_t> subs[2] = {0, 0};
+    if (const std::size_t slash = inside.find('/'); slash != std::string_view::npos) {
+      const std::string_view pair = inside.substr(slash + 1);
+      const std::size_t second = pair.find('/');
+      if (second == std::string_view::npos) return unknown();
+      subs[0] = parse_u64(pair.substr(0, second));
+      subs[1] = parse_u64(pair.substr(second + 1));
+      inside = inside.substr(0, slash);
+    }
+    const auto other = parse_u64(inside);
     if (!other || *other == 0 || *other > 0xFFFFFFFFU || !rest.starts_with(".")) return unknown();
+    for (const auto& sub : subs)
+      if (!sub || *sub > 0xFFFFFFFFU) return unknown();
+    t.sub_body = static_cast<std::uint32_t>(*subs[0]);
+    t.sub_other = static_cast<std::uint32_t>(*subs[1]);
     std::string_view name;
     auto point = indexed(rest.substr(1), "point", name);
     if (!point || *point > 3 || !name.starts_with(".")) return unknown();
@@ -403,16 +423,35 @@ Status apply_injection(World& world, const Injection& injection) {
   BodyState& body = s.bodies[static_cast<std::size_t>(index)];
 
   if (t.part == Target::Part::contact) {
-    const std::uint32_t a = std::min(injection.body, t.other);
-    const std::uint32_t b = std::max(injection.body, t.other);
-    auto it = std::find_if(s.contacts.begin(), s.contacts.end(),
-                           [&](const sim_detail::Contact& c) { return c.a == a && c.b == b; });
-    if (it == s.contacts.end())
+    // The pair is stored lower ID first: BODY's sub-shape is sub_a when BODY is the lower.
+    const bool body_first = injection.body < t.other;
+    const std::uint32_t a = body_first ? injection.body : t.other;
+    const std::uint32_t b = body_first ? t.other : injection.body;
+    const std::uint32_t sub_a = body_first ? t.sub_body : t.sub_other;
+    const std::uint32_t sub_b = body_first ? t.sub_other : t.sub_body;
+    auto it = std::find_if(s.contacts.begin(), s.contacts.end(), [&](const sim_detail::Contact& c) {
+      return c.a == a && c.b == b && c.sub_a == sub_a && c.sub_b == sub_b;
+    });
+    const std::string subs = sub_a == 0 && sub_b == 0 ? ""
+                                                      : " (sub-shapes " + std::to_string(sub_a) +
+                                                            " and " + std::to_string(sub_b) + ")";
+    if (it == s.contacts.end()) {
+      // Name the sub-shape pairs the bodies do have, so the fix is one look away.
+      std::string have;
+      for (const sim_detail::Contact& c : s.contacts) {
+        if (c.a != a || c.b != b) continue;
+        have += (have.empty() ? "" : ", ") + std::string("contact[") +
+                std::to_string(body_first ? b : a) + "/" +
+                std::to_string(body_first ? c.sub_a : c.sub_b) + "/" +
+                std::to_string(body_first ? c.sub_b : c.sub_a) + "]";
+      }
       return Status::error(where + "bodies " + std::to_string(a) + " and " + std::to_string(b) +
-                           " have no contact");
+                           " have no contact" + subs +
+                           (have.empty() ? "" : "; their contacts: " + have));
+    }
     if (t.point >= it->point_count)
       return Status::error(where + "the contact of " + std::to_string(a) + " and " +
-                           std::to_string(b) + " has " + std::to_string(it->point_count) +
+                           std::to_string(b) + subs + " has " + std::to_string(it->point_count) +
                            " cached points");
     sim_detail::CachedPoint& p = it->cached[t.point];
     const Fixed d = Fixed::parse(injection.delta).value;

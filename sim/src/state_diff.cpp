@@ -6,11 +6,16 @@
 #include <detsim/sim/state_diff.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 
+#include <detsim/core/bytes.hpp>
+#include <detsim/core/hash.hpp>
 #include <detsim/fixed/decimal.hpp>
+#include <detsim/sim/state_sections.hpp>
 
 #include "body_fields.hpp"
+#include "geometry/geometry.hpp"
 #include "joint_fields.hpp"
 
 namespace detsim {
@@ -125,8 +130,13 @@ void diff_body(Collector& c, const BodyState& a, const BodyState& b) {
   }
 }
 
+// "contact[B]" for whole shapes; "contact[B/SUB_A/SUB_B]" between sub-shapes: the body is the
+// pair's lower ID, so this is the form --inject takes with BODY = a (inject.hpp).
 std::string contact_name(const ContactState& c) {
-  return "contact[" + std::to_string(c.b.value) + "]";
+  std::string name = "contact[" + std::to_string(c.b.value);
+  if (c.sub_a != 0 || c.sub_b != 0)
+    name += "/" + std::to_string(c.sub_a) + "/" + std::to_string(c.sub_b);
+  return name + "]";
 }
 
 void diff_contact(Collector& c, const ContactState& a, const ContactState& b) {
@@ -148,11 +158,12 @@ void diff_contact(Collector& c, const ContactState& a, const ContactState& b) {
   }
 }
 
-// A merge of both contact lists, ascending (a, b); a pair on one side only is "present".
+// A merge of both contact lists, ascending (a, b, sub_a, sub_b); a contact on one side only is
+// "present".
 void diff_contacts(Collector& c, const std::vector<ContactState>& ca,
                    const std::vector<ContactState>& cb) {
   const auto key = [](const ContactState& x) {
-    return (std::uint64_t{x.a.value} << 32) | x.b.value;
+    return std::array<std::uint32_t, 4>{x.a.value, x.b.value, x.sub_a, x.sub_b};
   };
   std::size_t i = 0;
   std::size_t j = 0;
@@ -209,20 +220,78 @@ void diff_joint(Collector& c, JointState a, JointState b) {
 
 // ---- Sections: each a differ that lists its fields; any other section is named by its hash ----
 
-struct Sides {
-  const World& a;
-  const World& b;
+/// One entry of a state's "geometry" section (state_geometry.cpp): what the state needs the
+/// restoring world to hold under ID index + 1.
+struct NamedGeometry {
+  std::uint8_t type = 0;
+  std::uint64_t hash = 0;
+
+  friend bool operator==(const NamedGeometry&, const NamedGeometry&) = default;
 };
 
+/// The geometry a state names, read from its "geometry" section without restoring it (the world
+/// at hand may lack it); an empty list for a state without that section, which restore refuses
+/// with its own message.
+Expected<std::vector<NamedGeometry>> named_geometry(std::span<const std::uint8_t> bytes) {
+  auto sections = read_state_sections(bytes);
+  if (!sections) return Status::error("invalid state: " + sections.message());
+  std::vector<NamedGeometry> out;
+  for (const StateSection& section : *sections) {
+    if (section.name != "geometry") continue;
+    const std::size_t end = section.payload_offset + section.payload.size();
+    ByteReader r(bytes.first(end), section.payload_offset);
+    const std::uint64_t count = r.var("geometry count");
+    for (std::uint64_t i = 0; i < count && r.ok(); ++i) {
+      NamedGeometry g;
+      g.type = r.u8("geometry type");
+      g.hash = r.u64("geometry hash");
+      if (r.ok()) out.push_back(g);
+    }
+    if (!r.ok()) return Status::error("invalid state: section \"geometry\": " + r.error());
+  }
+  return out;
+}
+
+std::string show(const NamedGeometry& g) {
+  using sim_detail::GeometryType;
+  const bool known = g.type >= static_cast<std::uint8_t>(GeometryType::convex_hull) &&
+                     g.type <= static_cast<std::uint8_t>(GeometryType::compound);
+  const std::string type = known ? sim_detail::geometry_type_name(static_cast<GeometryType>(g.type))
+                                 : "unknown type " + std::to_string(g.type);
+  return type + ", content hash " + hex(g.hash);
+}
+
+/// What a section's differ compares: the restored worlds (null when that side was not restored)
+/// and the geometry lists read from the bytes.
+struct Sides {
+  const World* a;
+  const World* b;
+  const std::vector<NamedGeometry>& geometry_a;
+  const std::vector<NamedGeometry>& geometry_b;
+};
+
+// Entry by entry, by ID: a type and content hash on each side, or "absent".
+void diff_geometry(Collector& c, const Sides& w) {
+  const std::size_t n = std::max(w.geometry_a.size(), w.geometry_b.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool in_a = i < w.geometry_a.size();
+    const bool in_b = i < w.geometry_b.size();
+    if (in_a && in_b && w.geometry_a[i] == w.geometry_b[i]) continue;
+    c.add("geometry", 0, "geometry[" + std::to_string(i + 1) + "]",
+          in_a ? show(w.geometry_a[i]) : "absent", in_b ? show(w.geometry_b[i]) : "absent");
+  }
+}
+
 void diff_globals(Collector& c, const Sides& w) {
-  if (w.a.frame() != w.b.frame())
-    c.add("globals", 0, "frame", show(w.a.frame()), show(w.b.frame()));
-  if (!(w.a.def() == w.b.def())) c.add("globals", 0, "world definition", "(differs)", "(differs)");
+  if (w.a->frame() != w.b->frame())
+    c.add("globals", 0, "frame", show(w.a->frame()), show(w.b->frame()));
+  if (!(w.a->def() == w.b->def()))
+    c.add("globals", 0, "world definition", "(differs)", "(differs)");
 }
 
 void diff_rng(Collector& c, const Sides& w) {
-  const Rng::State& ra = w.a.rng().state();
-  const Rng::State& rb = w.b.rng().state();
+  const Rng::State& ra = w.a->rng().state();
+  const Rng::State& rb = w.b->rng().state();
   for (std::size_t i = 0; i < ra.size(); ++i)
     if (ra[i] != rb[i])
       c.add("rng", 0, "state[" + std::to_string(i) + "]", show(ra[i]), show(rb[i]));
@@ -230,8 +299,8 @@ void diff_rng(Collector& c, const Sides& w) {
 
 // A merge of both ascending ID lists.
 void diff_bodies(Collector& c, const Sides& w) {
-  const std::vector<BodyId> ia = w.a.body_ids();
-  const std::vector<BodyId> ib = w.b.body_ids();
+  const std::vector<BodyId> ia = w.a->body_ids();
+  const std::vector<BodyId> ib = w.b->body_ids();
   std::size_t i = 0;
   std::size_t j = 0;
   while (i < ia.size() || j < ib.size()) {
@@ -242,7 +311,7 @@ void diff_bodies(Collector& c, const Sides& w) {
       c.add("bodies", ib[j].value, "present", "absent", "present");
       ++j;
     } else {
-      diff_body(c, w.a.body(ia[i]).value(), w.b.body(ib[j]).value());
+      diff_body(c, w.a->body(ia[i]).value(), w.b->body(ib[j]).value());
       ++i;
       ++j;
     }
@@ -250,13 +319,13 @@ void diff_bodies(Collector& c, const Sides& w) {
 }
 
 void diff_contact_cache(Collector& c, const Sides& w) {
-  diff_contacts(c, w.a.contacts(), w.b.contacts());
+  diff_contacts(c, w.a->contacts(), w.b->contacts());
 }
 
 // A merge of both ascending joint ID lists; a joint on one side only is "present".
 void diff_joints(Collector& c, const Sides& w) {
-  const std::vector<JointId> ia = w.a.joint_ids();
-  const std::vector<JointId> ib = w.b.joint_ids();
+  const std::vector<JointId> ia = w.a->joint_ids();
+  const std::vector<JointId> ib = w.b->joint_ids();
   std::size_t i = 0;
   std::size_t j = 0;
   while (i < ia.size() || j < ib.size()) {
@@ -267,7 +336,7 @@ void diff_joints(Collector& c, const Sides& w) {
       c.add("joints", 0, joint_name(ib[j]) + ".present", "absent", "present");
       ++j;
     } else {
-      diff_joint(c, w.a.joint(ia[i]).value(), w.b.joint(ib[j]).value());
+      diff_joint(c, w.a->joint(ia[i]).value(), w.b->joint(ib[j]).value());
       ++i;
       ++j;
     }
@@ -277,13 +346,32 @@ void diff_joints(Collector& c, const Sides& w) {
 struct SectionDiffer {
   std::string_view name;
   void (*diff)(Collector& c, const Sides& w);
+  bool needs_worlds = true;  ///< reads the restored worlds (else only the bytes)
 };
 
 /// A new section of the World's state adds its differ here.
 constexpr SectionDiffer kDiffers[] = {
-    {"globals", diff_globals},        {"rng", diff_rng},       {"bodies", diff_bodies},
-    {"contacts", diff_contact_cache}, {"joints", diff_joints},
+    {"globals", diff_globals}, {"geometry", diff_geometry, false}, {"rng", diff_rng},
+    {"bodies", diff_bodies},   {"contacts", diff_contact_cache},   {"joints", diff_joints},
 };
+
+/// The hashes of a state's sections from its bytes (a state that may not restore here), and its
+/// frame: the first field of "globals" (state_io.cpp), 0 when unreadable.
+StateHashes hashes_of(std::span<const std::uint8_t> bytes, std::uint64_t& frame) {
+  StateHashes h;
+  h.total = hash64(bytes);
+  frame = 0;
+  if (auto sections = read_state_sections(bytes)) {
+    for (const StateSection& s : *sections) {
+      h.sections.push_back({std::string(s.name), section_hash(s)});
+      if (s.name != "globals") continue;
+      ByteReader r(bytes.first(s.payload_offset + s.payload.size()), s.payload_offset);
+      const std::uint64_t f = r.u64("frame");
+      if (r.ok()) frame = f;
+    }
+  }
+  return h;
+}
 
 /// Every section name of either side: A's in order, then those only B has.
 std::vector<std::string> section_names(const StateHashes& a, const StateHashes& b) {
@@ -312,30 +400,64 @@ std::vector<std::string> differing_subsystems(const StateHashes& a, const StateH
   return out;
 }
 
-Expected<StateDiff> diff_states(std::span<const std::uint8_t> a, std::span<const std::uint8_t> b,
-                                std::size_t max_fields) {
-  World wa;
-  World wb;
-  if (Status s = wa.restore(a); !s) return Status::error("state A: " + s.message());
-  if (Status s = wb.restore(b); !s) return Status::error("state B: " + s.message());
+Expected<StateDiff> diff_states(const World& geometry, std::span<const std::uint8_t> a,
+                                std::span<const std::uint8_t> b, std::size_t max_fields) {
+  auto geometry_a = named_geometry(a);
+  if (!geometry_a) return Status::error("state A: " + geometry_a.message());
+  auto geometry_b = named_geometry(b);
+  if (!geometry_b) return Status::error("state B: " + geometry_b.message());
+  // Restored over copies of `geometry`: restore() keeps a world's geometry and checks the state's
+  // against it (the bodies of `geometry` are replaced).
+  World wa(geometry);
+  World wb(geometry);
+  const Status restored_a = wa.restore(a);
+  const Status restored_b = wb.restore(b);
+  const bool same_geometry = geometry_a.value() == geometry_b.value();
+  // A state that cannot be restored is an error, unless the states name different geometry: then
+  // that difference is the answer, and it is listed with the sections' hashes.
+  const auto failed = [&](const char* side, const Status& s) -> Status {
+    std::string message = std::string("state ") + side + ": " + s.message();
+    if (s.message().find("geometry") != std::string::npos)
+      message +=
+          " (a diff restores both states against a world that holds their geometry: "
+          "the scenario's or game's, e.g. detsim diff --scenario NAME)";
+    return Status::error(message);
+  };
+  if (!restored_a && (same_geometry || restored_a.message().find("geometry") == std::string::npos))
+    return failed("A", restored_a);
+  if (!restored_b && (same_geometry || restored_b.message().find("geometry") == std::string::npos))
+    return failed("B", restored_b);
+  const bool both = restored_a && restored_b;
+
   StateDiff out;
-  out.a = wa.hashes();
-  out.b = wb.hashes();
-  out.frame_a = wa.frame();
-  out.frame_b = wb.frame();
+  out.a = restored_a ? wa.hashes() : hashes_of(a, out.frame_a);
+  out.b = restored_b ? wb.hashes() : hashes_of(b, out.frame_b);
+  if (restored_a) out.frame_a = wa.frame();
+  if (restored_b) out.frame_b = wb.frame();
+  if (!both)
+    out.note = std::string("state ") + (restored_a ? "B" : "A") +
+               " names geometry that the world given does not hold (" +
+               (restored_a ? restored_b : restored_a).message() +
+               "): only the geometry and the sections' hashes are compared";
   Collector c(out, max_fields);
 
   // The count is saved with the bodies, not the globals, but it is a global fact: listed first,
   // whichever section's hash differs, and as a line of the globals section.
   const std::size_t start = out.fields.size() + out.omitted;
-  if (wa.body_count() != wb.body_count())
+  if (both && wa.body_count() != wb.body_count())
     c.add("globals", 0, "body count", show(std::uint64_t{wa.body_count()}),
           show(std::uint64_t{wb.body_count()}));
-  const Sides sides{wa, wb};
-  for (const std::string& name : differing_subsystems(out.a, out.b)) {
+  const Sides sides{&wa, &wb, geometry_a.value(), geometry_b.value()};
+  std::vector<std::string> sections = differing_subsystems(out.a, out.b);
+  if (!both) {
+    // The geometry is why the rest could not be compared: it comes first.
+    const auto g = std::find(sections.begin(), sections.end(), "geometry");
+    if (g != sections.end()) std::rotate(sections.begin(), g, g + 1);
+  }
+  for (const std::string& name : sections) {
     const std::size_t before = name == "globals" ? start : out.fields.size() + out.omitted;
     for (const SectionDiffer& d : kDiffers) {
-      if (d.name == name) d.diff(c, sides);
+      if (d.name == name && (both || !d.needs_worlds)) d.diff(c, sides);
     }
     // A section may hold more than its accessors show (the next body ID, a contact's manifold
     // flags): name the section's hashes then.
@@ -343,6 +465,11 @@ Expected<StateDiff> diff_states(std::span<const std::uint8_t> a, std::span<const
       c.add(name.c_str(), 0, "hash", show(out.a.section(name)), show(out.b.section(name)));
   }
   return out;
+}
+
+Expected<StateDiff> diff_states(std::span<const std::uint8_t> a, std::span<const std::uint8_t> b,
+                                std::size_t max_fields) {
+  return diff_states(World(), a, b, max_fields);
 }
 
 }  // namespace detsim

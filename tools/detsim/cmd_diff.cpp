@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "diff_output.hpp"
 #include "output.hpp"
+#include "scenario_args.hpp"
 
 namespace detsim::cli {
 
@@ -57,7 +58,14 @@ int diff_command(const DiffArgs& args) {
   if (!a) return usage_error("diff", a.message());
   auto b = read_state(args.b);
   if (!b) return usage_error("diff", b.message());
-  auto diff = diff_states(a.value(), b.value(), args.max_fields);
+  // The states are restored against the scenario's world, which holds the geometry they name.
+  World geometry;
+  if (!args.scene.scenario.empty()) {
+    auto chosen = choose_scenario(args.scene);
+    if (!chosen) return usage_error("diff", chosen.message());
+    geometry = chosen.value().scenario.world();
+  }
+  auto diff = diff_states(geometry, a.value(), b.value(), args.max_fields);
   if (!diff) {
     // Name the file rather than the side.
     std::string message = diff.message();
@@ -70,15 +78,16 @@ int diff_command(const DiffArgs& args) {
     std::vector<std::string> fields;
     for (const FieldDiff& f : d.fields)
       fields.push_back(field_json(f));
-    Json()
-        .boolean("equal", d.equal())
+    Json j;
+    j.boolean("equal", d.equal())
         .num("frame_a", d.frame_a)
         .num("frame_b", d.frame_b)
         .hash("hash_a", d.a.total)
         .hash("hash_b", d.b.total)
         .raw("differences", Json::array(fields))
-        .num("omitted", d.omitted)
-        .print();
+        .num("omitted", d.omitted);
+    if (!d.note.empty()) j.str("note", d.note);
+    j.print();
     return d.equal() ? exit_ok : exit_check_failed;
   }
   if (d.equal()) {
@@ -92,6 +101,7 @@ int diff_command(const DiffArgs& args) {
   for (const FieldDiff& f : d.fields)
     print_field(f);
   if (d.omitted != 0) std::printf("  ... and %zu more differences (--max shows more)\n", d.omitted);
+  if (!d.note.empty()) std::printf("  note: %s\n", d.note.c_str());
   return exit_check_failed;
 }
 

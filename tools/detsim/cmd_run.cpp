@@ -167,6 +167,8 @@ int run_command(const RunArgs& args) {
   const double seconds = seconds_since(start);
   progress.done();
   if (!result) return usage_error("run", result.message());
+  if (!args.save_state.empty() && !write_file(args.save_state, scenario.world().save()))
+    return usage_error("run", "cannot write the state to " + args.save_state);
   if (args.json) {
     Json j;
     j.str("scenario", scenario.info().name)
@@ -187,6 +189,7 @@ int run_command(const RunArgs& args) {
   std::printf("%s: %llu frames, final hash %s\n", describe(scenario).c_str(),
               static_cast<unsigned long long>(result->frames), hex(result->final_hash).c_str());
   if (!args.record.empty()) std::printf("recorded %s\n", args.record.c_str());
+  if (!args.save_state.empty()) std::printf("state written to %s\n", args.save_state.c_str());
   return exit_ok;
 }
 

@@ -67,20 +67,14 @@ SyncResult run_synctest(Scenario& s, std::uint64_t frames, std::uint32_t distanc
 }
 
 /// Which parts of the state differ between the two states of a mismatch (their part hashes).
-std::string differing_parts(const net::SyncTestMismatch& m) {
-  auto diff = diff_states(m.expected_state, m.actual_state, 0);  // the hashes, no field list
+// `geometry`: the scenario's world, which holds the geometry the states name.
+std::string differing_parts(const World& geometry, const net::SyncTestMismatch& m) {
+  auto diff = diff_states(geometry, m.expected_state, m.actual_state, 0);  // hashes, no fields
   if (!diff) return "unknown";
   std::string parts;
   for (const std::string& part : differing_subsystems(diff.value().a, diff.value().b))
     parts += (parts.empty() ? "" : ", ") + part;
   return parts.empty() ? "none" : parts;
-}
-
-bool write_file(const std::string& path, const std::vector<std::uint8_t>& bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "wb");
-  if (f == nullptr) return false;
-  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-  return std::fclose(f) == 0 && ok;
 }
 
 }  // namespace
@@ -123,7 +117,7 @@ int synctest_command(const SynctestArgs& args) {
     } else {
       j.hash("expected_hash", r.mismatch->expected_hash)
           .hash("actual_hash", r.mismatch->actual_hash)
-          .str("differing_parts", differing_parts(*r.mismatch));
+          .str("differing_parts", differing_parts(scenario.world(), *r.mismatch));
       if (!dumped.empty()) j.str("dumped", dumped);
     }
     j.real("seconds", seconds).print();
@@ -143,7 +137,7 @@ int synctest_command(const SynctestArgs& args) {
               static_cast<unsigned long long>(r.frames - args.check_distance));
   std::printf("  first pass %s, re-simulation %s; differing: %s\n",
               hex(r.mismatch->expected_hash).c_str(), hex(r.mismatch->actual_hash).c_str(),
-              differing_parts(*r.mismatch).c_str());
+              differing_parts(scenario.world(), *r.mismatch).c_str());
   if (!dumped.empty()) std::printf("  states written to %s\n", dumped.c_str());
   return exit_check_failed;
 }

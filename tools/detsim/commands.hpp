@@ -26,6 +26,7 @@ struct RunArgs {
   ScenarioArgs scene;
   std::vector<std::string> injections;  ///< --inject FRAME:BODY:FIELD:DELTA, each
   std::string record;                   ///< replay file to write, or empty
+  std::string save_state;               ///< the last frame's state (World::save) to write, or empty
   std::uint32_t keyframe_interval = 300;
   bool json = false;
 };
@@ -52,6 +53,9 @@ int bisect_command(const BisectArgs& args);
 struct DiffArgs {
   std::string a;  ///< a saved state (World::save() bytes)
   std::string b;
+  /// The scenario whose world holds the states' geometry (--scenario, --seed, --players,
+  /// --count); empty: a world without geometry.
+  ScenarioArgs scene;
   std::size_t max_fields = 100;
   bool json = false;
 };

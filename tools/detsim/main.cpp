@@ -194,7 +194,12 @@ void add_inject_option(CLI::App* cmd, std::vector<std::string>& specs) {
 const std::string inject_footer = std::string(R"(
 --inject FRAME:BODY:FIELD:DELTA changes the state of frame FRAME (after its step, before its hash)
 on this machine only, as non-determinism would: e.g. 500:17:position.y:0.001. FIELD is one of: )") +
-                                  std::string(detsim::injection_fields_help()) + ".\n";
+                                  std::string(detsim::injection_fields_help()) +
+                                  ". A contact field is named as detsim diff prints it: "
+                                  "contact[OTHER] between whole shapes, contact[OTHER/S/T] "
+                                  "between sub-shape S of BODY (a compound's part, a mesh's "
+                                  "triangle) and sub-shape T of OTHER, e.g. "
+                                  "120:4:contact[9/0/17].point[0].normal_impulse:0.5.\n";
 
 void add_scenario_options(CLI::App* cmd, detsim::cli::ScenarioArgs& a) {
   cmd->add_option("--scenario", a.scenario, "Scenario name (detsim scenarios lists them)")
@@ -367,6 +372,9 @@ void add_scenario_commands(CLI::App& app, int& exit_code) {
   add_scenario_options(c, run.scene);
   c->add_option("--record", run.record, "Record the run to a replay file (replay/FORMAT.md)")
       ->type_name("FILE");
+  c->add_option("--save-state", run.save_state,
+                "Write the last frame's state (World::save bytes) to FILE, for detsim diff")
+      ->type_name("FILE");
   c->add_option("--keyframe-interval", run.keyframe_interval,
                 "Frames between the replay's keyframes, for seeking (default 300)")
       ->type_name("K")
@@ -445,13 +453,26 @@ frame is printed. Exit 0 when the records agree.)") +
   c->add_option("--max", diff.max_fields, "List at most N differences (default 100)")
       ->type_name("N")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}));
+  c->add_option("--scenario", diff.scene.scenario,
+                "The scenario whose geometry the states name (hulls, meshes, heightfields, "
+                "compounds): needed for states of such a scenario")
+      ->type_name("NAME");
+  c->add_option("--seed", diff.scene.seed, "With --scenario: its seed (default 1)")->type_name("S");
+  c->add_option("--players", diff.scene.players, "With --scenario: its players")->type_name("P");
+  c->add_option("--count", diff.scene.count, "With --scenario: its size")->type_name("N");
   c->add_flag("--json", diff.json,
               "Print one JSON object: equal, frame_a, frame_b, hash_a, hash_b, differences "
-              "(subsystem, body, field, a, b), omitted");
+              "(subsystem, body, field, a, b), omitted, and note when only part was compared");
   c->footer(std::string(R"(
-Each difference names the subsystem (globals, rng, bodies, contacts), the body ID and the field
-(position.y, orientation.w, angular_velocity.x, sleep_time, ...) with both values in decimal and
-raw hex; a body present in one state only is listed as such. Exit 0 when the states are equal.)") +
+Each difference names the subsystem (globals, geometry, rng, bodies, contacts, joints), the body ID
+and the field (position.y, orientation.w, angular_velocity.x, sleep_time, ...) with both values in
+decimal and raw hex; a body present in one state only is listed as such. A contact between
+sub-shapes (a compound's part, a mesh's triangle) is named contact[OTHER/S/T], as --inject takes it.
+A state names its geometry by type and content hash, so states of a scenario with geometry are
+restored against that scenario's world: give --scenario (and the --seed, --players, --count it ran
+with), e.g. detsim run --scenario rocks --frames 100 --save-state a.state, then
+detsim diff a.state b.state --scenario rocks. Geometry that differs between the states is listed
+as geometry[N] with its type and content hash on each side. Exit 0 when the states are equal.)") +
             exit_footer);
   c->callback([&exit_code] { exit_code = cli::diff_command(diff); });
 

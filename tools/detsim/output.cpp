@@ -20,6 +20,13 @@ std::string hex(std::uint64_t v) {
   return text;
 }
 
+bool write_file(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (f == nullptr) return false;
+  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  return std::fclose(f) == 0 && ok;
+}
+
 int usage_error(std::string_view command, const std::string& message) {
   std::fprintf(stderr, "detsim %.*s: %s\n", static_cast<int>(command.size()), command.data(),
                message.c_str());

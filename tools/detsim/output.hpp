@@ -20,6 +20,9 @@ inline constexpr int exit_usage = 2;         ///< bad usage or bad input (messag
 /// 16 lowercase hex digits.
 std::string hex(std::uint64_t v);
 
+/// Writes `bytes` to the file `path` (replacing it); false when it cannot.
+bool write_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
+
 /// Prints "detsim <command>: <message>" on stderr and returns exit_usage.
 int usage_error(std::string_view command, const std::string& message);
 

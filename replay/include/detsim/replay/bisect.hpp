@@ -19,6 +19,7 @@
 
 #include <detsim/core/status.hpp>
 #include <detsim/sim/shape.hpp>
+#include <detsim/sim/shape_outline.hpp>
 #include <detsim/sim/state_diff.hpp>
 #include <detsim/sim/world.hpp>
 
@@ -48,6 +49,10 @@ struct ScenePose {
   Vec3 position;
   Quat orientation;
   bool differs = false;  ///< one of the diff's bodies
+  /// What is drawn: the body's outline from its world (World::body_outline: hulls, surfaces and
+  /// compounds too); when absent, shape_outline(shape, position, orientation), which draws
+  /// primitives only.
+  std::optional<ShapeOutline> outline;
 };
 
 /// The inputs of one frame (the step that produced state frame `frame`), from side A.

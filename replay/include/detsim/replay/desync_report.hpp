@@ -14,6 +14,7 @@
 
 #include <detsim/core/status.hpp>
 #include <detsim/replay/replay.hpp>
+#include <detsim/sim/world.hpp>
 
 namespace detsim::replay {
 
@@ -67,7 +68,12 @@ struct DesyncReport {
   friend bool operator==(const DesyncReport&, const DesyncReport&) = default;
 };
 
-/// The per-body hashes of a saved World state, ascending ID; an error if it does not restore.
+/// The per-body hashes of a saved World state, ascending ID, restored into a copy of `geometry`:
+/// a world that holds the geometry the state names (the scenario's); an error if it does not
+/// restore.
+Expected<std::vector<BodyHash>> body_hashes(const World& geometry,
+                                            std::span<const std::uint8_t> state);
+/// The same against a world without geometry: for states that name none.
 Expected<std::vector<BodyHash>> body_hashes(std::span<const std::uint8_t> state);
 
 /// Writes `report` to `path` (replacing it).

@@ -18,6 +18,10 @@
 //   rng.state[0..3]       BODY 0; DELTA: an integer, added modulo 2^64
 //   contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2
 //                         the cached impulse of point I of the pair (BODY, OTHER); DELTA: a decimal
+//   contact[OTHER/S/T].point[I]....
+//                         the same for the contact of BODY's sub-shape S with OTHER's sub-shape T
+//                         (a compound's part, a mesh's or heightfield's triangle); contact[OTHER]
+//                         is contact[OTHER/0/0]. Diff prints contacts in this form.
 //   joint[J].FIELD        BODY 0; FIELD a field of joint J as diff names it (anchor.x,
 //                         linear_impulse.y, motor_speed, broken, ...): DELTA as for its kind
 // Results that restore() would refuse (an orientation no longer a unit quaternion, a negative
