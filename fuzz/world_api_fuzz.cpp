@@ -32,6 +32,7 @@ using detsim::BodyDef;
 using detsim::BodyId;
 using detsim::BodyType;
 using detsim::Fixed;
+using detsim::GeometryId;
 using detsim::Quat;
 using detsim::Shape;
 using detsim::ShapeType;
@@ -43,7 +44,8 @@ constexpr std::size_t kMaxBodies = 64;
 constexpr std::size_t kMaxJoints = 64;
 constexpr int kMaxSteps = 16;
 constexpr int kMaxCalls = 256;
-constexpr int kOps = 20;  // the calls' opcodes, op % kOps
+constexpr std::size_t kMaxGeometries = 16;
+constexpr int kOps = 24;  // the calls' opcodes, op % kOps
 // Sub-steps x iterations x (bodies + joints + 1), summed over the steps: what the steps of one
 // input may cost in total.
 constexpr std::uint64_t kStepBudget = 40000;
@@ -178,7 +180,7 @@ WorldDef world_def(Input& in) {
 }
 
 Shape shape(Input& in) {
-  const auto type = static_cast<ShapeType>(in.byte() % 8);  // 0 and 7 name no type
+  const auto type = static_cast<ShapeType>(in.byte() % 11);  // 0 and 10 name no type
   Shape s;
   s.type = type;
   const std::uint8_t fields = in.byte();
@@ -191,9 +193,60 @@ Shape shape(Input& in) {
     const Fixed h = in.fixed();
     s.half_extents = (fields & 1U) != 0 ? Vec3{h, h, h} : Vec3{h, in.fixed(), in.fixed()};
   }
-  // A geometry ID: mostly the convex hull's, sometimes on a primitive (refused) or unknown.
-  if (all || type == ShapeType::convex) s.geometry = GeometryId{in.byte() % 4U};
+  // A geometry ID: mostly one the world may hold (of the type or another: refused), sometimes on
+  // a primitive (refused) or unknown.
+  const bool registered = type == ShapeType::convex || type == ShapeType::mesh ||
+                          type == ShapeType::heightfield || type == ShapeType::compound;
+  if (all || registered) s.geometry = GeometryId{in.byte() % (kMaxGeometries + 2)};
   return s;
+}
+
+// ---- Registered geometry: hostile point sets, meshes, heightfields and compounds ----
+
+detsim::Status create_hull(Input& in, World& world) {
+  std::vector<Vec3> points(in.byte() % 24U);
+  for (Vec3& p : points)
+    p = in.vec3();
+  auto id = world.create_convex_hull(points);
+  return id ? detsim::Status::success() : id.status();
+}
+
+detsim::Status create_mesh(Input& in, World& world) {
+  std::vector<Vec3> vertices(in.byte() % 16U);
+  for (Vec3& v : vertices)
+    v = in.vec3();
+  std::vector<std::uint32_t> indices(in.byte() % 40U);
+  for (std::uint32_t& i : indices)
+    i = (in.byte() & 0x80U) != 0 ? in.u32() : in.byte() % 17U;  // mostly in range, or any
+  auto id = world.create_mesh(vertices, indices);
+  return id ? detsim::Status::success() : id.status();
+}
+
+detsim::Status create_heightfield(Input& in, World& world) {
+  detsim::HeightfieldDef def;
+  def.rows = in.byte() % 10U;
+  def.columns = in.byte() % 10U;
+  def.cell_size = in.fixed();
+  // Mostly rows x columns heights, sometimes a count that does not match (refused).
+  std::size_t n = std::size_t{def.rows} * def.columns;
+  if ((in.byte() & 0x80U) != 0) n = in.byte() % 100U;
+  def.heights.resize(n);
+  for (Fixed& h : def.heights)
+    h = (in.byte() & 1U) != 0 ? in.fixed()
+                              : Fixed::from_int(static_cast<std::int32_t>(in.byte() % 8));
+  auto id = world.create_heightfield(def);
+  return id ? detsim::Status::success() : id.status();
+}
+
+detsim::Status create_compound(Input& in, World& world) {
+  std::vector<detsim::CompoundChild> children(in.byte() % 6U);
+  for (detsim::CompoundChild& c : children) {
+    c.shape = shape(in);
+    c.position = in.vec3();
+    c.orientation = in.quat();
+  }
+  auto id = world.create_compound(children);
+  return id ? detsim::Status::success() : id.status();
 }
 
 BodyDef body_def(Input& in) {
@@ -321,10 +374,13 @@ void check_valid(const World& world, bool after_step) {
   fail("World::validate() failed");
 }
 
-/// save -> restore into a second World -> both step once -> the same bytes.
+/// save -> restore into a second World -> both step once -> the same bytes. The second World is
+/// a fresh one when there is no geometry, else a copy (geometry is the world's definition: a
+/// state restores only into a world that holds it).
 void check_restore_steps_alike(World& world) {
   const std::vector<std::uint8_t> bytes = world.save();
   World copy;
+  if (world.geometry_count() > 0) copy = world;
   if (!copy.restore(bytes)) fail("a saved state was refused by another World");
   if (copy.save() != bytes) fail("a restored state saves other bytes");
   world.step();
@@ -456,6 +512,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const detsim::JointId id = joint_id(in, world);
         const Fixed speed = in.fixed();
         status = world.set_joint_motor(id, speed, in.fixed());
+        break;
+      }
+      case 20:
+      case 21:
+      case 22:
+      case 23: {
+        if (world.geometry_count() >= kMaxGeometries) break;
+        const int kind = op % kOps;
+        status = kind == 20   ? create_hull(in, world)
+                 : kind == 21 ? create_mesh(in, world)
+                 : kind == 22 ? create_heightfield(in, world)
+                              : create_compound(in, world);
         break;
       }
       default: {
