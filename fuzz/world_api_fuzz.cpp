@@ -197,7 +197,8 @@ Shape shape(Input& in) {
   // a primitive (refused) or unknown.
   const bool registered = type == ShapeType::convex || type == ShapeType::mesh ||
                           type == ShapeType::heightfield || type == ShapeType::compound;
-  if (all || registered) s.geometry = GeometryId{in.byte() % (kMaxGeometries + 2)};
+  if (all || registered)
+    s.geometry = GeometryId{static_cast<std::uint32_t>(in.byte() % (kMaxGeometries + 2))};
   return s;
 }
 

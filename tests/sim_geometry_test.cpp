@@ -174,6 +174,51 @@ TEST(Geometry, TheSnapshotDoesNotGrowWithTheGeometry) {
   EXPECT_LE(many, cube + 64);
 }
 
+// Rollback over a registration: a rock registered at frame 5 leaves the state when frame 2 is
+// restored, but the world sets it aside, so frame 8 restores after it (and hashes as it did);
+// re-simulating registers the same rock again under the same ID; registering another rock there
+// instead forgets the set-aside one, and frame 8 is then refused, naming what it needs.
+TEST(Geometry, RestoringAnEarlierFrameThenALaterOneKeepsGeometryRegisteredBetween) {
+  const std::vector<Vec3> cube = box_corners({0.5_fx, 0.5_fx, 0.5_fx});
+  const std::vector<Vec3> slab = box_corners({1_fx, 0.25_fx, 1_fx});
+  World w = make_world();
+  add(w, hull_body(hull(w, cube), {0_fx, 2_fx, 0_fx}));
+  const auto play = [&](World& world, std::uint64_t to) {
+    while (world.frame() < to) {
+      if (world.frame() == 5) add(world, hull_body(hull(world, slab), {3_fx, 2_fx, 0_fx}));
+      world.step();
+    }
+  };
+  play(w, 2);
+  const std::vector<std::uint8_t> frame2 = w.save();
+  play(w, 8);
+  const std::vector<std::uint8_t> frame8 = w.save();
+  ASSERT_EQ(w.geometry_count(), 2U);
+
+  ASSERT_TRUE(w.restore(frame2).ok());
+  EXPECT_EQ(w.geometry_count(), 1U);
+  EXPECT_EQ(w.save(), frame2);
+  ASSERT_TRUE(w.restore(frame8).ok()) << "the slab registered at frame 5 was forgotten";
+  EXPECT_EQ(w.geometry_count(), 2U);
+  EXPECT_EQ(w.save(), frame8);
+
+  // Re-simulating from frame 2 registers the slab again: the same ID, the same frame 8.
+  ASSERT_TRUE(w.restore(frame2).ok());
+  play(w, 8);
+  EXPECT_EQ(w.save(), frame8);
+
+  // Another rock in the slab's place: the slab is forgotten; frame 8 needs it and says so.
+  ASSERT_TRUE(w.restore(frame2).ok());
+  const GeometryId other = hull(w, box_corners({0.3_fx, 0.3_fx, 0.3_fx}));
+  EXPECT_EQ(other.value, 2U);
+  const std::vector<std::uint8_t> before = w.save();
+  const Status refused = w.restore(frame8);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("geometry 2 (convex hull"), std::string::npos)
+      << refused.message();
+  EXPECT_EQ(w.save(), before);
+}
+
 TEST(Geometry, ACopyOfAWorldSharesItsGeometryAndStepsTheSame) {
   World w = make_world();
   const GeometryId g = hull(w, box_corners({0.5_fx, 0.25_fx, 0.5_fx}, {0.1_fx, 0_fx, 0_fx}));

@@ -34,8 +34,9 @@ void write_geometry(const WorldState& s, ByteWriter& w) {
 }
 
 // `s.geometries` holds the restoring world's geometry (World::restore puts it there): the state's
-// list must be a prefix of it, entry for entry; geometry registered after the state was saved is
-// dropped with the rest of what came later, like bodies created since.
+// list must be a prefix of it, entry for entry; geometry registered after the state was saved
+// leaves the state with the rest of what came later, like bodies created since (World::restore
+// sets it aside: WorldState::retained).
 bool read_geometry(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
                    std::string& error) {
   const std::size_t count_at = r.offset();

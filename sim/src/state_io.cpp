@@ -457,10 +457,16 @@ std::vector<std::uint8_t> World::save() const {
 Status World::restore(std::span<const std::uint8_t> bytes) {
   auto scratch = std::make_unique<sim_detail::WorldState>();
   // The geometry is the world's definition, not the state's: the state names it by hash, and
-  // read_geometry checks it against this world's.
+  // read_geometry checks it against this world's, including what an earlier restore set aside
+  // (so restoring frame 90 and then frame 100 works when frame 100's geometry came later).
+  // Whatever the state does not name is set aside again, not forgotten.
   scratch->geometries = s_->geometries;
+  scratch->geometries.insert(scratch->geometries.end(), s_->retained.begin(), s_->retained.end());
+  const sim_detail::GeometryTable known = scratch->geometries;
   std::string error;
   if (!sim_detail::read_state(bytes, *scratch, error)) return Status::error(error);
+  scratch->retained.assign(known.begin() + static_cast<std::ptrdiff_t>(scratch->geometries.size()),
+                           known.end());
   s_ = std::move(scratch);
   return Status::success();
 }

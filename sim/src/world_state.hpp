@@ -98,6 +98,11 @@ struct WorldState {
   WorldDef def;
   /// Registered geometry (part of the definition; the "geometry" section lists it by hash).
   GeometryTable geometries;
+  /// Geometry this world registered after the state it last restored was saved: not part of the
+  /// state (not saved, not hashed), kept so that a later state that names it restores (rollback
+  /// restores an earlier frame, then a later one), and reused, not rebuilt, when the same geometry
+  /// is registered again in the same place. Registering other geometry drops it.
+  GeometryTable retained;
   std::uint64_t frame = 0;
   std::uint32_t next_id = 1;
   Rng rng;

@@ -103,6 +103,15 @@ constexpr std::size_t kMaxGeometries = 0xFFFFFFFEU;
 Expected<GeometryId> add(WorldState& s, std::shared_ptr<const Geometry> g) {
   if (s.geometries.size() >= kMaxGeometries)
     return Status::error("geometry IDs exhausted (2^32 - 2 registered)");
+  // Registering again what a restore set aside (WorldState::retained) takes the same entry back;
+  // anything else forgets the retained entries, which no state of this world's future names.
+  if (!s.retained.empty() && s.retained.front()->type == g->type &&
+      s.retained.front()->hash == g->hash) {
+    g = s.retained.front();
+    s.retained.erase(s.retained.begin());
+  } else {
+    s.retained.clear();
+  }
   s.geometries.push_back(std::move(g));
   return GeometryId{static_cast<std::uint32_t>(s.geometries.size())};
 }
