@@ -1,6 +1,7 @@
 // Writes the state fuzzer's seed corpus: the saved state of every scenario (small parameters) at a
-// few frames, and one world whose bodies carry user data, a force and a torque (the optional body
-// fields of docs/STATE.md).
+// few frames, one world whose bodies carry user data, a force and a torque (the optional body
+// fields of docs/STATE.md), and the world of geometry_world.hpp, whose geometry the target holds.
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -9,6 +10,8 @@
 
 #include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/world.hpp>
+
+#include "geometry_world.hpp"
 
 namespace {
 
@@ -28,7 +31,8 @@ int main(int argc, char** argv) {
   const std::string dir = argv[1];
   for (const detsim::ScenarioInfo& info : detsim::scenario_list()) {
     detsim::ScenarioParams params;
-    if (info.default_count > 0) params.count = info.count_unit == "rows" ? 4 : 27;
+    if (info.default_count > 0)
+      params.count = std::min(info.max_count, info.count_unit == "rows" ? 4U : 27U);
     auto created = detsim::Scenario::create(info.name, params);
     if (!created) continue;
     detsim::Scenario& scenario = created.value();
@@ -52,5 +56,12 @@ int main(int argc, char** argv) {
   (void)w.apply_force(box.value(), {detsim::Fixed::one(), {}, {}});
   (void)w.apply_torque(box.value(), {{}, detsim::Fixed::one(), {}});
   write(dir + "/flags", w.save());
+  // The geometry the target world holds, with a body on each kind, at rest and after a fall.
+  detsim::World g = fuzz_support::geometry_world(true);
+  if (g.geometry_count() == 0) return 1;
+  write(dir + "/geometry_0", g.save());
+  for (int i = 0; i < 40; ++i)
+    g.step();
+  write(dir + "/geometry_40", g.save());
   return 0;
 }

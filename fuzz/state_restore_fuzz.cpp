@@ -14,15 +14,18 @@
 
 #include <detsim/sim/world.hpp>
 
+#include "geometry_world.hpp"
+
 namespace {
 
+// A world holding the seeds' geometry (geometry_world.hpp), so that states naming it restore;
+// states naming other geometry (the scenarios') exercise the refusal.
 detsim::World& target() {
   static detsim::World world = [] {
-    auto w = detsim::World::create({});
-    if (!w) std::abort();
-    (void)w.value().create_body(
-        {.type = detsim::BodyType::static_body, .shape = detsim::Shape::plane()});
-    return std::move(w.value());
+    detsim::World w = fuzz_support::geometry_world(false);
+    if (w.geometry_count() == 0) std::abort();
+    (void)w.create_body({.type = detsim::BodyType::static_body, .shape = detsim::Shape::plane()});
+    return w;
   }();
   return world;
 }

@@ -34,11 +34,7 @@ GeometryId cube_hull(World& w) {
 }
 
 BodyDef at(Shape shape, Vec3 position, Quat orientation = {}) {
-  BodyDef d;
-  d.shape = shape;
-  d.position = position;
-  d.orientation = orientation;
-  return d;
+  return test::placed(shape, position, orientation);
 }
 
 // Dropped side by side from 10 cm onto a plane and onto a static box, the hull of a unit cube's
@@ -98,13 +94,7 @@ TEST(ConvexPhysics, AHullOfACubesCornersSlidesLikeABox) {
 TEST(ConvexPhysics, ARestingRockStaysPut) {
   World w = make_world();
   add_ground(w);
-  Rng rng(9);
-  std::vector<Vec3> rock;
-  for (int i = 0; i < 12; ++i) {
-    const Vec3 u = rng.unit_vector();
-    rock.push_back({u.x * 0.6_fx, u.y * 0.4_fx, u.z * 0.5_fx});
-  }
-  auto g = w.create_convex_hull(rock);
+  auto g = w.create_convex_hull(test::test_rock());
   ASSERT_TRUE(g.ok()) << g.message();
   const BodyId id = add(w, at(Shape::convex(*g), {0_fx, 1_fx, 0_fx}));
   for (int i = 0; i < 180; ++i)

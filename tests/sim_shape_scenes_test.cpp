@@ -105,42 +105,38 @@ double one_centimetre(const World& w) {
   return m * -d(w.def().gravity.y) * 0.01;
 }
 
-TEST(RocksScenario, HullsLandOnTheHeightfieldWithoutSinkingOrGainingEnergy) {
-  // 60 rocks: four layers of 15 falling onto rolling hills and onto each other. A rock's centre of
-  // mass is inside it, so it can never be below the terrain's surface under it; a fall only loses
-  // energy (impacts and friction dissipate, nothing drives), so the energy never exceeds its
-  // start by more than the potential energy of the scene dropping 1 cm (the solver's position
-  // correction may lift a body out of a penetration a little).
-  Scenario s = make("rocks", {.seed = 1, .count = 60});
-  const BodyId terrain = first_static(s.world());
-  ASSERT_EQ(state(s.world(), terrain).shape.type, ShapeType::heightfield);
+// Runs `s` for 10 s (scaled) on its first static body, a surface of type `surface`: no dynamic
+// body's centre of mass goes below the surface under it (a centre of mass is inside its body, so
+// it cannot be below what the body rests on), and the energy never exceeds its start by more than
+// the potential energy of the scene dropping 1 cm (a fall only loses energy: impacts and friction
+// dissipate, nothing drives; the solver's position correction may lift a body a little).
+void expect_lands_without_sinking_or_gaining_energy(Scenario s, ShapeType surface,
+                                                    std::size_t at_least_checked) {
+  const std::string name(s.info().name);
+  const BodyId ground = first_static(s.world());
+  ASSERT_EQ(state(s.world(), ground).shape.type, surface) << name;
   const double tolerance = one_centimetre(s.world());
-  const Watch r = run_watching(s, terrain, test::scaled(600));
+  const Watch r = run_watching(s, ground, test::scaled(600));
   std::printf(
-      "[ rocks ] 60 rocks: energy rose at most %.3f J (1 cm of the scene: %.3f J); "
-      "deepest centre of mass below the terrain %s m over %zu checks\n",
-      r.worst_gain, tolerance, to_string(r.worst_sink).c_str(), r.checked);
-  EXPECT_LE(r.worst_gain, tolerance);
-  EXPECT_LE(r.worst_sink, 0_fx) << to_string(r.worst_sink);
-  EXPECT_GT(r.checked, 60U);
+      "[ %s ] energy rose at most %.3f J (1 cm of the scene: %.3f J); deepest centre of mass "
+      "below the surface %s m over %zu checks\n",
+      name.c_str(), r.worst_gain, tolerance, to_string(r.worst_sink).c_str(), r.checked);
+  EXPECT_LE(r.worst_gain, tolerance) << name;
+  EXPECT_LE(r.worst_sink, 0_fx) << name << ": " << to_string(r.worst_sink);
+  EXPECT_GT(r.checked, at_least_checked) << name;
+}
+
+TEST(RocksScenario, HullsLandOnTheHeightfieldWithoutSinkingOrGainingEnergy) {
+  // 60 rocks: four layers of 15 falling onto rolling hills and onto each other.
+  expect_lands_without_sinking_or_gaining_energy(make("rocks", {.seed = 1, .count = 60}),
+                                                 ShapeType::heightfield, 60);
 }
 
 TEST(LevelScenario, EveryKindOfBodyStaysOnTheMeshWithoutGainingEnergy) {
   // Boxes, rocks, capsules and compound tables dropped onto the ramp, the stairs and the ground of
-  // a triangle mesh: none passes the mesh (a centre of mass is inside its body, above the surface
-  // it rests on) and none gains energy (as for the rocks).
-  Scenario s = make("level", {.seed = 1, .count = 8});
-  const BodyId level = first_static(s.world());
-  ASSERT_EQ(state(s.world(), level).shape.type, ShapeType::mesh);
-  const double tolerance = one_centimetre(s.world());
-  const Watch r = run_watching(s, level, test::scaled(600));
-  std::printf(
-      "[ level ] energy rose at most %.3f J (1 cm: %.3f J); deepest centre of mass below "
-      "the mesh %s m over %zu checks\n",
-      r.worst_gain, tolerance, to_string(r.worst_sink).c_str(), r.checked);
-  EXPECT_LE(r.worst_gain, tolerance);
-  EXPECT_LE(r.worst_sink, 0_fx) << to_string(r.worst_sink);
-  EXPECT_GT(r.checked, 32U);
+  // a triangle mesh.
+  expect_lands_without_sinking_or_gaining_energy(make("level", {.seed = 1, .count = 8}),
+                                                 ShapeType::mesh, 32);
 }
 
 // How far a body's local +y axis is tilted from the world's up, radians.

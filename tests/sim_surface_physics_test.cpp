@@ -20,15 +20,8 @@ using namespace detsim::literals;
 
 using test::add;
 using test::make_world;
+using test::placed;
 using test::state;
-
-BodyDef placed(Shape shape, Vec3 position, Quat orientation = {}) {
-  BodyDef d;
-  d.shape = shape;
-  d.position = position;
-  d.orientation = orientation;
-  return d;
-}
 
 BodyDef static_at(Shape shape, Vec3 position = {}) {
   BodyDef d = placed(shape, position);
@@ -180,13 +173,7 @@ TEST(SurfacePhysics, AHullRestsOnAMeshAcrossItsEdgesWithoutCreeping) {
   // falls asleep, as on a plane.
   World w = make_world();
   add(w, static_at(Shape::mesh(flat_mesh(w, 4, 2_fx))));
-  Rng rng(9);
-  std::vector<Vec3> rock;
-  for (int i = 0; i < 12; ++i) {
-    const Vec3 u = rng.unit_vector();
-    rock.push_back({u.x * 0.6_fx, u.y * 0.4_fx, u.z * 0.5_fx});
-  }
-  auto g = w.create_convex_hull(rock);
+  auto g = w.create_convex_hull(test::test_rock());
   ASSERT_TRUE(g.ok()) << g.message();
   const BodyId id = add(w, placed(Shape::convex(*g), {0_fx, 1_fx, 0_fx}));
   for (int i = 0; i < 180; ++i)

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <detsim/detsim.hpp>
@@ -38,6 +39,29 @@ inline BodyState state(const World& w, BodyId id) {
   auto b = w.body(id);
   EXPECT_TRUE(b.ok()) << b.message();
   return b.ok() ? *b : BodyState{};
+}
+
+/// A dynamic body of `shape` placed at `position` turned by `orientation`, every other field
+/// default.
+inline BodyDef placed(Shape shape, Vec3 position, Quat orientation = {}) {
+  BodyDef d;
+  d.shape = shape;
+  d.position = position;
+  d.orientation = orientation;
+  return d;
+}
+
+/// The 12-point rock of the hull tests: points of Rng(9) on an ellipsoid of semi-axes 0.6, 0.4,
+/// 0.5 m.
+inline std::vector<Vec3> test_rock() {
+  using namespace detsim::literals;
+  Rng rng(9);
+  std::vector<Vec3> rock;
+  for (int i = 0; i < 12; ++i) {
+    const Vec3 u = rng.unit_vector();
+    rock.push_back({u.x * 0.6_fx, u.y * 0.4_fx, u.z * 0.5_fx});
+  }
+  return rock;
 }
 
 /// |actual - expected| <= tolerance, printing all three as decimals on failure.
