@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 #include <detsim/detsim.hpp>
+#include <detsim/fixed/exact_sum.hpp>
 
 #include "sim/src/geometry/hull.hpp"
 #include "sim/src/geometry/inertia.hpp"
@@ -432,6 +433,52 @@ TEST(Hull, SupportIsTheFarthestVertexWithTiesToTheLowestIndex) {
   EXPECT_EQ(sim_detail::hull_support(hull, {1000000_fx, -1000000_fx, 1000000_fx}), 5);
   EXPECT_EQ(sim_detail::hull_support(hull, {Fixed::epsilon(), -Fixed::epsilon(), Fixed::epsilon()}),
             5);
+}
+
+// The support search prunes with a 64-bit estimate before comparing exactly: it must give the
+// exact scan's answer (the lowest index of the exactly farthest vertices) for every direction,
+// whatever its length, along face normals (ties) included, on hulls small and large.
+TEST(Hull, SupportEqualsTheExactScanForAnyDirection) {
+  const auto reference = [](const Hull& h, Vec3 d) {
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < h.vertices.size(); ++i) {
+      detsim::detail::ExactSum<3> s;
+      s.add_product(d.x.raw(), h.vertices[i].x.raw() - h.vertices[best].x.raw());
+      s.add_product(d.y.raw(), h.vertices[i].y.raw() - h.vertices[best].y.raw());
+      s.add_product(d.z.raw(), h.vertices[i].z.raw() - h.vertices[best].z.raw());
+      if (!s.negative() && !s.is_zero()) best = i;
+    }
+    return static_cast<std::uint16_t>(best);
+  };
+  Rng rng(21);
+  int checked = 0;
+  for (const int points : {8, 12, 40, 200}) {
+    std::vector<Vec3> cloud;
+    for (int i = 0; i < points; ++i)
+      cloud.push_back(rng.unit_vector() * rng.uniform(0.2_fx, 900_fx));
+    if (points == 8) cloud = box_corners({0.5_fx, 5000_fx, 0.05_fx});
+    const auto built = build_hull(cloud);
+    ASSERT_TRUE(built.ok()) << built.message();
+    const Hull& hull = *built;
+    std::vector<Vec3> directions;
+    for (int i = 0; i < 400; ++i) {
+      const Vec3 u = rng.unit_vector();
+      directions.push_back(u);
+      directions.push_back(u * Fixed::from_raw(rng.uniform(1_fx, 4_fx).raw() << 30));  // huge
+      directions.push_back(Vec3{Fixed::from_raw(u.x.raw() >> 28), Fixed::from_raw(u.y.raw() >> 28),
+                                Fixed::from_raw(u.z.raw() >> 28)});  // a few raw units
+    }
+    // Edge directions between vertices, turned a quarter: orthogonal to an edge, ties likely.
+    for (std::size_t i = 0; i + 1 < hull.vertices.size() && i < 60; ++i)
+      directions.push_back(cross(hull.vertices[i + 1] - hull.vertices[i], Vec3::unit_y()));
+    for (const Vec3 d : directions) {
+      ASSERT_EQ(sim_detail::hull_support(hull, d), reference(hull, d))
+          << points << " points, direction " << to_string(d.x) << " " << to_string(d.y) << " "
+          << to_string(d.z);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 4000);
 }
 
 TEST(Hull, WorstRelativeErrorOfTheClosedFormChecks) {
