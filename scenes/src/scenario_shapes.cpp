@@ -85,7 +85,10 @@ void build_rocks(World& w, const ScenarioParams& p) {
     const GeometryId g = hull(w, rock_points(w.rng()));
     const Vec3 at{Fixed::from_int(column - 7) * 1.4_fx, 4_fx + Fixed::from_int(layer) * 1.4_fx,
                   Fixed::from_int(row - 7) * 1.4_fx};
-    const Quat turn = from_axis_angle(w.rng().unit_vector(), w.rng().uniform(0_fx, Fixed::pi()));
+    // One draw per statement: the order of a call's arguments is the compiler's choice.
+    const Fixed angle = w.rng().uniform(0_fx, Fixed::pi());
+    const Vec3 axis = w.rng().unit_vector();
+    const Quat turn = from_axis_angle(axis, angle);
     add(w, dynamic(Shape::convex(g), at, turn));
   }
 }
