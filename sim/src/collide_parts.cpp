@@ -58,6 +58,24 @@ void parts_of(const PosedShape& s, std::vector<PlacedPart>& out) {
   }
 }
 
+// The working lists of collide_all, reused from call to call (a pair of a compound and a surface
+// would otherwise allocate several lists per step): one set per thread, as worlds may step on
+// different threads. They hold nothing between calls; the results depend only on the inputs.
+struct PartsScratch {
+  std::vector<PlacedPart> parts_a;
+  std::vector<PlacedPart> parts_b;
+  std::vector<std::uint32_t> triangles;
+  std::vector<SubManifold> per_triangle;
+  std::vector<convex::Candidate> candidates;
+  std::vector<convex::Candidate> unique;
+  std::vector<bool> taken;
+};
+
+PartsScratch& parts_scratch() {
+  thread_local PartsScratch scratch;
+  return scratch;
+}
+
 Fixed part_radius(const PlacedPart& p) noexcept {
   return shape_kind(p.shape->type).bounding_radius(*p.shape, p.geometry);
 }
@@ -83,8 +101,10 @@ constexpr std::uint16_t kPatchFace = narrow::feature(narrow::Kind::face, 0);
 // as it slides from triangle to triangle (collide_group matches a patch by its normal); the
 // snapshot does not grow with the number of triangles under a body.
 void merge_patches(std::span<const SubManifold> tri, Vec3 origin, std::vector<SubManifold>& out) {
-  std::vector<bool> taken(tri.size(), false);
-  std::vector<convex::Candidate> candidates;
+  PartsScratch& scratch = parts_scratch();
+  std::vector<bool>& taken = scratch.taken;
+  taken.assign(tri.size(), false);
+  std::vector<convex::Candidate>& candidates = scratch.candidates;
   for (std::size_t i = 0; i < tri.size(); ++i) {
     if (taken[i]) continue;
     const Vec3 n = tri[i].manifold.normal;
@@ -107,7 +127,8 @@ void merge_patches(std::span<const SubManifold> tri, Vec3 origin, std::vector<Su
       continue;
     }
     // Points of two triangles on their shared edge or vertex are one point: keep the first.
-    std::vector<convex::Candidate> unique;
+    std::vector<convex::Candidate>& unique = scratch.unique;
+    unique.clear();
     for (const convex::Candidate& c : candidates) {
       const bool seen = std::any_of(unique.begin(), unique.end(), [&c](const convex::Candidate& u) {
         return u.point == c.point;
@@ -125,13 +146,14 @@ void merge_patches(std::span<const SubManifold> tri, Vec3 origin, std::vector<Su
 // part's merged into patches of one normal (merge_patches).
 void against_surface(const PosedShape& x, const PosedShape& surface, Fixed margin,
                      std::vector<SubManifold>& out) {
-  std::vector<PlacedPart> parts;
+  PartsScratch& scratch = parts_scratch();
+  std::vector<PlacedPart>& parts = scratch.parts_a;
   parts_of(x, parts);
   const Mat3 to_surface = transpose(surface.pose.rotation);
   const Geometry& g = *surface.geometry;
   const bool mesh = g.type == GeometryType::mesh;
-  std::vector<std::uint32_t> triangles;
-  std::vector<SubManifold> per_triangle;
+  std::vector<std::uint32_t>& triangles = scratch.triangles;
+  std::vector<SubManifold>& per_triangle = scratch.per_triangle;
   for (const PlacedPart& part : parts) {
     // The part's world box, in the surface's frame: its centre moved in, its extent turned.
     const ShapeKind& kind = shape_kind(part.shape->type);
@@ -208,8 +230,9 @@ void collide_all(const PosedShape& a, const PosedShape& b, Fixed margin,
   }
   // Compounds: part against part, culled by bounding balls (an unbounded shape, a plane, has
   // radius 0 and is never culled).
-  std::vector<PlacedPart> parts_a;
-  std::vector<PlacedPart> parts_b;
+  PartsScratch& scratch = parts_scratch();
+  std::vector<PlacedPart>& parts_a = scratch.parts_a;
+  std::vector<PlacedPart>& parts_b = scratch.parts_b;
   parts_of(a, parts_a);
   parts_of(b, parts_b);
   for (const PlacedPart& pa : parts_a) {

@@ -142,7 +142,8 @@ std::vector<BodyId> World::overlap(const Shape& shape, Vec3 position, Quat orien
   const Pose query{position, to_mat3(orientation)};
   const sim_detail::Geometry* shape_geometry = s_->geometry(shape);
   const Fixed reach = bounding_radius(shape, shape_geometry);
-  std::vector<sim_detail::SubManifold> manifolds;
+  // Reused between queries (one list per thread): a query allocates only its result.
+  thread_local std::vector<sim_detail::SubManifold> manifolds;
   for (const BodyState& b : s_->bodies) {
     if (!passes(b, filter)) continue;
     if (sim_detail::shape_kind(b.shape.type).bounded) {
