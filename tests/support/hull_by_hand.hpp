@@ -87,7 +87,8 @@ inline sim_detail::Hull hull_by_hand(std::vector<Vec3> points) {
       std::uint16_t a = h.face_vertices[f.first + i];
       std::uint16_t b = h.face_vertices[f.first + (i + 1) % f.count];
       if (b < a) std::swap(a, b);
-      auto [it, fresh] = edges.try_emplace({a, b}, HullEdge{a, b, 0, 0});
+      auto [it, fresh] =
+          edges.try_emplace({a, b}, HullEdge{a, b, 0, 0, normalize(h.vertices[b] - h.vertices[a])});
       (fresh ? it->second.face_0 : it->second.face_1) = static_cast<std::uint16_t>(fi);
     }
   }

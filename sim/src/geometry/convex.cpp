@@ -424,7 +424,7 @@ SatEdge sat_edge(const ConvexView& v, unsigned i) noexcept {
       SatEdge e;
       e.p0 = v.hull->vertices[h.a];
       e.p1 = v.hull->vertices[h.b];
-      e.direction = normalize(e.p1 - e.p0);
+      e.direction = h.direction;
       e.n0 = v.hull->faces[h.face_0].normal;
       e.n1 = v.hull->faces[h.face_1].normal;
       e.feature = convex_feature(kEdge, i);

@@ -116,17 +116,33 @@ WorldEdge world_edge(const Body& b, unsigned i) noexcept {
   return w;
 }
 
-/// The edges of b in world space, posed once per pair (each needs a normalisation) when there
-/// are at most kCachedEdges of them; larger hulls pose them as they are read.
+/// The edges of b in world space, posed once per pair when there are at most kCachedEdges of
+/// them; larger hulls pose them as they are read. For a hull of at most kCachedFaces faces, also
+/// its faces' world normals and each edge's two faces (`by_face`): an edge's Gauss-map arc ends
+/// are its faces' normals, so the first Minkowski-face test of an edge of a against every edge of
+/// b needs one sign per face of b, not two per edge (edge_axes).
 constexpr unsigned kCachedEdges = 64;
+constexpr unsigned kCachedFaces = 64;
 struct PosedEdges {
   const Body& body;
   unsigned count;
   std::array<WorldEdge, kCachedEdges> cache;
+  bool by_face = false;
+  unsigned faces = 0;
+  std::array<Vec3, kCachedFaces> normals;
+  std::array<std::array<std::uint16_t, 2>, kCachedEdges> face_of;
   explicit PosedEdges(const Body& b) noexcept : body(b), count(sat_edge_count(*b.view)) {
     if (count > kCachedEdges) return;
     for (unsigned i = 0; i < count; ++i)
       cache[i] = world_edge(b, i);
+    if (b.view->kind != ConvexKind::hull || b.view->hull->faces.size() > kCachedFaces) return;
+    const Hull& h = *b.view->hull;
+    by_face = true;
+    faces = static_cast<unsigned>(h.faces.size());
+    for (unsigned f = 0; f < faces; ++f)  // as world_edge turns them: the same bits
+      normals[f] = b.unrotated ? h.faces[f].normal : b.rotation * h.faces[f].normal;
+    for (unsigned i = 0; i < count; ++i)
+      face_of[i] = {h.edges[i].face_0, h.edges[i].face_1};
   }
   /// Edge i, from the cache or posed into `scratch`.
   [[nodiscard]] const WorldEdge& at(unsigned i, WorldEdge& scratch) const noexcept {
@@ -159,6 +175,13 @@ bool arc_meets_circle(Vec3 n0, Vec3 n1, Vec3 u) noexcept {
 
 /// Whether edges ea (of a) and eb (of b) make a face of the Minkowski difference: their Gauss-map
 /// arcs, a's and b's negated, intersect (Gregorius). A segment core's arc is a whole circle.
+/// The second half of the arcs' test (minkowski_face), given the first's sign cba.
+bool arcs_cross(const WorldEdge& ea, const WorldEdge& eb, int cba) noexcept {
+  const int adc = sign_of_dot(ea.n0, eb.arc);
+  const int bdc = sign_of_dot(ea.n1, eb.arc);
+  return adc * bdc < 0 && cba * bdc > 0;
+}
+
 bool minkowski_face(const WorldEdge& ea, const WorldEdge& eb) noexcept {
   if (ea.circle && eb.circle) return true;
   if (ea.circle) return arc_meets_circle(-eb.n0, -eb.n1, ea.direction);
@@ -168,9 +191,7 @@ bool minkowski_face(const WorldEdge& ea, const WorldEdge& eb) noexcept {
   const int cba = -sign_of_dot(eb.n0, ea.arc);
   const int dba = -sign_of_dot(eb.n1, ea.arc);
   if (cba * dba >= 0) return false;
-  const int adc = sign_of_dot(ea.n0, eb.arc);
-  const int bdc = sign_of_dot(ea.n1, eb.arc);
-  return adc * bdc < 0 && cba * bdc > 0;
+  return arcs_cross(ea, eb, cba);
 }
 
 void face_axes(const Body& owner, const Body& a, const Body& b, bool owner_is_a, Fixed margin,
@@ -196,11 +217,21 @@ void edge_axes(const Body& a, const Body& b, Fixed margin, Best& best, bool& bey
   const bool straight =
       a.view->kind != ConvexKind::cylinder && b.view->kind != ConvexKind::cylinder;
   WorldEdge scratch;
+  std::array<int, kCachedFaces> side{};  // -(b's face normal . ea's arc), by face of b
   for (unsigned i = 0; i < count_a && !beyond; ++i) {
     const WorldEdge ea = world_edge(a, i);
+    const bool by_face = edges_b.by_face && !ea.circle;
+    for (unsigned f = 0; by_face && f < edges_b.faces; ++f)
+      side[f] = -sign_of_dot(edges_b.normals[f], ea.arc);
     for (unsigned j = 0; j < edges_b.count && !beyond; ++j) {
       const WorldEdge& eb = edges_b.at(j, scratch);
-      if (!minkowski_face(ea, eb)) continue;
+      if (by_face) {
+        // minkowski_face's first test from the faces' signs (the same bits), then its second.
+        const int cba = side[edges_b.face_of[j][0]];
+        if (cba * side[edges_b.face_of[j][1]] >= 0 || !arcs_cross(ea, eb, cba)) continue;
+      } else if (!minkowski_face(ea, eb)) {
+        continue;
+      }
       const Vec3 w = cross(ea.direction, eb.direction);
       if (length_squared(w) < parallel_sin2) continue;  // parallel edges add no direction
       Vec3 l = normalize(w);

@@ -56,6 +56,7 @@ struct HullEdge {
   std::uint16_t b = 0;
   std::uint16_t face_0 = 0;
   std::uint16_t face_1 = 0;
+  Vec3 direction;  ///< normalize(vertices[b] - vertices[a]), made by the build
 };
 
 /// Mass properties of a solid of uniform density: volume, centroid, and the inertia tensor per

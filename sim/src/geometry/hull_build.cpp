@@ -625,6 +625,10 @@ Expected<Hull> build_hull(std::span<const Vec3> points) {
     return std::pair(a[0], a[1]) < std::pair(b[0], b[1]);
   });
   if (Status s = finish_hull(hull, loops); !s) return s;
+  // Each edge's unit direction, once: the separating-axis test reads every edge of both hulls of
+  // every pair, every step.
+  for (HullEdge& e : hull.edges)
+    e.direction = normalize(hull.vertices[e.b] - hull.vertices[e.a]);
   return hull;
 }
 
