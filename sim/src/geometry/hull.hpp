@@ -7,6 +7,7 @@
 // on every platform.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -81,6 +82,10 @@ struct Hull {
   Vec3 aabb_max;
   Fixed bounding_radius;  ///< max |vertex| (about the local origin, not the centroid)
   Fixed inner_radius;     ///< the smallest distance from the centroid to a face plane
+  /// hull_support's estimates of the vertices (raw >> 20 per component) and their largest
+  /// magnitude, made by the build; empty for a hull made otherwise (hull_support makes them).
+  std::vector<std::array<std::int64_t, 3>> coarse;
+  std::int64_t coarse_widest = 0;
 };
 
 /// The volume, centroid and inertia of the solid bounded by `hull`'s faces (its vertices, faces
@@ -96,6 +101,9 @@ struct Hull {
 /// result is one of the points and a true corner (on at least three faces); every point is inside
 /// the hull or within hull_tolerance of it.
 [[nodiscard]] Expected<Hull> build_hull(std::span<const Vec3> points);
+
+/// Fills hull.coarse and hull.coarse_widest from its vertices (build_hull does).
+void make_coarse(Hull& hull);
 
 /// The point of `hull` farthest along `direction` (any length, not zero); ties go to the lowest
 /// vertex index, so the answer depends only on the hull and the direction.

@@ -629,6 +629,7 @@ Expected<Hull> build_hull(std::span<const Vec3> points) {
   // every pair, every step.
   for (HullEdge& e : hull.edges)
     e.direction = normalize(hull.vertices[e.b] - hull.vertices[e.a]);
+  make_coarse(hull);
   return hull;
 }
 
@@ -658,18 +659,41 @@ std::uint16_t exact_support(const Hull& hull, Vec3 direction, const bool* keep) 
 
 }  // namespace
 
+namespace {
+
+std::array<std::int64_t, 3> coarse_of(Vec3 v) noexcept {
+  return {v.x.raw() >> 20, v.y.raw() >> 20, v.z.raw() >> 20};
+}
+
+std::int64_t magnitude_of(const std::array<std::int64_t, 3>& c) noexcept {
+  const auto m = [](std::int64_t x) { return x < 0 ? -x : x; };
+  return std::max({m(c[0]), m(c[1]), m(c[2])});
+}
+
+}  // namespace
+
+void make_coarse(Hull& hull) {
+  hull.coarse.clear();
+  hull.coarse_widest = 0;
+  for (const Vec3 v : hull.vertices) {
+    hull.coarse.push_back(coarse_of(v));
+    hull.coarse_widest = std::max(hull.coarse_widest, magnitude_of(hull.coarse.back()));
+  }
+}
+
 std::uint16_t hull_support(const Hull& hull, Vec3 direction) noexcept {
   // The answer is the exact scan's (exact_support: the lowest index of the exactly farthest
   // vertices), found faster: a 64-bit estimate of every vertex's dot product, with a bound on its
   // error, keeps only the vertices that could be farthest, and the exact scan runs over those (in
   // index order, so ties still keep the lower index). The estimate: the direction cut to 15
-  // significant bits (d' = d >> s), each vertex coordinate to raw >> 20 (v'; |v'| < 2^43 for any
-  // Fixed), so |sum d' v'| < 3 * 2^58: no overflow. Its error against sum (d / 2^s)(v / 2^20) is
-  // below sum over c of (max |v'| + 1) + (|d'_c| + 1) per vertex; two estimates within twice
-  // that of the best may be in either order, and are both kept.
+  // significant bits (d' = d >> s), each vertex coordinate to raw >> 20 (v', Hull::coarse;
+  // |v'| < 2^43 for any Fixed), so |sum d' v'| < 3 * 2^58: no overflow. Its error against
+  // sum (d / 2^s)(v / 2^20) is below sum over c of (max |v'| + 1) + (|d'_c| + 1) per vertex; two
+  // estimates within twice that of the best may be in either order, and are both kept.
   constexpr std::size_t kMaxEstimated = 64;
   const std::size_t n = hull.vertices.size();
   if (n <= 1 || n > kMaxEstimated) return exact_support(hull, direction, nullptr);
+  const bool built = hull.coarse.size() == n;
   const std::array<std::int64_t, 3> d{direction.x.raw(), direction.y.raw(), direction.z.raw()};
   std::uint64_t largest = 0;
   for (const std::int64_t c : d)
@@ -683,19 +707,15 @@ std::uint16_t hull_support(const Hull& hull, Vec3 direction) noexcept {
     error += (dc[c] < 0 ? -dc[c] : dc[c]) + 1;
   }
   std::array<std::int64_t, kMaxEstimated> estimate{};
-  std::int64_t widest = 0;
+  std::int64_t widest = built ? hull.coarse_widest : 0;
+  std::int64_t top = INT64_MIN;
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 v = hull.vertices[i];
-    const std::int64_t x = v.x.raw() >> 20;
-    const std::int64_t y = v.y.raw() >> 20;
-    const std::int64_t z = v.z.raw() >> 20;
-    widest = std::max({widest, x < 0 ? -x : x, y < 0 ? -y : y, z < 0 ? -z : z});
-    estimate[i] = dc[0] * x + dc[1] * y + dc[2] * z;
+    const std::array<std::int64_t, 3> v = built ? hull.coarse[i] : coarse_of(hull.vertices[i]);
+    if (!built) widest = std::max(widest, magnitude_of(v));
+    estimate[i] = dc[0] * v[0] + dc[1] * v[1] + dc[2] * v[2];
+    top = std::max(top, estimate[i]);
   }
   error += 3 * (widest + 1);
-  std::int64_t top = estimate[0];
-  for (std::size_t i = 1; i < n; ++i)
-    top = std::max(top, estimate[i]);
   std::array<bool, kMaxEstimated> keep{};
   std::size_t kept = 0;
   std::size_t only = 0;
