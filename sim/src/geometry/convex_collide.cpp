@@ -24,6 +24,7 @@
 // 5. apart, and the axis made no contact (corners passing each other): GJK closest points.
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include <detsim/fixed/math.hpp>
 #include <detsim/fixed/vec3.hpp>
@@ -123,32 +124,49 @@ WorldEdge world_edge(const Body& b, unsigned i) noexcept {
 /// b needs one sign per face of b, not two per edge (edge_axes).
 constexpr unsigned kCachedEdges = 64;
 constexpr unsigned kCachedFaces = 64;
+// PosedEdges' lists, reused from pair to pair (one set per thread): filled, never zeroed.
+struct PosedLists {
+  std::vector<WorldEdge> edges;
+  std::vector<Vec3> normals;
+  std::vector<std::array<std::uint16_t, 2>> face_of;
+};
+PosedLists& posed_lists() {
+  thread_local PosedLists lists;
+  return lists;
+}
 struct PosedEdges {
   const Body& body;
   unsigned count;
-  std::array<WorldEdge, kCachedEdges> cache;
+  PosedLists& lists = posed_lists();
   bool by_face = false;
   unsigned faces = 0;
-  std::array<Vec3, kCachedFaces> normals;
-  std::array<std::array<std::uint16_t, 2>, kCachedEdges> face_of;
   explicit PosedEdges(const Body& b) noexcept : body(b), count(sat_edge_count(*b.view)) {
     if (count > kCachedEdges) return;
+    lists.edges.clear();
     for (unsigned i = 0; i < count; ++i)
-      cache[i] = world_edge(b, i);
+      lists.edges.push_back(world_edge(b, i));
     if (b.view->kind != ConvexKind::hull || b.view->hull->faces.size() > kCachedFaces) return;
     const Hull& h = *b.view->hull;
     by_face = true;
     faces = static_cast<unsigned>(h.faces.size());
+    lists.normals.clear();
     for (unsigned f = 0; f < faces; ++f)  // as world_edge turns them: the same bits
-      normals[f] = b.unrotated ? h.faces[f].normal : b.rotation * h.faces[f].normal;
+      lists.normals.push_back(b.unrotated ? h.faces[f].normal : b.rotation * h.faces[f].normal);
+    lists.face_of.clear();
     for (unsigned i = 0; i < count; ++i)
-      face_of[i] = {h.edges[i].face_0, h.edges[i].face_1};
+      lists.face_of.push_back({h.edges[i].face_0, h.edges[i].face_1});
   }
+  PosedEdges(const PosedEdges&) = delete;
+  PosedEdges& operator=(const PosedEdges&) = delete;
   /// Edge i, from the cache or posed into `scratch`.
   [[nodiscard]] const WorldEdge& at(unsigned i, WorldEdge& scratch) const noexcept {
-    if (count <= kCachedEdges) return cache[i];
+    if (count <= kCachedEdges) return lists.edges[i];
     scratch = world_edge(body, i);
     return scratch;
+  }
+  [[nodiscard]] Vec3 normal(unsigned f) const noexcept { return lists.normals[f]; }
+  [[nodiscard]] const std::array<std::uint16_t, 2>& faces_of(unsigned i) const noexcept {
+    return lists.face_of[i];
   }
 };
 
@@ -217,18 +235,18 @@ void edge_axes(const Body& a, const Body& b, Fixed margin, Best& best, bool& bey
   const bool straight =
       a.view->kind != ConvexKind::cylinder && b.view->kind != ConvexKind::cylinder;
   WorldEdge scratch;
-  std::array<int, kCachedFaces> side{};  // -(b's face normal . ea's arc), by face of b
+  std::array<int, kCachedFaces> side;  // -(b's face normal . ea's arc), by face of b (as filled)
   for (unsigned i = 0; i < count_a && !beyond; ++i) {
     const WorldEdge ea = world_edge(a, i);
     const bool by_face = edges_b.by_face && !ea.circle;
     for (unsigned f = 0; by_face && f < edges_b.faces; ++f)
-      side[f] = -sign_of_dot(edges_b.normals[f], ea.arc);
+      side[f] = -sign_of_dot(edges_b.normal(f), ea.arc);
     for (unsigned j = 0; j < edges_b.count && !beyond; ++j) {
       const WorldEdge& eb = edges_b.at(j, scratch);
       if (by_face) {
         // minkowski_face's first test from the faces' signs (the same bits), then its second.
-        const int cba = side[edges_b.face_of[j][0]];
-        if (cba * side[edges_b.face_of[j][1]] >= 0 || !arcs_cross(ea, eb, cba)) continue;
+        const int cba = side[edges_b.faces_of(j)[0]];
+        if (cba * side[edges_b.faces_of(j)[1]] >= 0 || !arcs_cross(ea, eb, cba)) continue;
       } else if (!minkowski_face(ea, eb)) {
         continue;
       }

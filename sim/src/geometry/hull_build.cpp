@@ -531,7 +531,7 @@ Status finish_hull(Hull& hull, const std::vector<std::vector<std::uint16_t>>& lo
     const auto it = std::lower_bound(directed.begin(), directed.end(), reverse, before);
     if (it == directed.end() || it->from != d.to || it->to != d.from)
       return refuse("internal error: an edge has one face");
-    if (d.from < d.to) hull.edges.push_back({d.from, d.to, d.face, it->face});
+    if (d.from < d.to) hull.edges.push_back({d.from, d.to, d.face, it->face, Vec3{}});
   }
   if (v.size() + hull.faces.size() != hull.edges.size() + 2)
     return refuse("internal error: the faces do not close (V - E + F != 2)");
@@ -706,7 +706,7 @@ std::uint16_t hull_support(const Hull& hull, Vec3 direction) noexcept {
     dc[c] = d[c] >> s;  // arithmetic: floor
     error += (dc[c] < 0 ? -dc[c] : dc[c]) + 1;
   }
-  std::array<std::int64_t, kMaxEstimated> estimate{};
+  std::array<std::int64_t, kMaxEstimated> estimate;  // entries [0, n) written below (no memset)
   std::int64_t widest = built ? hull.coarse_widest : 0;
   std::int64_t top = INT64_MIN;
   for (std::size_t i = 0; i < n; ++i) {
@@ -716,7 +716,7 @@ std::uint16_t hull_support(const Hull& hull, Vec3 direction) noexcept {
     top = std::max(top, estimate[i]);
   }
   error += 3 * (widest + 1);
-  std::array<bool, kMaxEstimated> keep{};
+  std::array<bool, kMaxEstimated> keep;  // entries [0, n) written below
   std::size_t kept = 0;
   std::size_t only = 0;
   for (std::size_t i = 0; i < n; ++i) {
