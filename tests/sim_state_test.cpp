@@ -38,7 +38,7 @@ TEST(StateFormat, DefaultWorldStartsWithMagicAndVersion) {
   EXPECT_EQ(bytes[2], 'I');
   EXPECT_EQ(bytes[3], 'M');
   EXPECT_EQ((Bytes(bytes.begin() + 4, bytes.begin() + 8)), (Bytes{5, 0, 0, 0}));
-  EXPECT_EQ(state_encoding_version, 5U);
+  EXPECT_EQ(state_encoding_version, 6U);
   // Then the section count (var 6) and the first section's record: its name's length (7),
   // "globals", its version (var 1) and its payload's length: frame 8 + next ID 4 + definition 137
   // = 149 = 0x95 (u32); then frame 0 (u64) and the next body ID, 1 (u32).

@@ -9,6 +9,7 @@
 
 #include <detsim/fixed/math.hpp>
 
+#include "particles/xpbd.hpp"
 #include "world_state.hpp"
 
 namespace detsim::sim_detail {
@@ -198,6 +199,14 @@ UnionFind islands(const WorldState& s) {
     if (a.type == BodyType::dynamic && b.type == BodyType::dynamic && !a.sensor && !b.sensor)
       uf.join(static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
   }
+  // So are two bodies that a rope holds together (its tether).
+  for (const ParticleGroup& g : s.particle_groups) {
+    if (g.type != ParticleGroupType::rope || g.attachments.size() != 2) continue;
+    const auto ia = static_cast<std::size_t>(s.find(g.attachments[0].body));
+    const auto ib = static_cast<std::size_t>(s.find(g.attachments[1].body));
+    if (s.bodies[ia].type == BodyType::dynamic && s.bodies[ib].type == BodyType::dynamic)
+      uf.join(static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
+  }
   // Joined bodies are one island: they sleep and wake together.
   for (std::size_t ji = 0; ji < s.joints.size(); ++ji) {
     if (s.joints[ji].broken) continue;
@@ -335,9 +344,10 @@ void update_sleep(WorldState& s) {
   // An island sleeps when every body in it has been slow long enough and nothing moving that is
   // outside the island (a kinematic body) touches it.
   std::vector<bool> keep_awake(s.bodies.size(), false);
+  const std::vector<bool> held = bodies_held_by_particles(s);
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
     const BodyState& b = s.bodies[i];
-    if (b.type == BodyType::dynamic && b.awake && b.sleep_time < s.def.time_to_sleep)
+    if (b.type == BodyType::dynamic && b.awake && (b.sleep_time < s.def.time_to_sleep || held[i]))
       keep_awake[uf.root(static_cast<std::uint32_t>(i))] = true;
   }
   for (const Contact& c : s.contacts) {

@@ -282,6 +282,7 @@ constexpr WorldSection kSections[] = {
     {"globals", 1, write_globals, read_globals},    {"rng", 1, write_rng_section, read_rng},
     {"geometry", 1, write_geometry, read_geometry}, {"bodies", 2, write_bodies, read_bodies},
     {"contacts", 2, write_contacts, read_contacts}, {"joints", 1, write_joints, read_joints},
+    {"particles", 1, write_particles, read_particles},
 };
 constexpr std::size_t kSectionCount = std::size(kSections);
 

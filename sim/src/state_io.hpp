@@ -26,6 +26,10 @@ bool read_bodies(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState&
 void write_joints(const WorldState& s, ByteWriter& w);
 bool read_joints(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState& s,
                  std::string& error);
+/// The "particles" payload (state_particles.cpp), and its reader (bodies already read).
+void write_particles(const WorldState& s, ByteWriter& w);
+bool read_particles(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState& s,
+                    std::string& error);
 /// The checks restore() makes of a joint against the bodies of `s` ("" when valid): what --inject
 /// must keep.
 [[nodiscard]] std::string check_joint_record(const WorldState& s, const JointState& j);

@@ -1,6 +1,7 @@
 // World::step: a short orchestrator of named stages (docs/SIM.md describes each).
 #include <detsim/fixed/math.hpp>
 
+#include "particles/xpbd.hpp"
 #include "shapes.hpp"
 #include "world_state.hpp"
 
@@ -10,15 +11,17 @@ void World::step() {
   sim_detail::WorldState& s = *s_;
   s.events.clear();
   s.joint_events.clear();
-  sim_detail::prepare_bodies(s);        // 1. derived data: poses, inverse mass and inertia, AABBs
-  sim_detail::update_contacts(s);       // 2. broadphase: overlapping pairs, ascending by ID pair
-  sim_detail::collide_contacts(s);      // 3. narrowphase: manifolds, warm-start impulses matched
-  sim_detail::wake_touched_islands(s);  // 4. islands touched by moving bodies wake up
-  sim_detail::solve(s);                 // 5. inputs, velocities, contacts, positions (sub-stepped)
-  sim_detail::continuous(s);            // 6. fast and CCD bodies stop at their first touch
-  sim_detail::update_sleep(s);          // 7. islands at rest fall asleep
-  sim_detail::report_contacts(s);       // 8. contact and sensor events, by pair
-  for (BodyState& b : s.bodies) {       // 9. game inputs are consumed by the step
+  sim_detail::prepare_bodies(s);         // 1. derived data: poses, inverse mass and inertia, AABBs
+  sim_detail::prepare_particles(s);      //    particle groups' boxes; awake groups wake bodies
+  sim_detail::update_contacts(s);        // 2. broadphase: overlapping pairs, ascending by ID pair
+  sim_detail::collide_contacts(s);       // 3. narrowphase: manifolds, warm-start impulses matched
+  sim_detail::wake_touched_islands(s);   // 4. islands touched by moving bodies wake up
+  sim_detail::solve(s);                  // 5. inputs, velocities, contacts, positions (sub-stepped)
+  sim_detail::continuous(s);             // 6. fast and CCD bodies stop at their first touch
+  sim_detail::update_sleep(s);           // 7. islands at rest fall asleep
+  sim_detail::update_particle_sleep(s);  //    then particle groups at rest, among sleeping bodies
+  sim_detail::report_contacts(s);        // 8. contact and sensor events, by pair
+  for (BodyState& b : s.bodies) {        // 9. game inputs are consumed by the step
     b.force = {};
     b.torque = {};
   }

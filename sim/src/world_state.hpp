@@ -20,6 +20,7 @@
 
 #include "collide.hpp"
 #include "geometry/geometry.hpp"
+#include "particles/group.hpp"
 
 namespace detsim::sim_detail {
 
@@ -110,6 +111,8 @@ struct WorldState {
   std::vector<Contact> contacts;   ///< ascending (a, b)
   std::vector<JointState> joints;  ///< ascending ID
   std::uint32_t next_joint_id = 1;
+  std::vector<ParticleGroup> particle_groups;  ///< ascending ID
+  std::uint32_t next_particle_group_id = 1;
   std::vector<Derived> derived;  ///< rebuilt each step
   /// Step scratch, not saved: where each joint's body_a and body_b are in `bodies` (parallel to
   /// `joints`), set by prepare_bodies for the stages after it so that they need not search for
@@ -134,6 +137,10 @@ struct WorldState {
   [[nodiscard]] std::ptrdiff_t find(std::uint32_t id) const noexcept;
   /// Index of joint `id` in `joints`, or -1.
   [[nodiscard]] std::ptrdiff_t find_joint(std::uint32_t id) const noexcept;
+  /// Index of particle group `id` in `particle_groups`, or -1.
+  [[nodiscard]] std::ptrdiff_t find_group(std::uint32_t id) const noexcept;
+  /// Particles in every group.
+  [[nodiscard]] std::size_t particle_total() const noexcept;
 };
 
 /// Definition checks shared by World::create, create_body and restore. Empty string: valid.
@@ -199,6 +206,10 @@ void destroy_joints_of(WorldState& s, BodyId id);
 /// The force and torque joint `j` applied to its body b in the last step it was solved, from its
 /// accumulated impulses and its bodies' present poses (joint_solver.cpp; zero when broken).
 [[nodiscard]] JointReaction joint_reaction_of(const WorldState& s, const JointState& j);
+
+/// Detaches every particle attached to body `id` (the particle goes free; its group wakes)
+/// (particles/api.cpp).
+void detach_particles_of(WorldState& s, BodyId id);
 
 /// Appends the end event of a contact that is reported as touching (a pair that stops existing).
 void report_end(WorldState& s, const Contact& c);

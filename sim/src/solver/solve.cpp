@@ -17,28 +17,33 @@
 // The body stages (SolverBodies, bodies.hpp) run every body in ascending ID order; the constraint
 // stages run every kind in a fixed order (the `kinds` list below), each kind all of its
 // constraints in ascending ID order, through the ConstraintKind interface (constraint_kind.hpp).
-// Contacts are the first kind, joints (joint_solver.cpp) the second: each pass solves every
-// contact, then every joint (Box2D v3's stage list prepares joints before contacts; here they come
-// after, so that a world without joints gives the bits it gave before joints existed; the order
-// is part of the results, and fixed now that it is chosen).
-// Particle couplings and wheel contacts follow the same way. Wide (SIMD) rows do not change this
-// file: a kind's stage function will loop over batches of constraints (4 or 8 side by side, from a
-// deterministic graph colouring, each lane giving the scalar path's bits) instead of one constraint
-// at a time; the stage order and the kind order stay as they are here.
+// Contacts are the first kind, joints (joint_solver.cpp) the second, rope tethers
+// (tether_solver.cpp) the third: each pass solves every contact, then every joint (Box2D v3's stage
+// list prepares joints before contacts; here they come after, so that a world without joints gives
+// the bits it gave before joints existed; the order is part of the results, and fixed now that it
+// is chosen). Particle groups (particles/xpbd.cpp) are stepped after the bodies' positions move in
+// each sub-step, in small steps of their own, and pass what they push on bodies to the bodies'
+// velocities before the kinds see the new positions. Wheel contacts will follow as a kind. Wide
+// (SIMD) rows do not change this file: a kind's stage function will loop over batches of
+// constraints (4 or 8 side by side, from a deterministic graph colouring, each lane giving the
+// scalar path's bits) instead of one constraint at a time; the stage order and the kind order stay
+// as they are here.
 #include <array>
 #include <cstdint>
 
+#include "../particles/xpbd.hpp"
 #include "../world_state.hpp"
 #include "bodies.hpp"
 #include "constraint_kind.hpp"
 #include "contact_solver.hpp"
 #include "joint_solver.hpp"
+#include "tether_solver.hpp"
 
 namespace detsim::sim_detail {
 
 namespace {
 
-using Kinds = std::array<ConstraintKind*, 2>;
+using Kinds = std::array<ConstraintKind*, 3>;
 
 // One stage of every kind, in kind order.
 void each_kind(const Kinds& kinds, void (ConstraintKind::*stage)()) {
@@ -58,10 +63,13 @@ void solve(WorldState& s) {
   SolverBodies bodies(s);
   ContactSolver contacts(s, bodies);
   JointSolver joints(s, bodies);
-  const Kinds kinds{&contacts, &joints};  // the kind order: part of the results
+  TetherSolver tethers(s, bodies);
+  ParticleStepper particles(s, bodies);
+  const Kinds kinds{&contacts, &joints, &tethers};  // the kind order: part of the results
   const std::uint32_t iterations = s.def.iterations;
 
   each_kind(kinds, &ConstraintKind::prepare);
+  particles.prepare();
   for (std::uint32_t sub = 0; sub < s.def.substeps; ++sub) {
     bodies.integrate_velocities();
     each_kind(kinds, &ConstraintKind::warm_start);
@@ -70,6 +78,7 @@ void solve(WorldState& s) {
     each_kind(kinds, &ConstraintKind::push_out, iterations);
     bodies.clamp_speeds();
     bodies.integrate_positions();
+    particles.substep();
     each_kind(kinds, &ConstraintKind::positions_moved);
     each_kind(kinds, &ConstraintKind::relax, iterations);
     each_kind(kinds, &ConstraintKind::restitution);

@@ -23,7 +23,7 @@ namespace detsim {
 
 /// The version of the canonical state encoding that World::save() writes and World::restore()
 /// reads. Replays record it: a keyframe can be restored only by a build that reads it.
-inline constexpr std::uint32_t state_encoding_version = 5;
+inline constexpr std::uint32_t state_encoding_version = 6;
 
 /// The longest section name.
 inline constexpr std::size_t max_section_name = 32;

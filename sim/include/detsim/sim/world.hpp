@@ -21,6 +21,7 @@
 #include <detsim/sim/geometry.hpp>
 #include <detsim/sim/joint.hpp>
 #include <detsim/sim/mass.hpp>
+#include <detsim/sim/particles.hpp>
 #include <detsim/sim/shape_outline.hpp>
 #include <detsim/sim/state_sections.hpp>
 #include <detsim/sim/world_def.hpp>
@@ -268,6 +269,32 @@ class World {
   /// ascending). destroy_joint reports nothing: the game asked for it. The next step() starts a
   /// new list; restore() clears it (output, not state, like contact_events()).
   [[nodiscard]] std::span<const JointEvent> joint_events() const noexcept;
+
+  // ---- Particles: ropes and cloth (docs/PARTICLES.md) ----
+
+  /// Creates a rope (RopeDef); its ID is the next in particle-group sequence. Refused, with a
+  /// message naming the field and changing nothing: a value outside its documented range, an
+  /// attach body that does not exist, or more particles than max_particles_per_group or (with the
+  /// world's other groups) max_particles_per_world, or more than max_particle_groups groups.
+  /// Wakes the bodies it is attached to.
+  Expected<ParticleGroupId> create_rope(const RopeDef& def);
+  /// Creates a sheet of cloth (ClothDef), refused like create_rope (and for a pinned index out of
+  /// range or not ascending, or an attach_body with nothing pinned).
+  Expected<ParticleGroupId> create_cloth(const ClothDef& def);
+  /// Removes a group; wakes the bodies it was attached to. Unknown IDs are an error.
+  Status destroy_particle_group(ParticleGroupId id);
+  /// Every group's ID, ascending.
+  [[nodiscard]] std::vector<ParticleGroupId> particle_group_ids() const;
+  /// A group's particle positions (m) and velocities (m/s), by particle index, or an error for an
+  /// unknown ID.
+  [[nodiscard]] Expected<std::vector<Vec3>> particle_positions(ParticleGroupId id) const;
+  [[nodiscard]] Expected<std::vector<Vec3>> particle_velocities(ParticleGroupId id) const;
+  /// A group's statistics (energy, strain, speed), or an error for an unknown ID.
+  [[nodiscard]] Expected<ParticleGroupStats> particle_group_stats(ParticleGroupId id) const;
+  /// A force (N, world frame) spread evenly over a group's free particles for the next step (wind,
+  /// a push): accumulated like apply_force, cleared by the step. Wakes the group. Refused beyond
+  /// +-2^30 N per component (summed), changing nothing.
+  Status apply_particle_force(ParticleGroupId id, Vec3 force);
 
   // ---- Game inputs: accumulated until the next step. Each wakes the body. ----
   // A call whose sums, accelerations or resulting velocities would leave the limits of docs/SIM.md
