@@ -241,5 +241,42 @@ TEST(Rope, PullsTheBodyItIsAttachedTo) {
   EXPECT_LT(v, 1.2);
 }
 
+// A sheet hung by its top row, of stretch compliance c, pulled down by F: across the top row's
+// gap, its C vertical edges take delta / c each and its 2 (C - 1) diagonals delta cos^2(theta) / c
+// vertically (theta from the vertical), so delta = F c / (C + 2 (C - 1) cos^2 theta) and the
+// edges' strain is delta / s. With C = 3, s = u = 0.2 m (cos^2 = 1/2), c = 0.001 m/N: strain =
+// F * 0.001. It tears (at tear_strain 0.1) under F = 400 N (strain 0.4) and never under
+// F = 40 N (strain 0.04), the force ramped in over a second so that nothing overshoots.
+Fixed pulled_until_torn(Fixed force) {
+  World w = make_world();
+  ClothDef cloth;
+  cloth.origin = {0_fx, 5_fx, 0_fx};
+  cloth.axis_u = {0.4_fx, 0_fx, 0_fx};
+  cloth.axis_v = {0_fx, -1_fx, 0_fx};
+  cloth.columns = 3;
+  cloth.rows = 6;
+  cloth.mass = 0.1_fx;
+  cloth.stretch_compliance = 0.001_fx;
+  cloth.bend_compliance = 1000_fx;
+  cloth.tear_strain = 0.1_fx;
+  cloth.pinned = {0, 1, 2};
+  cloth.settings.damping = 5_fx;
+  auto id = w.create_cloth(cloth);
+  EXPECT_TRUE(id.ok()) << id.message();
+  if (!id.ok()) return {};
+  for (int i = 1; i <= 180; ++i) {
+    const Fixed ramp = min(Fixed::from_int(i) / 60_fx, 1_fx);
+    EXPECT_TRUE(w.apply_particle_force(*id, {0_fx, -force * ramp, 0_fx}).ok());
+    w.step();
+  }
+  const ParticleGroupStats st = w.particle_group_stats(*id).value();
+  return Fixed::from_int(static_cast<std::int32_t>(st.broken_count));
+}
+
+TEST(Cloth, TearsUnderAPullBeyondItsTearStrainAndNeverBelow) {
+  EXPECT_EQ(pulled_until_torn(40_fx), 0_fx);
+  EXPECT_GT(pulled_until_torn(400_fx), 0_fx);
+}
+
 }  // namespace
 }  // namespace detsim

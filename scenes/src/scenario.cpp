@@ -60,6 +60,16 @@ constexpr std::array entries{
     Entry{{"dominoes", "30 dominoes in a row; the first is tipped over", 600, 0, 0, 0, 0, 0, false},
           scenes_detail::build_dominoes,
           nullptr},
+    Entry{{"drape",
+           "an N x N sheet of cloth (default 24) falls over a sphere and a box on the ground", 600,
+           0, 0, 0, 24, 100, false, "particles per side"},
+          scenes_detail::build_drape,
+          nullptr},
+    Entry{{"flag",
+           "a 12 x 8 cloth pinned along a pole, in gusts of wind drawn from the RNG each frame",
+           600, 0, 0, 0, 0, 0, true},
+          scenes_detail::build_flag,
+          scenes_detail::control_flag},
     Entry{{"furniture",
            "N sets of compounds with offset centres of mass (default 4): a chair tipped back, a "
            "hammer leaning towards its head, an upright chair",
@@ -110,6 +120,12 @@ constexpr std::array entries{
            600, 0, 0, 0, 500, 5000, true, "rocks"},
           scenes_detail::build_rocks,
           nullptr},
+    Entry{{"rope_bridge",
+           "N planks (default 8) hung between two posts by short ropes at both sides; three "
+           "crates dropped on the deck",
+           600, 0, 0, 0, 8, 60, false, "planks"},
+          scenes_detail::build_rope_bridge,
+          nullptr},
     Entry{
         {"slope", "boxes of friction 0.2 to 1.0 on a 30-degree slope: those with tan 30 > mu slide",
          600, 0, 0, 0, 0, 0, false},
@@ -128,6 +144,12 @@ constexpr std::array entries{
            "a 500 kg ball on a chain swings into a wall of bricks welded by breakable fixed joints",
            600, 0, 0, 0, 0, 0, false},
           scenes_detail::build_wrecking_ball,
+          nullptr},
+    Entry{{"wrecking_rope",
+           "a 200 kg ball on a 6 m rope, released level with the pivot, swings into a stack of "
+           "boxes",
+           600, 0, 0, 0, 0, 0, false},
+          scenes_detail::build_wrecking_rope,
           nullptr},
 };
 

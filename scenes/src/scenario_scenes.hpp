@@ -36,11 +36,17 @@ void build_motors(World& w, const ScenarioParams& p);
 void build_rocks(World& w, const ScenarioParams& p);
 void build_level(World& w, const ScenarioParams& p);
 void build_furniture(World& w, const ScenarioParams& p);
+// The scenes with particles (scenario_particles.cpp).
+void build_rope_bridge(World& w, const ScenarioParams& p);
+void build_flag(World& w, const ScenarioParams& p);
+void build_drape(World& w, const ScenarioParams& p);
+void build_wrecking_rope(World& w, const ScenarioParams& p);
 
 // Per-frame logic, run before each step. Reads only the World and the inputs.
 void control_spray(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_arena(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_bridge(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
+void control_flag(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 
 // Tags in BodyDef::user_data by which game logic finds its bodies again (the World is the whole
 // scenario state, so nothing else may remember them). A player's tag is player_tag + index.
@@ -131,5 +137,44 @@ inline constexpr Fixed axle_x = 0.8_fx;
 inline constexpr Fixed track_z = 0.9_fx;
 inline constexpr Fixed car_spacing = 5_fx;
 }  // namespace motors
+
+// The particle scenes' dimensions (m, kg, N), shared with the tests that derive what each must do.
+namespace rope_bridge {
+inline constexpr Fixed height = 4_fx;  ///< the posts' tops and the deck at rest
+inline constexpr Fixed plank_width = 0.5_fx;
+inline constexpr Fixed gap = 0.3_fx;     ///< between planks: each rope spans one gap
+inline constexpr Fixed slack = 1.2_fx;   ///< a rope's length over its gap
+inline constexpr Fixed side_z = 0.7_fx;  ///< the ropes' distance from the middle
+inline constexpr Fixed plank_mass = 4_fx;
+inline constexpr Fixed crate_mass = 10_fx;
+}  // namespace rope_bridge
+
+namespace flag {
+inline constexpr Fixed pole_height = 4_fx;
+inline constexpr Fixed width = 1.5_fx;
+inline constexpr Fixed height = 1_fx;
+inline constexpr std::uint32_t columns = 12;
+inline constexpr std::uint32_t rows = 8;
+inline constexpr Fixed wind_min = 2_fx;  ///< N on the whole 0.5 kg sheet
+inline constexpr Fixed wind_max = 8_fx;
+inline constexpr Fixed wind_side = 1_fx;
+}  // namespace flag
+
+namespace drape {
+inline constexpr Fixed size = 4_fx;  ///< the sheet's side
+inline constexpr Fixed drop_height = 2.5_fx;
+inline constexpr Fixed sphere_radius = 0.7_fx;
+inline constexpr Vec3 sphere_at{-0.9_fx, 0.7_fx, 0_fx};
+inline constexpr Vec3 box_half{0.5_fx, 0.6_fx, 0.5_fx};
+inline constexpr Vec3 box_at{1_fx, 0.6_fx, 0_fx};
+}  // namespace drape
+
+namespace wrecking_rope {
+inline constexpr Vec3 pivot{0_fx, 7_fx, 0_fx};
+inline constexpr Fixed length = 6_fx;
+inline constexpr std::uint32_t segments = 24;
+inline constexpr Fixed ball_radius = 0.4_fx;
+inline constexpr Fixed ball_mass = 200_fx;
+}  // namespace wrecking_rope
 
 }  // namespace detsim::scenes_detail

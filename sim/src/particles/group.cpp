@@ -21,6 +21,9 @@ constexpr Fixed kMinParticleMass = Fixed::from_raw(Fixed::one_raw >> 20);
 constexpr Fixed kMaxMass = Fixed::from_int(1000000);
 constexpr Fixed kMaxCompliance = Fixed::from_int(1000);
 constexpr Fixed kMaxRadius = Fixed::from_int(10);
+// The shortest link, 2^-7 m (7.8 mm): the solver works on squared lengths, whose resolution
+// (2^-32 m^2) is then 2^-18 of the square, so that strains stay resolved to about 10^-6.
+constexpr Fixed kMinLink = Fixed::from_raw(Fixed::one_raw >> 7);
 
 std::string num(Fixed x) {
   return to_string(x);
@@ -101,8 +104,8 @@ std::string check_rope_def(const WorldState& s, const RopeDef& def, bool bodies)
   if (def.length != Fixed::zero() && def.length < distance)
     return "length must be >= |end - start| (" + num(distance) + " m), got " + num(def.length);
   if (auto e = in_range("length", def.length, Fixed::zero(), kMaxExtent, "m"); !e.empty()) return e;
-  if (rope_length(def) / count_fx(def.segments) < Fixed::from_raw(Fixed::one_raw >> 16))
-    return "length / segments must be at least 2^-16 m, got " +
+  if (rope_length(def) / count_fx(def.segments) < kMinLink)
+    return "length / segments must be at least " + num(kMinLink) + " m, got " +
            num(rope_length(def) / count_fx(def.segments));
   if (auto e = check_mass(def.mass, particle_count(def)); !e.empty()) return e;
   if (auto e = in_range("radius", def.radius, Fixed::from_raw(1), kMaxRadius, "m"); !e.empty())
@@ -133,8 +136,7 @@ std::string check_cloth_def(const WorldState& s, const ClothDef& def, bool bodie
            std::to_string(std::uint64_t{def.columns} * def.rows);
   if (length_squared(cross(def.axis_u, def.axis_v)) == Fixed::zero())
     return "axis_u and axis_v must span a sheet (not zero, not parallel)";
-  // Rest lengths of at least 2^-16 m, so that strains and directions stay well resolved.
-  constexpr Fixed kMinSpacing = Fixed::from_raw(Fixed::one_raw >> 16);
+  constexpr Fixed kMinSpacing = kMinLink;
   if (length(def.axis_u) / count_fx(def.columns - 1) < kMinSpacing ||
       length(def.axis_v) / count_fx(def.rows - 1) < kMinSpacing)
     return "the particles must be at least " + num(kMinSpacing) +

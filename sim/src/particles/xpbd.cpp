@@ -175,6 +175,36 @@ void ParticleStepper::prepare_group(ParticleGroup& g, GroupScratch& sc) {
   }
   sc.previous.resize(g.size());
   sc.target_from.resize(g.attachments.size());
+  sc.targets.resize(g.attachments.size());
+  // Which particles the group's constraints cannot move (pinned, or following a body), and each
+  // link's 1 / (w_a + w_b + compliance / h^2): constant through the step (the small step's h is).
+  sc.fixed.assign(g.size(), false);
+  sc.attachment_of.assign(g.size(), -1);
+  for (std::size_t k = 0; k < g.attachments.size(); ++k) {
+    sc.fixed[g.attachments[k].particle] = true;
+    sc.attachment_of[g.attachments[k].particle] = static_cast<std::int32_t>(k);
+  }
+  sc.free_count = 0;
+  for (std::uint32_t i = 0; i < g.size(); ++i) {
+    if (is_pinned(g, i)) sc.fixed[i] = true;
+    sc.free_count += sc.fixed[i] ? 0 : 1;
+  }
+  sc.h = bodies_.h / Fixed::from_int(static_cast<std::int32_t>(g.settings().substeps));
+  sc.inv_h = Fixed::one() / sc.h;
+  const Fixed inv_h2 = sc.inv_h * sc.inv_h;
+  sc.link_factor.resize(g.links.size());
+  Fixed last_compliance = Fixed::min();
+  Fixed scaled;
+  for (std::size_t k = 0; k < g.links.size(); ++k) {
+    const Link& l = g.links[k];
+    if (l.compliance != last_compliance) {  // links come in runs of one compliance
+      last_compliance = l.compliance;
+      scaled = l.compliance * inv_h2;
+    }
+    const Fixed denominator = (sc.fixed[l.a] ? Fixed::zero() : g.inverse_mass) +
+                              (sc.fixed[l.b] ? Fixed::zero() : g.inverse_mass) + scaled;
+    sc.link_factor[k] = denominator == Fixed::zero() ? Fixed::zero() : Fixed::one() / denominator;
+  }
 
   // Contact planes: each particle, as a ball of the group's radius, against each near body whose
   // box its own box meets, with a margin that covers the step's relative motion.
@@ -255,40 +285,29 @@ void ParticleStepper::apply_pushes() {
 void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
   const ParticleSettings& settings = g.settings();
   const std::uint32_t small_steps = settings.substeps;
-  const Fixed h = bodies_.h / Fixed::from_int(static_cast<std::int32_t>(small_steps));
-  const Fixed inv_h = Fixed::one() / h;
-  const Fixed inv_h2 = inv_h * inv_h;
+  const Fixed h = sc.h;
+  const Fixed inv_h = sc.inv_h;
   const Fixed w = g.inverse_mass;
   const Fixed drag = Fixed::one() / (Fixed::one() + h * settings.damping);
   const Fixed tear = [&] {
     if (const auto* cloth = std::get_if<ClothDef>(&g.def)) return cloth->tear_strain;
     return Fixed::zero();
   }();
+  const std::vector<bool>& fixed_particle = sc.fixed;
 
   // Where each attached particle's body puts it now (the bodies moved in this sub-step); the
   // small steps move it there in equal parts.
-  std::vector<bool>& fixed_particle = sc.fixed;
-  fixed_particle.assign(g.size(), false);
-  sc.attachment_of.assign(g.size(), -1);
-  sc.targets.resize(g.attachments.size());
   for (std::size_t k = 0; k < g.attachments.size(); ++k) {
     const Attachment& a = g.attachments[k];
     const BodyState& b = s_.bodies[sc.attached_body[k]];
     sc.targets[k] = b.position + rotate(b.orientation, a.local);
     sc.target_from[k] = g.positions[a.particle];
-    fixed_particle[a.particle] = true;
-    sc.attachment_of[a.particle] = static_cast<std::int32_t>(k);
   }
-  for (std::uint32_t i = 0; i < g.size(); ++i)
-    fixed_particle[i] = fixed_particle[i] || is_pinned(g, i);
-  const auto weight = [&](std::uint32_t i) { return fixed_particle[i] ? Fixed::zero() : w; };
   // The group's force is spread over its free particles.
-  std::int32_t free_count = 0;
-  for (std::uint32_t i = 0; i < g.size(); ++i)
-    free_count += fixed_particle[i] ? 0 : 1;
   const Vec3 kick =
-      (s_.def.gravity +
-       (free_count > 0 ? g.force / (g.particle_mass * Fixed::from_int(free_count)) : Vec3{})) *
+      (s_.def.gravity + (sc.free_count > 0
+                             ? g.force / (g.particle_mass * Fixed::from_int(sc.free_count))
+                             : Vec3{})) *
       h;
   // What a link pushes on an attached particle goes to its body.
   const auto pull_attached = [&](std::uint32_t i, Vec3 impulse) {
@@ -321,14 +340,17 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
           sc.target_from[k] + (sc.targets[k] - sc.target_from[k]) * part;
 
     // Distance links: lambda = -C / (w_a + w_b + compliance / h^2), one pass, no accumulation.
+    // With n = delta / |delta|, x_a -= w_a lambda n and x_b += w_b lambda n are the link's delta
+    // times w * C / (|delta| * denominator): one reciprocal square root and no division per link.
     for (std::size_t k = 0; k < g.links.size(); ++k) {
       if (g.link_broken[k]) continue;
       const Link& l = g.links[k];
       const Vec3 delta = g.positions[l.b] - g.positions[l.a];
-      const Fixed dist = length(delta);
-      const Fixed c = dist - l.rest;
+      const Fixed d2 = length_squared(delta);
+      if (d2 == Fixed::zero()) continue;  // no direction to push in
+      const Fixed inverse = rsqrt(d2);
+      const Fixed c = d2 * inverse - l.rest;
       if (l.kind == LinkKind::rope && c <= Fixed::zero()) continue;  // a rope is never pushed
-      if (dist == Fixed::zero()) continue;                           // no direction to push in
       if (tear > Fixed::zero() && c > l.rest * tear) {
         g.link_broken[k] = true;
         g.broken.insert(
@@ -336,21 +358,15 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
             static_cast<std::uint32_t>(k));
         continue;
       }
-      const Fixed wa = weight(l.a);
-      const Fixed wb = weight(l.b);
-      const Fixed denominator = wa + wb + l.compliance * inv_h2;
-      if (denominator == Fixed::zero()) continue;
-      const Fixed lambda = -c / denominator;
-      const Vec3 n = delta / dist;
-      // x_a -= w_a lambda n, x_b += w_b lambda n; a held end passes its share to its body.
-      if (wa != Fixed::zero())
-        g.positions[l.a] -= n * (wa * lambda);
+      const Fixed scale = c * inverse * sc.link_factor[k];
+      if (!fixed_particle[l.a])
+        g.positions[l.a] += delta * (w * scale);
       else
-        pull_attached(l.a, n * (-lambda * inv_h));
-      if (wb != Fixed::zero())
-        g.positions[l.b] += n * (wb * lambda);
+        pull_attached(l.a, delta * (scale * inv_h));
+      if (!fixed_particle[l.b])
+        g.positions[l.b] -= delta * (w * scale);
       else
-        pull_attached(l.b, n * (lambda * inv_h));
+        pull_attached(l.b, -delta * (scale * inv_h));
     }
 
     // Long-range tethers: only pull, only the free particle moves.

@@ -54,6 +54,10 @@ class ParticleStepper {
     std::vector<bool> fixed;                   ///< per particle: pinned or attached
     std::vector<std::int32_t> attachment_of;   ///< per particle: its attachment, or -1
     bool tethered = false;                     ///< a rope whose tether row holds its two bodies
+    std::int32_t free_count = 0;               ///< particles neither pinned nor attached
+    Fixed h;                                   ///< the small step
+    Fixed inv_h;
+    std::vector<Fixed> link_factor;  ///< per link: 1 / (w_a + w_b + compliance / h^2)
   };
 
   void prepare_group(ParticleGroup& g, GroupScratch& scratch);

@@ -1,0 +1,168 @@
+// The scenes with particles: rope_bridge (planks hung on ropes between two posts), flag (cloth on
+// a pole in RNG gusts of wind), drape (cloth falling over a sphere and a box) and wrecking_rope
+// (a heavy ball on a rope swinging into boxes).
+#include <cstdint>
+#include <vector>
+
+#include <detsim/fixed/math.hpp>
+
+#include "scenario_scenes.hpp"
+
+namespace detsim::scenes_detail {
+
+namespace {
+
+// Particle groups are part of a scenario's definition: a refusal is a bug here.
+ParticleGroupId rope(World& w, const RopeDef& def) {
+  return w.create_rope(def).value();
+}
+
+void ground(World& w) {
+  add(w, {.type = BodyType::static_body, .shape = Shape::plane(), .friction = 0.6_fx});
+}
+
+BodyId fixed_box(World& w, Vec3 half, Vec3 at) {
+  return add(w, {.type = BodyType::static_body, .shape = Shape::box(half), .position = at});
+}
+
+Fixed fx(std::uint32_t n) {
+  return Fixed::from_int(static_cast<std::int32_t>(n));
+}
+
+}  // namespace
+
+// ---- rope_bridge ----
+
+void build_rope_bridge(World& w, const ScenarioParams& p) {
+  using namespace rope_bridge;
+  ground(w);
+  // Two posts; N planks across the gap between them, each hung from its neighbours (or a post)
+  // by two short ropes, one at each side: the ropes run from post to post through the planks.
+  const Fixed span = (plank_width + gap) * fx(p.count) + gap;
+  const Fixed left = -span / 2_fx;
+  const BodyId left_post =
+      fixed_box(w, {0.2_fx, height / 2_fx, 1_fx}, {left - 0.2_fx, height / 2_fx, 0_fx});
+  const BodyId right_post =
+      fixed_box(w, {0.2_fx, height / 2_fx, 1_fx}, {-left + 0.2_fx, height / 2_fx, 0_fx});
+  BodyId previous = left_post;
+  Fixed previous_edge = left;
+  for (std::uint32_t i = 0; i <= p.count; ++i) {
+    BodyId next = right_post;
+    Fixed next_edge = -left;
+    if (i < p.count) {
+      const Fixed x = previous_edge + gap + plank_width / 2_fx;
+      next = add(w, {.shape = Shape::box({plank_width / 2_fx, 0.03_fx, 0.8_fx}),
+                     .position = {x, height, 0_fx},
+                     .mass = plank_mass,
+                     .friction = 0.6_fx});
+      next_edge = x - plank_width / 2_fx;
+    }
+    for (const Fixed z : {-side_z, side_z}) {
+      rope(w, {.start = {previous_edge, height, z},
+               .end = {next_edge, height, z},
+               .segments = 4,
+               .length = gap * slack,
+               .mass = 0.05_fx,
+               .radius = 0.02_fx,
+               .attach_start = previous,
+               .attach_end = next,
+               .settings = {.damping = 0.5_fx, .mask = 0}});
+    }
+    previous = next;
+    previous_edge = next_edge + plank_width;
+  }
+  // Three crates dropped onto the deck.
+  for (std::int32_t k = -1; k <= 1; ++k) {
+    add(w, {.shape = Shape::box({0.2_fx, 0.2_fx, 0.2_fx}),
+            .position = {Fixed::from_int(k) * span / 4_fx, height + 1_fx, 0_fx},
+            .mass = crate_mass,
+            .user_data = crate_tag});
+  }
+}
+
+// ---- flag ----
+
+void build_flag(World& w, const ScenarioParams&) {
+  using namespace flag;
+  ground(w);
+  add(w, {.type = BodyType::static_body,
+          .shape = Shape::capsule(0.05_fx, pole_height / 2_fx),
+          .position = {0_fx, pole_height / 2_fx, 0_fx}});
+  // The sheet hangs from the pole's top along +x, its left column pinned to the pole.
+  ClothDef cloth{.origin = {0.06_fx, pole_height - height, 0_fx},
+                 .axis_u = {width, 0_fx, 0_fx},
+                 .axis_v = {0_fx, height, 0_fx},
+                 .columns = columns,
+                 .rows = rows,
+                 .mass = 0.5_fx,
+                 .thickness = 0.02_fx,
+                 .settings = {.damping = 0.2_fx}};
+  for (std::uint32_t r = 0; r < rows; ++r)
+    cloth.pinned.push_back(r * columns);
+  (void)w.create_cloth(cloth).value();
+}
+
+void control_flag(World& w, std::span<const PlayerInput>, const ScenarioParams&) {
+  // Wind along +x with gusts: the RNG draws each frame's strength and sideways part, so that the
+  // sheet lifts and flutters (a force on the whole sheet, spread over its particles).
+  Rng& rng = w.rng();
+  const Fixed strength = rng.uniform(flag::wind_min, flag::wind_max);
+  const Fixed side = rng.uniform(-flag::wind_side, flag::wind_side);
+  for (const ParticleGroupId id : w.particle_group_ids())
+    (void)w.apply_particle_force(id, {strength, 0_fx, side});
+}
+
+// ---- drape ----
+
+void build_drape(World& w, const ScenarioParams& p) {
+  using namespace drape;
+  ground(w);
+  add(w, {.type = BodyType::static_body,
+          .shape = Shape::sphere(sphere_radius),
+          .position = sphere_at});
+  fixed_box(w, box_half, box_at);
+  (void)w
+      .create_cloth({.origin = {-size / 2_fx, drop_height, -size / 2_fx},
+                     .axis_u = {size, 0_fx, 0_fx},
+                     .axis_v = {0_fx, 0_fx, size},
+                     .columns = p.count,
+                     .rows = p.count,
+                     .mass = 1_fx,
+                     .thickness = 0.04_fx,
+                     .settings = {.friction = 0.6_fx, .damping = 1_fx}})
+      .value();
+}
+
+// ---- wrecking_rope ----
+
+void build_wrecking_rope(World& w, const ScenarioParams&) {
+  using namespace wrecking_rope;
+  ground(w);
+  const BodyId beam = fixed_box(w, {0.2_fx, 0.2_fx, 0.2_fx}, pivot + Vec3{0_fx, 0.2_fx, 0_fx});
+  // The ball starts level with the pivot, the rope straight and taut along -x.
+  const Vec3 start = pivot + Vec3{-length, 0_fx, 0_fx};
+  const BodyId ball = add(w, {.shape = Shape::sphere(ball_radius),
+                              .position = start + Vec3{-ball_radius, 0_fx, 0_fx},
+                              .mass = ball_mass,
+                              .user_data = ball_tag});
+  rope(w, {.start = pivot,
+           .end = start,
+           .segments = segments,
+           .mass = 2_fx,
+           .radius = 0.03_fx,
+           .attach_start = beam,
+           .attach_end = ball,
+           .settings = {.damping = 0.1_fx}});
+  // A stack of boxes where the ball passes its lowest point.
+  for (std::int32_t level = 0; level < 5; ++level) {
+    for (std::int32_t k = -1; k <= 1; ++k) {
+      add(w, {.shape = Shape::box({0.25_fx, 0.25_fx, 0.25_fx}),
+              .position = {pivot.x + 1_fx, 0.25_fx + Fixed::from_int(level) * 0.5_fx,
+                           Fixed::from_int(k) * 0.55_fx},
+              .mass = 5_fx,
+              .user_data = crate_tag});
+    }
+  }
+}
+
+}  // namespace detsim::scenes_detail
