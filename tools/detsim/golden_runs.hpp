@@ -10,7 +10,7 @@ namespace detsim::golden {
 
 /// Every scenario, each long enough to have a hash at frame 1000, and small enough for the
 /// emulated 32-bit legs of the determinism matrix, which run ~50x slower than x86-64: the piles
-/// have 64 bodies, the pyramid 8 rows, the rocks 30 hulls, and the resting scenes fall asleep long
+/// have 64 bodies, the pyramid 8 rows, the rocks 30 hulls, the drape a 12 x 12 sheet, and the resting scenes fall asleep long
 /// before their last frame, after which a frame costs almost nothing.
 struct GoldenRun {
   const char* scenario;
@@ -25,6 +25,8 @@ inline constexpr GoldenRun runs[] = {
     {"bullet_wall", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"chain", {.seed = 1, .players = 0, .count = 30}, 1200},
     {"dominoes", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"drape", {.seed = 1, .players = 0, .count = 12}, 1000},
+    {"flag", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"furniture", {.seed = 1, .players = 0, .count = 4}, 1000},
     {"level", {.seed = 1, .players = 0, .count = 4}, 1000},
     {"motors", {.seed = 1, .players = 0, .count = 0}, 1000},
@@ -34,10 +36,12 @@ inline constexpr GoldenRun runs[] = {
     {"pyramid", {.seed = 1, .players = 0, .count = 8}, 1000},
     {"ragdolls", {.seed = 3, .players = 0, .count = 4}, 1000},
     {"rocks", {.seed = 1, .players = 0, .count = 30}, 1000},
+    {"rope_bridge", {.seed = 1, .players = 0, .count = 4}, 1000},
     {"slope", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"spray", {.seed = 3, .players = 0, .count = 0}, 1200},
     {"stack", {.seed = 1, .players = 0, .count = 0}, 1200},
     {"wrecking_ball", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"wrecking_rope", {.seed = 1, .players = 0, .count = 0}, 1000},
 };
 
 }  // namespace detsim::golden

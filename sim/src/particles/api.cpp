@@ -105,6 +105,28 @@ Expected<std::vector<Vec3>> World::particle_velocities(ParticleGroupId id) const
   return s_->particle_groups[static_cast<std::size_t>(k)].velocities;
 }
 
+namespace {
+
+template <class Def>
+Expected<Def> def_of(const sim_detail::WorldState& s, ParticleGroupId id, const char* what) {
+  const std::ptrdiff_t k = s.find_group(id.value);
+  if (k < 0) return unknown_group(id);
+  const auto* def = std::get_if<Def>(&s.particle_groups[static_cast<std::size_t>(k)].def);
+  if (def == nullptr)
+    return Status::error("particle group " + std::to_string(id.value) + " is not a " + what);
+  return *def;
+}
+
+}  // namespace
+
+Expected<RopeDef> World::rope_def(ParticleGroupId id) const {
+  return def_of<RopeDef>(*s_, id, "rope");
+}
+
+Expected<ClothDef> World::cloth_def(ParticleGroupId id) const {
+  return def_of<ClothDef>(*s_, id, "sheet of cloth");
+}
+
 Expected<ParticleGroupStats> World::particle_group_stats(ParticleGroupId id) const {
   const std::ptrdiff_t k = s_->find_group(id.value);
   if (k < 0) return unknown_group(id);

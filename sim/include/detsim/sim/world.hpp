@@ -289,6 +289,10 @@ class World {
   /// unknown ID.
   [[nodiscard]] Expected<std::vector<Vec3>> particle_positions(ParticleGroupId id) const;
   [[nodiscard]] Expected<std::vector<Vec3>> particle_velocities(ParticleGroupId id) const;
+  /// The definition a rope or a sheet was created from (attach bodies as given then, even if
+  /// destroyed since), or an error for an unknown ID or a group of the other type.
+  [[nodiscard]] Expected<RopeDef> rope_def(ParticleGroupId id) const;
+  [[nodiscard]] Expected<ClothDef> cloth_def(ParticleGroupId id) const;
   /// A group's statistics (energy, strain, speed), or an error for an unknown ID.
   [[nodiscard]] Expected<ParticleGroupStats> particle_group_stats(ParticleGroupId id) const;
   /// A force (N, world frame) spread evenly over a group's free particles for the next step (wind,

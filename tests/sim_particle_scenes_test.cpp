@@ -1,0 +1,185 @@
+// The particle scenes' physical promises (docs/SCENARIOS.md): the wrecking rope holds its ball at
+// its length and knocks the boxes over, the drape rests on the sphere, the box and the ground
+// without passing through them, the flag streams out in the wind and stays on its pole, and the
+// rope bridge sags no more than its ropes allow. Each expectation comes from the scene's geometry
+// as the World reports it at frame 0 and the physics, never from a run.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <detsim/detsim.hpp>
+
+#include "support/scale.hpp"
+#include "support/sim_helpers.hpp"
+
+namespace detsim {
+namespace {
+
+using namespace detsim::literals;
+
+using test::state;
+
+Scenario make(std::string_view name, const ScenarioParams& p = {}) {
+  auto s = Scenario::create(name, p);
+  EXPECT_TRUE(s.ok()) << s.message();
+  return std::move(s.value());
+}
+
+double d(Fixed x) {
+  return x.to_double();
+}
+
+std::vector<BodyState> bodies_of(const World& w, BodyType type) {
+  std::vector<BodyState> out;
+  for (const BodyId id : w.body_ids()) {
+    const BodyState b = state(w, id);
+    if (b.type == type) out.push_back(b);
+  }
+  return out;
+}
+
+std::vector<Vec3> all_particles(const World& w) {
+  std::vector<Vec3> out;
+  for (const ParticleGroupId id : w.particle_group_ids()) {
+    const std::vector<Vec3> p = w.particle_positions(id).value();
+    out.insert(out.end(), p.begin(), p.end());
+  }
+  return out;
+}
+
+// The ball hangs on an inextensible rope from a pivot: it is never farther from the pivot than
+// the rope's length plus its own radius (1 % for the solver), and its swing scatters the boxes
+// standing in its path.
+TEST(WreckingRopeScenario, HoldsTheBallAtItsLengthAndKnocksTheBoxesOver) {
+  Scenario s = make("wrecking_rope");
+  const World& w = s.world();
+  const ParticleGroupId rope = w.particle_group_ids().at(0);
+  const RopeDef def = w.rope_def(rope).value();
+  const double length = d(::detsim::length(def.end - def.start));
+  const BodyState ball = state(w, def.attach_end);
+  const double reach = length + d(ball.shape.radius);
+  const Vec3 pivot = def.start;
+  std::vector<BodyState> boxes;
+  for (const BodyState& b : bodies_of(w, BodyType::dynamic))
+    if (b.id != ball.id) boxes.push_back(b);
+  double farthest = 0;
+  const std::size_t frames = test::scaled(300);
+  for (std::size_t f = 0; f < frames; ++f) {
+    s.step();
+    farthest = std::max(farthest, d(::detsim::length(state(w, ball.id).position - pivot)));
+  }
+  EXPECT_LT(farthest, reach * 1.01);
+  EXPECT_GT(farthest, reach * 0.99);
+  std::size_t moved = 0;
+  for (const BodyState& b : boxes)
+    moved += d(::detsim::length(state(w, b.id).position - b.position)) > 1.0 ? 1 : 0;
+  EXPECT_GE(moved, boxes.size() / 2);
+}
+
+// A sheet dropped over a sphere and a box on the ground comes to rest on them: no particle inside
+// the sphere, the box or the ground by more than 5 mm past its own radius, and the sheet lies on
+// the sphere's top.
+TEST(DrapeScenario, RestsOnTheSphereTheBoxAndTheGroundWithoutPassingThrough) {
+  Scenario s = make("drape", {.count = 16});
+  const World& w = s.world();
+  const ParticleGroupId cloth = w.particle_group_ids().at(0);
+  const double radius = d(w.cloth_def(cloth).value().thickness) / 2;
+  BodyState sphere;
+  BodyState box;
+  for (const BodyState& b : bodies_of(w, BodyType::static_body)) {
+    if (b.shape.type == ShapeType::sphere) sphere = b;
+    if (b.shape.type == ShapeType::box) box = b;
+  }
+  const double slack = 0.005;
+  const std::size_t frames = test::scaled(300);
+  for (std::size_t f = 0; f < frames; ++f) {
+    s.step();
+    for (const Vec3& p : all_particles(w)) {
+      EXPECT_GE(d(p.y), radius - slack);
+      EXPECT_GE(d(::detsim::length(p - sphere.position)), d(sphere.shape.radius) + radius - slack);
+      // Inside the box when within its half extents plus the radius on every axis.
+      const Vec3 q = p - box.position;
+      const double depth = std::min({d(box.shape.half_extents.x) + radius - std::abs(d(q.x)),
+                                     d(box.shape.half_extents.y) + radius - std::abs(d(q.y)),
+                                     d(box.shape.half_extents.z) + radius - std::abs(d(q.z))});
+      EXPECT_LT(depth, slack) << "frame " << f;
+      if (::testing::Test::HasFailure()) return;
+    }
+  }
+  // The sheet covers the sphere: its highest particle is on the sphere's top.
+  double top = -1;
+  for (const Vec3& p : all_particles(w))
+    top = std::max(top, d(p.y));
+  const double sphere_top = d(sphere.position.y + sphere.shape.radius) + radius;
+  EXPECT_GT(top, sphere_top - slack);
+  EXPECT_LT(top, sphere_top + 0.1);
+}
+
+// The flag's pinned edge stays on the pole, and a wind of about its own weight (2 to 8 N on
+// 0.5 kg, 4.9 N) holds it out: over the last second its far edge is more than half its width
+// out from the pole (hanging in still air, it would be under the pole).
+TEST(FlagScenario, StreamsOutInTheWindAndStaysOnItsPole) {
+  Scenario s = make("flag");
+  const World& w = s.world();
+  const ParticleGroupId flag = w.particle_group_ids().at(0);
+  const ClothDef def = w.cloth_def(flag).value();
+  const std::vector<Vec3> start = w.particle_positions(flag).value();
+  const std::size_t frames = test::scaled(300);
+  double far_x = 0;
+  std::size_t samples = 0;
+  for (std::size_t f = 0; f < frames; ++f) {
+    s.step();
+    if (f + 60 < frames) continue;
+    const std::vector<Vec3> p = w.particle_positions(flag).value();
+    for (std::uint32_t r = 0; r < def.rows; ++r) {
+      far_x += d(p[r * def.columns + def.columns - 1].x);
+      ++samples;
+    }
+  }
+  const std::vector<Vec3> end = w.particle_positions(flag).value();
+  for (const std::uint32_t i : def.pinned)
+    EXPECT_EQ(end[i], start[i]) << "pinned particle " << i;
+  EXPECT_GT(far_x / double(samples), d(def.origin.x) + d(def.axis_u.x) / 2);
+}
+
+// Planks hung on ropes between two posts: the deck can sag no lower than a chain of the same
+// length pulled into a V, sqrt((L / 2)^2 - (S / 2)^2) below the posts, L the ropes' and planks'
+// total length and S the span; the crates end up on the deck, above the ground.
+TEST(RopeBridgeScenario, SagsNoMoreThanItsRopesAllowAndCarriesTheCrates) {
+  Scenario s = make("rope_bridge", {.count = 6});
+  const World& w = s.world();
+  double total = 0;
+  double left = 1e9;
+  double right = -1e9;
+  double deck = 0;
+  for (const ParticleGroupId id : w.particle_group_ids()) {
+    const RopeDef r = w.rope_def(id).value();
+    if (r.start.z > 0_fx) continue;  // one side's ropes
+    total += d(r.length);
+    left = std::min(left, d(r.start.x));
+    right = std::max(right, d(r.end.x));
+    deck = d(r.start.y);
+  }
+  std::vector<BodyState> planks;
+  std::vector<BodyState> crates;
+  for (const BodyState& b : bodies_of(w, BodyType::dynamic))
+    (b.shape.half_extents.y < 0.1_fx ? planks : crates).push_back(b);  // planks are thin
+  for (const BodyState& p : planks)
+    total += 2 * d(p.shape.half_extents.x);
+  const double span = right - left;
+  const double lowest = deck - std::sqrt(total * total / 4 - span * span / 4);
+  const std::size_t frames = test::scaled(300);
+  for (std::size_t f = 0; f < frames; ++f) {
+    s.step();
+    for (const BodyState& p : planks)
+      EXPECT_GT(d(state(w, p.id).position.y), lowest - 0.02) << "frame " << f;
+  }
+  for (const BodyState& c : crates)
+    EXPECT_GT(d(state(w, c.id).position.y), 1.0) << "crate " << c.id.value << " fell through";
+}
+
+}  // namespace
+}  // namespace detsim
