@@ -1,6 +1,7 @@
 // The scenes with particles: rope_bridge (planks hung on ropes between two posts), flag (cloth on
 // a pole in RNG gusts of wind), drape (cloth falling over a sphere and a box) and wrecking_rope
 // (a heavy ball on a rope swinging into boxes).
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -89,14 +90,15 @@ void build_flag(World& w, const ScenarioParams&) {
           .shape = Shape::capsule(0.05_fx, pole_height / 2_fx),
           .position = {0_fx, pole_height / 2_fx, 0_fx}});
   // The sheet hangs from the pole's top along +x, its left column pinned to the pole.
-  ClothDef cloth{.origin = {0.06_fx, pole_height - height, 0_fx},
-                 .axis_u = {width, 0_fx, 0_fx},
-                 .axis_v = {0_fx, height, 0_fx},
-                 .columns = columns,
-                 .rows = rows,
-                 .mass = 0.5_fx,
-                 .thickness = 0.02_fx,
-                 .settings = {.damping = 0.2_fx}};
+  ClothDef cloth;
+  cloth.origin = {0.06_fx, pole_height - height, 0_fx};
+  cloth.axis_u = {width, 0_fx, 0_fx};
+  cloth.axis_v = {0_fx, height, 0_fx};
+  cloth.columns = columns;
+  cloth.rows = rows;
+  cloth.mass = 0.5_fx;
+  cloth.thickness = 0.02_fx;
+  cloth.settings.damping = 0.2_fx;
   for (std::uint32_t r = 0; r < rows; ++r)
     cloth.pinned.push_back(r * columns);
   (void)w.create_cloth(cloth).value();
@@ -121,16 +123,18 @@ void build_drape(World& w, const ScenarioParams& p) {
           .shape = Shape::sphere(sphere_radius),
           .position = sphere_at});
   fixed_box(w, box_half, box_at);
-  (void)w
-      .create_cloth({.origin = {-size / 2_fx, drop_height, -size / 2_fx},
-                     .axis_u = {size, 0_fx, 0_fx},
-                     .axis_v = {0_fx, 0_fx, size},
-                     .columns = p.count,
-                     .rows = p.count,
-                     .mass = 1_fx,
-                     .thickness = 0.04_fx,
-                     .settings = {.friction = 0.6_fx, .damping = 1_fx}})
-      .value();
+  ClothDef cloth;
+  cloth.origin = {-size / 2_fx, drop_height, -size / 2_fx};
+  cloth.axis_u = {size, 0_fx, 0_fx};
+  cloth.axis_v = {0_fx, 0_fx, size};
+  // A sheet needs two particles a side: a count of 1 makes the smallest sheet.
+  cloth.columns = std::max<std::uint32_t>(p.count, 2);
+  cloth.rows = cloth.columns;
+  cloth.mass = 1_fx;
+  cloth.thickness = 0.04_fx;
+  cloth.settings.friction = 0.6_fx;
+  cloth.settings.damping = 1_fx;
+  (void)w.create_cloth(cloth).value();
 }
 
 // ---- wrecking_rope ----

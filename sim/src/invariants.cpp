@@ -54,6 +54,30 @@ std::string validate_world(const WorldState& s) {
     if (s.find(j.def.body_a.value) < 0 || s.find(j.def.body_b.value) < 0)
       return joint + "names a body that does not exist";
   }
+  std::size_t particles = 0;
+  for (std::size_t k = 0; k < s.particle_groups.size(); ++k) {
+    const ParticleGroup& g = s.particle_groups[k];
+    const std::string group = "particle group " + std::to_string(g.id.value) + ": ";
+    if (g.id.value == 0 || g.id.value >= s.next_particle_group_id)
+      return group + "ID outside 1.." + std::to_string(s.next_particle_group_id - 1);
+    if (k > 0 && s.particle_groups[k - 1].id >= g.id) return group + "IDs are not ascending";
+    if (g.velocities.size() != g.size() || g.size() < 2 || g.size() > max_particles_per_group)
+      return group + "particle arrays of " + std::to_string(g.size()) + " and " +
+             std::to_string(g.velocities.size());
+    particles += g.size();
+    for (std::size_t a = 0; a < g.attachments.size(); ++a) {
+      if (g.attachments[a].particle >= g.size() || s.find(g.attachments[a].body) < 0 ||
+          (a > 0 && g.attachments[a - 1].particle >= g.attachments[a].particle))
+        return group + "attachment " + std::to_string(a) + " is not a particle on a body";
+    }
+    for (std::size_t b = 0; b < g.broken.size(); ++b) {
+      if (g.broken[b] >= g.links.size() || !g.link_broken[g.broken[b]] ||
+          (b > 0 && g.broken[b - 1] >= g.broken[b]))
+        return group + "the broken constraints disagree with the links";
+    }
+  }
+  if (particles > max_particles_per_world)
+    return std::to_string(particles) + " particles, above max_particles_per_world";
   // Islands sleep and wake as a whole: no touching pair of dynamic bodies is half asleep.
   if (s.def.enable_sleep) {
     for (const Contact& c : s.contacts) {
