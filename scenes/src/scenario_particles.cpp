@@ -55,7 +55,9 @@ void build_rope_bridge(World& w, const ScenarioParams& p) {
       next = add(w, {.shape = Shape::box({plank_width / 2_fx, 0.03_fx, 0.8_fx}),
                      .position = {x, height, 0_fx},
                      .mass = plank_mass,
-                     .friction = 0.6_fx});
+                     .friction = 0.6_fx,
+                     .linear_damping = plank_damping,
+                     .angular_damping = plank_damping});
       next_edge = x - plank_width / 2_fx;
     }
     for (const Fixed z : {-side_z, side_z}) {

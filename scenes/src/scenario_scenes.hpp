@@ -146,6 +146,8 @@ inline constexpr Fixed gap = 0.3_fx;     ///< between planks: each rope spans on
 inline constexpr Fixed slack = 1.2_fx;   ///< a rope's length over its gap
 inline constexpr Fixed side_z = 0.7_fx;  ///< the ropes' distance from the middle
 inline constexpr Fixed plank_mass = 4_fx;
+/// 1/s, linear and angular: a chain of planks on ropes sways for a long time without it.
+inline constexpr Fixed plank_damping = 0.5_fx;
 inline constexpr Fixed crate_mass = 10_fx;
 }  // namespace rope_bridge
 
