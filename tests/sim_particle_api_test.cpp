@@ -123,6 +123,69 @@ TEST(ParticleApi, ClothRefusalsNameTheField) {
   expect_refused(d, make_cloth, "columns * rows");
 }
 
+auto make_soft = [](World& w, const SoftBodyDef& d) { return w.create_soft_body(d); };
+
+TEST(ParticleApi, SoftBodyRefusalsNameTheField) {
+  SoftBodyDef d;
+  d.shape = Shape::sphere(1_fx);
+  expect_refused(d, make_soft, "shape");
+  d = SoftBodyDef{};
+  d.resolution = 0;
+  expect_refused(d, make_soft, "resolution");
+  d = SoftBodyDef{};
+  d.resolution = 41;
+  expect_refused(d, make_soft, "resolution");
+  d = SoftBodyDef{};
+  d.resolution = 1;  // one cell along the longest side: one particle per axis
+  expect_refused(d, make_soft, "fewer than 2 particles");
+  d = SoftBodyDef{};
+  d.shape = Shape::box({0.02_fx, 0.02_fx, 0.02_fx});
+  d.resolution = 8;  // 5 mm cells
+  expect_refused(d, make_soft, "below the smallest");
+  d = SoftBodyDef{};
+  d.volume_compliance = -1_fx;
+  expect_refused(d, make_soft, "volume_compliance");
+  d = SoftBodyDef{};
+  d.edge_compliance = -1_fx;
+  expect_refused(d, make_soft, "edge_compliance");
+  d = SoftBodyDef{};
+  d.orientation = Quat{2_fx, 0_fx, 0_fx, 0_fx};
+  expect_refused(d, make_soft, "orientation");
+  d = SoftBodyDef{};
+  d.shape = Shape::convex(GeometryId{5});
+  expect_refused(d, make_soft, "shape");
+}
+
+// A soft body fills its shape: a box with a lattice of resolution cells along its longest side,
+// a hull with the cells whose corners are inside it (fewer than its box's).
+TEST(ParticleApi, SoftBodiesFillTheirShape) {
+  World w = make_world();
+  SoftBodyDef box;
+  box.shape = Shape::box({0.5_fx, 0.25_fx, 0.25_fx});
+  box.resolution = 4;  // cells of 0.25 m: 4 x 2 x 2 particles
+  const ParticleGroupId a = w.create_soft_body(box).value();
+  const ParticleGroupStats sa = w.particle_group_stats(a).value();
+  EXPECT_EQ(sa.particle_count, 16U);
+  EXPECT_EQ(sa.type, ParticleGroupType::soft_body);
+  // 3 x 1 x 1 cubes of 0.25 m between the particles' centres.
+  EXPECT_EQ(sa.rest_volume, 3_fx * 0.25_fx * 0.25_fx * 0.25_fx);
+  std::vector<Vec3> corners;
+  for (const Fixed x : {-0.5_fx, 0.5_fx})
+    for (const Fixed y : {-0.5_fx, 0.5_fx})
+      for (const Fixed z : {-0.5_fx, 0.5_fx})
+        corners.push_back({x, y, z});
+  corners.push_back({0_fx, 0.9_fx, 0_fx});  // a roof: the hull is not its box
+  SoftBodyDef hull;
+  hull.shape = Shape::convex(w.create_convex_hull(corners).value());
+  hull.resolution = 8;
+  const ParticleGroupStats sh = w.particle_group_stats(w.create_soft_body(hull).value()).value();
+  // Its box is 1 x 1.4 x 1 m: cells of 1.4 / 8 = 0.175 m, a 6 x 8 x 6 lattice centred in it. The
+  // six lowest layers (centres up to 0.4625 m) are inside the cube part: 216 particles; the top
+  // two only where the roof holds them.
+  EXPECT_GE(sh.particle_count, 216U);
+  EXPECT_LT(sh.particle_count, 288U);
+}
+
 TEST(ParticleApi, TheWorldsParticleLimitHolds) {
   World w = make_world();
   ClothDef d = a_cloth();

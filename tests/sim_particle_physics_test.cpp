@@ -278,5 +278,70 @@ TEST(Cloth, TearsUnderAPullBeyondItsTearStrainAndNeverBelow) {
   EXPECT_GT(pulled_until_torn(400_fx), 0_fx);
 }
 
+// A soft cube dropped on the ground, at volume compliance 0, after 5 s: its volume within 3 % of
+// its rest volume, and still (no particle faster than 1 mm/s) on the ground (its lowest particle
+// a particle radius, half a cell, above it).
+TEST(SoftBody, RestsOnTheGroundKeepingItsVolumeWithoutJitter) {
+  World w = make_world();
+  BodyDef ground;
+  ground.type = BodyType::static_body;
+  ground.shape = Shape::plane();
+  add(w, ground);
+  SoftBodyDef cube;
+  cube.shape = Shape::box({0.25_fx, 0.25_fx, 0.25_fx});
+  cube.position = {0_fx, 1_fx, 0_fx};
+  cube.orientation = from_axis_angle({1_fx, 0_fx, 0_fx}, 0.3_fx);
+  cube.resolution = 5;
+  cube.mass = 5_fx;
+  cube.edge_compliance = 0.001_fx;
+  cube.settings.damping = 1_fx;
+  auto id = w.create_soft_body(cube);
+  ASSERT_TRUE(id.ok()) << id.message();
+  for (int i = 0; i < 300; ++i)
+    w.step();
+  const ParticleGroupStats st = w.particle_group_stats(*id).value();
+  EXPECT_EQ(st.particle_count, 125U);
+  EXPECT_NEAR(d(st.volume), d(st.rest_volume), 0.03 * d(st.rest_volume));
+  // The rest volume is the lattice's: 4^3 cells of 0.1 m, as the cube's cells are 0.5 / 5 m.
+  EXPECT_NEAR(d(st.rest_volume), 0.064, 1e-6);
+  EXPECT_LT(d(st.max_speed), 0.001);
+  double lowest = 1e9;
+  for (const Vec3& p : positions(w, *id))
+    lowest = std::min(lowest, d(p.y));
+  EXPECT_NEAR(lowest, 0.05, 0.005);
+}
+
+// Under a 20 kg box, a soft cube at volume compliance 0 keeps its volume within 3 %, and carries
+// the box: each of its 4 x 4 columns of 3 edges takes 196 N / 16 = 12 N, which compresses an edge
+// of compliance 10^-4 m/N by 1.2 mm, so the box sinks by millimetres, not centimetres (2 cm
+// allowed).
+TEST(SoftBody, KeepsItsVolumeUnderALoad) {
+  World w = make_world();
+  BodyDef ground;
+  ground.type = BodyType::static_body;
+  ground.shape = Shape::plane();
+  add(w, ground);
+  SoftBodyDef cube;
+  cube.shape = Shape::box({0.25_fx, 0.25_fx, 0.25_fx});
+  cube.position = {0_fx, 0.25_fx, 0_fx};
+  cube.resolution = 4;
+  cube.mass = 2_fx;
+  cube.edge_compliance = 0.0001_fx;
+  cube.settings.damping = 2_fx;
+  auto id = w.create_soft_body(cube);
+  ASSERT_TRUE(id.ok()) << id.message();
+  BodyDef load;
+  load.shape = Shape::box({0.4_fx, 0.05_fx, 0.4_fx});
+  load.position = {0_fx, 0.56_fx, 0_fx};
+  load.mass = 20_fx;
+  const BodyId box = add(w, load);
+  for (int i = 0; i < 300; ++i)
+    w.step();
+  const ParticleGroupStats st = w.particle_group_stats(*id).value();
+  EXPECT_NEAR(d(st.volume), d(st.rest_volume), 0.03 * d(st.rest_volume));
+  // The cube's top is at 0.5 m, the box's half height 0.05 m.
+  EXPECT_GT(d(state(w, box).position.y), 0.55 - 0.02);
+}
+
 }  // namespace
 }  // namespace detsim

@@ -181,5 +181,37 @@ TEST(RopeBridgeScenario, SagsNoMoreThanItsRopesAllowAndCarriesTheCrates) {
     EXPECT_GT(d(state(w, c.id).position.y), 1.0) << "crate " << c.id.value << " fell through";
 }
 
+// Soft cubes dropped on stairs keep their volume (3 %, at volume compliance 0) and never pass
+// into a step: every particle over a step stays above its top by its radius (5 mm allowed).
+TEST(JellyScenario, CubesKeepTheirVolumeAndStayOnTheSteps) {
+  Scenario s = make("jelly", {.count = 3});
+  const World& w = s.world();
+  std::vector<BodyState> stairs;
+  for (const BodyState& b : bodies_of(w, BodyType::static_body))
+    if (b.shape.type == ShapeType::box) stairs.push_back(b);
+  ASSERT_FALSE(stairs.empty());
+  const std::size_t frames = test::scaled(300);
+  for (std::size_t f = 0; f < frames; ++f) {
+    s.step();
+    for (const ParticleGroupId id : w.particle_group_ids()) {
+      const ParticleGroupStats st = w.particle_group_stats(id).value();
+      EXPECT_NEAR(d(st.volume), d(st.rest_volume), 0.03 * d(st.rest_volume)) << "frame " << f;
+      const double radius = d(w.soft_body_def(id).value().shape.half_extents.x) /
+                            w.soft_body_def(id).value().resolution;
+      const std::vector<Vec3> particles = w.particle_positions(id).value();
+      for (const Vec3& p : particles) {
+        for (const BodyState& step : stairs) {
+          const Vec3 q = p - step.position;
+          const Vec3 e = step.shape.half_extents;
+          if (abs(q.x) > e.x || abs(q.z) > e.z) continue;  // not over this step
+          EXPECT_GT(d(p.y), d(step.position.y + e.y) + radius - 0.005)
+              << "frame " << f << " x " << d(q.x) << " of " << d(e.x) << " z " << d(q.z);
+        }
+      }
+      if (::testing::Test::HasFailure()) return;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace detsim

@@ -76,6 +76,12 @@ constexpr std::array entries{
            600, 0, 0, 0, 4, 200, false, "sets"},
           scenes_detail::build_furniture,
           nullptr},
+    Entry{{"jelly",
+           "N soft cubes (default 4; 2 kg, 4 x 4 x 4 particles) dropped turning onto a flight of "
+           "five stairs, where they land, wobble and come to rest",
+           600, 0, 0, 0, 4, 50, false, "cubes"},
+          scenes_detail::build_jelly,
+          nullptr},
     Entry{{"level",
            "N each (default 8) of boxes, convex rocks, capsules and compound tables onto a "
            "triangle-mesh level with a ramp and stairs",

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <detsim/fixed/math.hpp>
+#include <detsim/fixed/quat.hpp>
 
 #include "scenario_scenes.hpp"
 
@@ -137,6 +138,36 @@ void build_drape(World& w, const ScenarioParams& p) {
   cloth.settings.friction = 0.6_fx;
   cloth.settings.damping = 1_fx;
   (void)w.create_cloth(cloth).value();
+}
+
+// ---- jelly ----
+
+void build_jelly(World& w, const ScenarioParams& p) {
+  using namespace jelly;
+  ground(w);
+  // A flight of stairs down towards +x, its top step at x = 0.
+  for (std::int32_t k = 0; k < steps; ++k) {
+    const Fixed top = rise * Fixed::from_int(steps - k);
+    fixed_box(w, {run / 2_fx, top / 2_fx, width / 2_fx},
+              {run * Fixed::from_int(k) + run / 2_fx, top / 2_fx, 0_fx});
+  }
+  // The cubes drop in a row across the top step, each a little further down the stairs and
+  // turned a little more than the last, and slide and tumble down.
+  const Fixed top = rise * Fixed::from_int(steps);
+  for (std::uint32_t i = 0; i < p.count; ++i) {
+    const Fixed f = fx(i);
+    SoftBodyDef cube;
+    cube.shape = Shape::box({half, half, half});
+    cube.position = {run / 2_fx + f * 0.05_fx, top + 0.6_fx + f * 0.1_fx,
+                     (f - fx(p.count - 1) / 2_fx) * (half * 2_fx + 0.1_fx)};
+    cube.orientation = from_axis_angle({0_fx, 0_fx, 1_fx}, 0.3_fx + f * 0.1_fx);
+    cube.resolution = resolution;
+    cube.mass = mass;
+    cube.edge_compliance = edge_compliance;
+    cube.settings.damping = 1_fx;
+    cube.settings.friction = 0.3_fx;
+    (void)w.create_soft_body(cube).value();
+  }
 }
 
 // ---- wrecking_rope ----

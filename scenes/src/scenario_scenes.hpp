@@ -41,6 +41,7 @@ void build_rope_bridge(World& w, const ScenarioParams& p);
 void build_flag(World& w, const ScenarioParams& p);
 void build_drape(World& w, const ScenarioParams& p);
 void build_wrecking_rope(World& w, const ScenarioParams& p);
+void build_jelly(World& w, const ScenarioParams& p);
 
 // Per-frame logic, run before each step. Reads only the World and the inputs.
 void control_spray(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
@@ -170,6 +171,17 @@ inline constexpr Vec3 sphere_at{-0.9_fx, 0.7_fx, 0_fx};
 inline constexpr Vec3 box_half{0.5_fx, 0.6_fx, 0.5_fx};
 inline constexpr Vec3 box_at{1_fx, 0.6_fx, 0_fx};
 }  // namespace drape
+
+namespace jelly {
+inline constexpr std::int32_t steps = 5;
+inline constexpr Fixed rise = 0.3_fx;
+inline constexpr Fixed run = 0.6_fx;
+inline constexpr Fixed width = 6_fx;
+inline constexpr Fixed half = 0.2_fx;  ///< the cubes' half side
+inline constexpr std::uint32_t resolution = 4;
+inline constexpr Fixed mass = 2_fx;
+inline constexpr Fixed edge_compliance = 0.001_fx;
+}  // namespace jelly
 
 namespace wrecking_rope {
 inline constexpr Vec3 pivot{0_fx, 7_fx, 0_fx};

@@ -129,6 +129,44 @@ bool read_cloth(ByteReader& r, ClothDef& d, std::string& error) {
   return r.ok();
 }
 
+void write_def(const SoftBodyDef& d, ByteWriter& w) {
+  w.u8(static_cast<std::uint8_t>(d.shape.type));
+  if (d.shape.type == ShapeType::convex) {
+    w.var(d.shape.geometry.value);
+  } else {
+    w.vec3(d.shape.half_extents);
+  }
+  w.vec3(d.position);
+  w.quat(d.orientation);
+  w.var(d.resolution);
+  w.fixed(d.mass);
+  w.fixed(d.edge_compliance);
+  w.fixed(d.volume_compliance);
+  write_settings(d.settings, w);
+}
+
+bool read_soft_body(ByteReader& r, SoftBodyDef& d) {
+  const std::size_t type_at = r.offset();
+  const std::uint8_t type = r.u8("soft body shape type");
+  if (!r.ok()) return false;
+  if (type == static_cast<std::uint8_t>(ShapeType::convex)) {
+    d.shape = Shape::convex(GeometryId{r.var32("soft body hull")});
+  } else if (type == static_cast<std::uint8_t>(ShapeType::box)) {
+    d.shape = Shape::box(r.vec3("soft body half extents"));
+  } else {
+    r.fail_at(type_at, "soft body shape type", "a box or a convex hull");
+    return false;
+  }
+  d.position = r.vec3("soft body position");
+  d.orientation = r.quat("soft body orientation");
+  d.resolution = r.var32("soft body resolution");
+  d.mass = r.fixed("soft body mass");
+  d.edge_compliance = r.fixed("soft body edge compliance");
+  d.volume_compliance = r.fixed("soft body volume compliance");
+  d.settings = read_settings(r);
+  return r.ok();
+}
+
 std::string check_record(const WorldState& s, const ParticleGroup& g) {
   const std::uint32_t n = static_cast<std::uint32_t>(g.size());
   for (std::size_t k = 0; k < g.attachments.size(); ++k) {
@@ -223,8 +261,8 @@ bool read_particles(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
     const std::string name = "particle group " + std::to_string(g.id.value) + ": ";
     const std::size_t type_at = r.offset();
     const std::uint8_t type = r.u8("particle group type");
-    if (r.ok() && type > static_cast<std::uint8_t>(ParticleGroupType::cloth))
-      r.fail_at(type_at, "particle group type", "0-1 (rope, cloth)");
+    if (r.ok() && type > static_cast<std::uint8_t>(ParticleGroupType::soft_body))
+      r.fail_at(type_at, "particle group type", "0-2 (rope, cloth, soft body)");
     if (!r.ok()) break;
     g.type = static_cast<ParticleGroupType>(type);
     const std::size_t def_at = r.offset();
@@ -235,6 +273,12 @@ bool read_particles(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
       if (!r.ok()) break;
       check = check_rope_def(s, def, false);
       n = particle_count(def);
+      g.def = def;
+    } else if (g.type == ParticleGroupType::soft_body) {
+      SoftBodyDef def;
+      if (!read_soft_body(r, def)) break;
+      check = check_soft_body_def(s, def);
+      n = check.empty() ? particle_count(s, def) : 0;
       g.def = def;
     } else {
       ClothDef def;
@@ -300,7 +344,7 @@ bool read_particles(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
     if (!r.ok()) break;
     if (auto e = check_record(s, g); !e.empty()) return failed_at(at, name + e);
     // The constraints, from the definition; the broken ones must be among them.
-    build_group(g);
+    build_group(s, g);
     if (!g.broken.empty() && g.broken.back() >= g.links.size())
       return failed_at(broken_at, name + "broken constraint " + std::to_string(g.broken.back()) +
                                       " of " + std::to_string(g.links.size()));

@@ -28,6 +28,7 @@ inline constexpr GoldenRun runs[] = {
     {"drape", {.seed = 1, .players = 0, .count = 12}, 1000},
     {"flag", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"furniture", {.seed = 1, .players = 0, .count = 4}, 1000},
+    {"jelly", {.seed = 1, .players = 0, .count = 2}, 1000},
     {"level", {.seed = 1, .players = 0, .count = 4}, 1000},
     {"motors", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"pendulum", {.seed = 1, .players = 0, .count = 0}, 1200},

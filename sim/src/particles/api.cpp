@@ -44,6 +44,16 @@ void wake_attached(sim_detail::WorldState& s, const sim_detail::ParticleGroup& g
   }
 }
 
+std::size_t count_of(const sim_detail::WorldState&, const RopeDef& def) {
+  return sim_detail::particle_count(def);
+}
+std::size_t count_of(const sim_detail::WorldState&, const ClothDef& def) {
+  return sim_detail::particle_count(def);
+}
+std::size_t count_of(const sim_detail::WorldState& s, const SoftBodyDef& def) {
+  return sim_detail::particle_count(s, def);
+}
+
 template <class Def>
 Expected<ParticleGroupId> create_group(sim_detail::WorldState& s, const Def& def, std::string check,
                                        const char* what) {
@@ -52,7 +62,7 @@ Expected<ParticleGroupId> create_group(sim_detail::WorldState& s, const Def& def
   if (s.particle_groups.size() >= max_particle_groups)
     return Status::error("invalid " + std::string(what) + " definition: the world has " +
                          std::to_string(max_particle_groups) + " particle groups, the most it may");
-  const std::size_t n = sim_detail::particle_count(def);
+  const std::size_t n = count_of(s, def);
   if (s.particle_total() + n > max_particles_per_world)
     return Status::error("invalid " + std::string(what) + " definition: " + std::to_string(n) +
                          " more particles would make " + std::to_string(s.particle_total() + n) +
@@ -75,6 +85,10 @@ Expected<ParticleGroupId> World::create_rope(const RopeDef& def) {
 
 Expected<ParticleGroupId> World::create_cloth(const ClothDef& def) {
   return create_group(*s_, def, sim_detail::check_cloth_def(*s_, def), "cloth");
+}
+
+Expected<ParticleGroupId> World::create_soft_body(const SoftBodyDef& def) {
+  return create_group(*s_, def, sim_detail::check_soft_body_def(*s_, def), "soft body");
 }
 
 Status World::destroy_particle_group(ParticleGroupId id) {
@@ -125,6 +139,10 @@ Expected<RopeDef> World::rope_def(ParticleGroupId id) const {
 
 Expected<ClothDef> World::cloth_def(ParticleGroupId id) const {
   return def_of<ClothDef>(*s_, id, "sheet of cloth");
+}
+
+Expected<SoftBodyDef> World::soft_body_def(ParticleGroupId id) const {
+  return def_of<SoftBodyDef>(*s_, id, "soft body");
 }
 
 Expected<ParticleGroupStats> World::particle_group_stats(ParticleGroupId id) const {

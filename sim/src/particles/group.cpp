@@ -4,7 +4,11 @@
 #include <detsim/fixed/decimal.hpp>
 #include <detsim/fixed/math.hpp>
 
+#include <algorithm>
+#include <array>
+
 #include "../limits.hpp"
+#include "../shapes.hpp"
 #include "../world_state.hpp"
 
 namespace detsim::sim_detail {
@@ -173,6 +177,145 @@ std::string check_cloth_def(const WorldState& s, const ClothDef& def, bool bodie
   return check_settings(def.settings);
 }
 
+namespace {
+
+// A soft body's lattice in its own frame: the particles (cell centres of a cubic grid over the
+// shape's box, kept where the shape contains them) and the cubes of eight kept neighbours.
+struct SoftLayout {
+  std::vector<Vec3> local;
+  std::vector<std::array<std::uint32_t, 8>> cubes;  ///< corners by bits (x 1, y 2, z 4)
+  Fixed spacing;
+  std::string error;
+};
+
+constexpr Fixed kMinSoftSpacing = Fixed::from_raw(Fixed::one_raw / 100);  // 1 cm
+
+SoftLayout soft_layout(const WorldState& s, const SoftBodyDef& def) {
+  SoftLayout out;
+  const Geometry* g = s.geometry(def.shape);
+  const ShapeKind& kind = shape_kind(def.shape.type);
+  // The shape's bounding box in its frame: a box's, or a hull's corners' (its extent about the
+  // origin would be wider where the hull is not centred on it).
+  Vec3 lo = -def.shape.half_extents;
+  Vec3 hi = def.shape.half_extents;
+  if (g != nullptr) {
+    lo = hi = g->hull().vertices.front();
+    for (const Vec3& v : g->hull().vertices) {
+      lo = {min(lo.x, v.x), min(lo.y, v.y), min(lo.z, v.z)};
+      hi = {max(hi.x, v.x), max(hi.y, v.y), max(hi.z, v.z)};
+    }
+  }
+  const Vec3 e = (hi - lo) * Fixed::half();
+  const Vec3 centre = lo + e;
+  const Fixed longest = max(e.x, max(e.y, e.z)) * 2;
+  out.spacing = longest / count_fx(def.resolution);
+  if (out.spacing < kMinSoftSpacing) {
+    out.error = "resolution " + std::to_string(def.resolution) + " makes cells of " +
+                num(out.spacing) + " m, below the smallest, " + num(kMinSoftSpacing) + " m";
+    return out;
+  }
+  // Cells per axis: the side over the spacing, to nearest; particles at the cells' centres.
+  const auto cells = [&](Fixed half) {
+    return static_cast<std::uint32_t>((half * 2 / out.spacing).to_int());
+  };
+  const std::array<std::uint32_t, 3> n{cells(e.x), cells(e.y), cells(e.z)};
+  if (n[0] < 2 || n[1] < 2 || n[2] < 2) {
+    out.error = "resolution " + std::to_string(def.resolution) +
+                " gives fewer than 2 particles along an axis of the shape";
+    return out;
+  }
+  const auto at = [&](std::uint32_t i, std::uint32_t j, std::uint32_t k) {
+    // The lattice centred in the box (its cells may not divide every side exactly).
+    return centre +
+           Vec3{out.spacing * (count_fx(i) + Fixed::half() - count_fx(n[0]) * Fixed::half()),
+                out.spacing * (count_fx(j) + Fixed::half() - count_fx(n[1]) * Fixed::half()),
+                out.spacing * (count_fx(k) + Fixed::half() - count_fx(n[2]) * Fixed::half())};
+  };
+  // Lattice points inside the shape, x fastest; their index among the kept ones.
+  const std::size_t total = std::size_t{n[0]} * n[1] * n[2];
+  std::vector<std::int64_t> index(total, -1);
+  std::vector<bool> inside(total, false);
+  for (std::uint32_t k = 0; k < n[2]; ++k)
+    for (std::uint32_t j = 0; j < n[1]; ++j)
+      for (std::uint32_t i = 0; i < n[0]; ++i)
+        inside[(std::size_t{k} * n[1] + j) * n[0] + i] = kind.contains(def.shape, g, at(i, j, k));
+  // Cubes whose eight corners are all inside; their corners are the particles, in lattice order.
+  std::vector<std::array<std::size_t, 8>> cubes;
+  for (std::uint32_t k = 0; k + 1 < n[2]; ++k)
+    for (std::uint32_t j = 0; j + 1 < n[1]; ++j)
+      for (std::uint32_t i = 0; i + 1 < n[0]; ++i) {
+        std::array<std::size_t, 8> c{};
+        bool all = true;
+        for (std::uint32_t b = 0; b < 8; ++b) {
+          c[b] = (std::size_t{k + ((b >> 2) & 1)} * n[1] + (j + ((b >> 1) & 1))) * n[0] +
+                 (i + (b & 1));
+          all = all && inside[c[b]];
+        }
+        if (all) cubes.push_back(c);
+      }
+  for (const auto& c : cubes)
+    for (std::size_t v : c)
+      index[v] = 0;
+  for (std::uint32_t k = 0; k < n[2]; ++k)
+    for (std::uint32_t j = 0; j < n[1]; ++j)
+      for (std::uint32_t i = 0; i < n[0]; ++i) {
+        std::int64_t& slot = index[(std::size_t{k} * n[1] + j) * n[0] + i];
+        if (slot < 0) continue;
+        slot = static_cast<std::int64_t>(out.local.size());
+        out.local.push_back(at(i, j, k));
+      }
+  for (const auto& c : cubes) {
+    std::array<std::uint32_t, 8> cube{};
+    for (std::size_t b = 0; b < 8; ++b)
+      cube[b] = static_cast<std::uint32_t>(index[c[b]]);
+    out.cubes.push_back(cube);
+  }
+  if (out.cubes.empty())
+    out.error = "the shape holds no whole cell at resolution " + std::to_string(def.resolution);
+  return out;
+}
+
+Fixed triple(Vec3 x0, Vec3 x1, Vec3 x2, Vec3 x3) {
+  return dot(x1 - x0, cross(x2 - x0, x3 - x0));
+}
+
+}  // namespace
+
+std::uint32_t particle_count(const WorldState& s, const SoftBodyDef& def) {
+  return static_cast<std::uint32_t>(soft_layout(s, def).local.size());
+}
+
+std::string check_soft_body_def(const WorldState& s, const SoftBodyDef& def) {
+  if (def.shape.type != ShapeType::box && def.shape.type != ShapeType::convex)
+    return "shape must be a box or a convex hull";
+  if (auto e = check_shape(s.geometries, def.shape, BodyType::dynamic); !e.empty())
+    return "shape: " + e;
+  if (auto e = check_components("position", def.position, max_position, "m"); !e.empty()) return e;
+  if (auto e = check_orientation(def.orientation); !e.empty()) return e;
+  if (def.resolution < 1 || def.resolution > 40)
+    return "resolution must be within 1 .. 40, got " + std::to_string(def.resolution);
+  const SoftLayout layout = soft_layout(s, def);
+  if (!layout.error.empty()) return layout.error;
+  if (auto e = check_mass(def.mass, static_cast<std::uint32_t>(layout.local.size())); !e.empty())
+    return e;
+  if (auto e =
+          in_range("edge_compliance", def.edge_compliance, Fixed::zero(), kMaxCompliance, "m/N");
+      !e.empty())
+    return e;
+  if (auto e = in_range("volume_compliance", def.volume_compliance, Fixed::zero(), kMaxCompliance,
+                        "m^3/(N m)");
+      !e.empty())
+    return e;
+  return check_settings(def.settings);
+}
+
+std::vector<Vec3> rest_positions(const WorldState& s, const SoftBodyDef& def) {
+  std::vector<Vec3> out = soft_layout(s, def).local;
+  for (Vec3& p : out)
+    p = def.position + rotate(def.orientation, p);
+  return out;
+}
+
 std::vector<Vec3> rest_positions(const RopeDef& def) {
   const std::uint32_t n = particle_count(def);
   std::vector<Vec3> out(n);
@@ -276,10 +419,42 @@ void build_cloth(ParticleGroup& g, const ClothDef& def) {
 
 }  // namespace
 
-void build_group(ParticleGroup& g) {
+namespace {
+
+// A soft body's links (every tetrahedron's edges, once each, ascending) and tetrahedra.
+void build_soft_body(const WorldState& s, ParticleGroup& g, const SoftBodyDef& def) {
+  const SoftLayout layout = soft_layout(s, def);
+  g.radius = layout.spacing * Fixed::half();
+  // Freudenthal's six tetrahedra of a cube: from corner 0 to corner 7 through one axis, then two.
+  constexpr std::array<std::array<std::uint32_t, 2>, 6> kPaths{
+      {{1, 3}, {1, 5}, {2, 3}, {2, 6}, {4, 5}, {4, 6}}};
+  std::vector<std::array<std::uint32_t, 2>> edges;
+  for (const auto& cube : layout.cubes) {
+    for (const auto& path : kPaths) {
+      Tetrahedron t;
+      t.corners = {cube[0], cube[path[0]], cube[path[1]], cube[7]};
+      t.rest_triple = triple(layout.local[t.corners[0]], layout.local[t.corners[1]],
+                             layout.local[t.corners[2]], layout.local[t.corners[3]]);
+      g.tetrahedra.push_back(t);
+      for (std::size_t a = 0; a < 4; ++a)
+        for (std::size_t b = a + 1; b < 4; ++b)
+          edges.push_back(
+              {std::min(t.corners[a], t.corners[b]), std::max(t.corners[a], t.corners[b])});
+    }
+  }
+  std::sort(edges.begin(), edges.end());  // a total order on (a, b): no ties between equals
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const auto& e : edges)
+    add_link(g, e[0], e[1], def.edge_compliance, LinkKind::stretch, layout.local);
+}
+
+}  // namespace
+
+void build_group(const WorldState& s, ParticleGroup& g) {
   g.links.clear();
   g.tethers.clear();
   g.pinned.clear();
+  g.tetrahedra.clear();
   const std::uint32_t n = static_cast<std::uint32_t>(g.positions.size());
   std::visit(
       [&](const auto& def) {
@@ -287,8 +462,10 @@ void build_group(ParticleGroup& g) {
         using Def = std::decay_t<decltype(def)>;
         if constexpr (std::is_same_v<Def, RopeDef>) {
           build_rope(g, def);
-        } else {
+        } else if constexpr (std::is_same_v<Def, ClothDef>) {
           build_cloth(g, def);
+        } else {
+          build_soft_body(s, g, def);
         }
       },
       g.def);
@@ -321,7 +498,7 @@ ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const RopeDef&
     g.attachments.push_back(attach(s, 0, def.attach_start, g.positions[0]));
   if (!def.attach_end.is_null())
     g.attachments.push_back(attach(s, last, def.attach_end, g.positions[last]));
-  build_group(g);
+  build_group(s, g);
   return g;
 }
 
@@ -336,7 +513,18 @@ ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const ClothDef
     for (std::uint32_t p : def.pinned)
       g.attachments.push_back(attach(s, p, def.attach_body, g.positions[p]));
   }
-  build_group(g);
+  build_group(s, g);
+  return g;
+}
+
+ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const SoftBodyDef& def) {
+  ParticleGroup g;
+  g.id = id;
+  g.type = ParticleGroupType::soft_body;
+  g.def = def;
+  g.positions = rest_positions(s, def);
+  g.velocities.assign(g.positions.size(), Vec3{});
+  build_group(s, g);
   return g;
 }
 
@@ -356,6 +544,15 @@ ParticleGroupStats group_stats(const ParticleGroup& g) {
   }
   st.kinetic_energy = v2_sum * g.particle_mass * Fixed::half();
   st.max_speed = sqrt(max_v2);
+  for (const Tetrahedron& t : g.tetrahedra) {
+    const auto& c = t.corners;
+    // Six times the tetrahedron's volume, signed by its corners' order.
+    st.volume +=
+        abs(triple(g.positions[c[0]], g.positions[c[1]], g.positions[c[2]], g.positions[c[3]]));
+    st.rest_volume += abs(t.rest_triple);
+  }
+  st.volume = st.volume / Fixed::from_int(6);
+  st.rest_volume = st.rest_volume / Fixed::from_int(6);
   for (std::size_t k = 0; k < g.links.size(); ++k) {
     const Link& l = g.links[k];
     if (g.link_broken[k] || l.kind == LinkKind::bend || l.kind == LinkKind::shear) continue;

@@ -8,6 +8,7 @@
 // constraints, bit for bit, on every machine.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <variant>
@@ -57,10 +58,17 @@ struct Tether {
   Fixed max;
 };
 
+/// A soft body's tetrahedron: its corners, and six times its rest volume (the scalar triple
+/// product (x1 - x0) . ((x2 - x0) x (x3 - x0)) at rest), which its volume constraint holds.
+struct Tetrahedron {
+  std::array<std::uint32_t, 4> corners{};
+  Fixed rest_triple;
+};
+
 struct ParticleGroup {
   ParticleGroupId id{};
   ParticleGroupType type = ParticleGroupType::rope;
-  std::variant<RopeDef, ClothDef> def;
+  std::variant<RopeDef, ClothDef, SoftBodyDef> def;
 
   // State: the particles, parallel arrays by index.
   std::vector<Vec3> positions;
@@ -75,13 +83,14 @@ struct ParticleGroup {
   Fixed tether_impulse;
 
   // Built from the definition (never saved).
-  Fixed particle_mass;            ///< kg, every particle's
-  Fixed inverse_mass;             ///< 1 / particle_mass
-  Fixed radius;                   ///< m, for collisions
-  std::vector<Link> links;        ///< ascending (a, b), by kind within a particle pair's
-  std::vector<Tether> tethers;    ///< ascending particle
-  std::vector<bool> pinned;       ///< held in space (cloth's pinned without a body)
-  std::vector<bool> link_broken;  ///< parallel to links, from `broken`
+  Fixed particle_mass;                  ///< kg, every particle's
+  Fixed inverse_mass;                   ///< 1 / particle_mass
+  Fixed radius;                         ///< m, for collisions
+  std::vector<Link> links;              ///< ascending (a, b), by kind within a particle pair's
+  std::vector<Tether> tethers;          ///< ascending particle
+  std::vector<Tetrahedron> tetrahedra;  ///< a soft body's, by cube then Freudenthal order
+  std::vector<bool> pinned;             ///< held in space (cloth's pinned without a body)
+  std::vector<bool> link_broken;        ///< parallel to links, from `broken`
 
   // Step scratch (not saved; stale between steps): the bodies whose boxes overlap the group's
   // (indices into WorldState::bodies, ascending), found by prepare_particles.
@@ -99,25 +108,31 @@ struct ParticleGroup {
                                          bool bodies = true);
 [[nodiscard]] std::string check_cloth_def(const WorldState& s, const ClothDef& def,
                                           bool bodies = true);
+[[nodiscard]] std::string check_soft_body_def(const WorldState& s, const SoftBodyDef& def);
 
 /// The particle count a valid definition makes.
 [[nodiscard]] std::uint32_t particle_count(const RopeDef& def) noexcept;
 [[nodiscard]] std::uint32_t particle_count(const ClothDef& def) noexcept;
+/// A soft body's particle count depends on its shape's geometry (a hull's cells).
+[[nodiscard]] std::uint32_t particle_count(const WorldState& s, const SoftBodyDef& def);
 
 /// A new group of a valid definition: particles at rest where the definition lays them out,
 /// attachments in the bodies' frames at their present poses, and the constraints.
 [[nodiscard]] ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const RopeDef& def);
 [[nodiscard]] ParticleGroup make_group(const WorldState& s, ParticleGroupId id,
                                        const ClothDef& def);
+[[nodiscard]] ParticleGroup make_group(const WorldState& s, ParticleGroupId id,
+                                       const SoftBodyDef& def);
 
 /// The particles' rest layout of a definition (where make_group puts them).
 [[nodiscard]] std::vector<Vec3> rest_positions(const RopeDef& def);
 [[nodiscard]] std::vector<Vec3> rest_positions(const ClothDef& def);
+[[nodiscard]] std::vector<Vec3> rest_positions(const WorldState& s, const SoftBodyDef& def);
 
 /// Rebuilds what is derived from the definition and `broken` (mass, radius, links, tethers,
 /// pins): what make_group and restore both do, so that a restored group steps exactly like the
 /// one that was saved.
-void build_group(ParticleGroup& g);
+void build_group(const WorldState& s, ParticleGroup& g);
 
 /// The group's statistics (World::particle_group_stats).
 [[nodiscard]] ParticleGroupStats group_stats(const ParticleGroup& g);

@@ -123,8 +123,8 @@ void update_particle_sleep(WorldState& s) {
     for (const Vec3& v : g.velocities)
       v2_sum += length_squared(v);
     const Fixed mean_v2 = v2_sum / Fixed::from_int(static_cast<std::int32_t>(g.size()));
-    g.sleep_time = mean_v2 <= limit2 ? min(g.sleep_time + s.def.dt, Fixed::from_int(1000))
-                                     : Fixed::zero();
+    g.sleep_time =
+        mean_v2 <= limit2 ? min(g.sleep_time + s.def.dt, Fixed::from_int(1000)) : Fixed::zero();
     if (!s.def.enable_sleep || g.sleep_time < s.def.time_to_sleep) continue;
     bool bodies_rest = true;
     for (std::uint32_t i : g.near_bodies)
@@ -196,6 +196,9 @@ void ParticleStepper::prepare_group(ParticleGroup& g, GroupScratch& sc) {
   sc.h = bodies_.h / Fixed::from_int(static_cast<std::int32_t>(g.settings().substeps));
   sc.inv_h = Fixed::one() / sc.h;
   const Fixed inv_h2 = sc.inv_h * sc.inv_h;
+  sc.volume_compliance = Fixed::zero();
+  if (const auto* soft = std::get_if<SoftBodyDef>(&g.def))
+    sc.volume_compliance = soft->volume_compliance * inv_h2;
   sc.link_factor.resize(g.links.size());
   Fixed last_compliance = Fixed::min();
   Fixed scaled;
@@ -371,6 +374,33 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
         g.positions[l.b] -= delta * (w * scale);
       else
         pull_attached(l.b, -delta * (scale * inv_h));
+    }
+
+    // Volumes (Macklin et al. 2016's tetrahedral volume constraint): C = (x1 - x0) . g1 - C0
+    // with g1 = (x2 - x0) x (x3 - x0) (six times the signed volume), gradients g0..g3,
+    // lambda = -C / (sum w |g_i|^2 + compliance / h^2).
+    for (const Tetrahedron& t : g.tetrahedra) {
+      const auto& c = t.corners;
+      const Vec3 x0 = g.positions[c[0]];
+      const Vec3 e1 = g.positions[c[1]] - x0;
+      const Vec3 e2 = g.positions[c[2]] - x0;
+      const Vec3 e3 = g.positions[c[3]] - x0;
+      const Vec3 g1 = cross(e2, e3);
+      const Vec3 g2 = cross(e3, e1);
+      const Vec3 g3 = cross(e1, e2);
+      const Vec3 g0 = -(g1 + g2 + g3);
+      const Fixed violation = dot(e1, g1) - t.rest_triple;
+      if (violation == Fixed::zero()) continue;
+      const Fixed denominator =
+          w * (length_squared(g0) + length_squared(g1) + length_squared(g2) + length_squared(g3)) +
+          sc.volume_compliance;
+      if (denominator == Fixed::zero()) continue;
+      const Fixed lambda = -violation / denominator;
+      const Fixed step = w * lambda;
+      g.positions[c[0]] += g0 * step;
+      g.positions[c[1]] += g1 * step;
+      g.positions[c[2]] += g2 * step;
+      g.positions[c[3]] += g3 * step;
     }
 
     // Long-range tethers: only pull, only the free particle moves.

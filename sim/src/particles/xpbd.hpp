@@ -58,6 +58,7 @@ class ParticleStepper {
     Fixed h;                                   ///< the small step
     Fixed inv_h;
     std::vector<Fixed> link_factor;  ///< per link: 1 / (w_a + w_b + compliance / h^2)
+    Fixed volume_compliance;         ///< a soft body's volume compliance / h^2
   };
 
   void prepare_group(ParticleGroup& g, GroupScratch& scratch);

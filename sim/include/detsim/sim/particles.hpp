@@ -14,8 +14,10 @@
 
 #include <detsim/fixed/decimal.hpp>
 #include <detsim/fixed/fixed.hpp>
+#include <detsim/fixed/quat.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
+#include <detsim/sim/shape.hpp>
 
 namespace detsim {
 
@@ -32,6 +34,7 @@ struct ParticleGroupId {
 enum class ParticleGroupType : std::uint8_t {
   rope = 0,
   cloth = 1,
+  soft_body = 2,
 };
 
 /// Hard limits (refused beyond them, with a message naming the field).
@@ -108,6 +111,26 @@ struct ClothDef {
   friend bool operator==(const ClothDef&, const ClothDef&) = default;
 };
 
+/// A soft body: a volume of particles filling `shape` (a box, or a convex hull registered with the
+/// world) placed at `position` with `orientation`. The particles sit at the centres of the cells
+/// of a cubic lattice of `resolution` cells along the shape's longest side, each a ball of half
+/// the cell's side, so that together they fill the shape (a hull keeps the cells whose corners are
+/// all inside it). Each cell is six tetrahedra (Freudenthal's split along its main diagonal):
+/// their edges are distance constraints of `edge_compliance`, their volumes volume constraints of
+/// `volume_compliance` (0: the volume is held).
+struct SoftBodyDef {
+  Shape shape = Shape::box({Fixed::half(), Fixed::half(), Fixed::half()});
+  Vec3 position{};
+  Quat orientation{};            ///< a unit quaternion, as a body's
+  std::uint32_t resolution = 4;  ///< cells along the longest side, 1..40
+  Fixed mass = Fixed::one();     ///< kg, spread evenly
+  Fixed edge_compliance{};       ///< m/N per edge, >= 0
+  Fixed volume_compliance{};     ///< per tetrahedron (m^3 per N m), >= 0
+  ParticleSettings settings{};
+
+  friend constexpr bool operator==(const SoftBodyDef&, const SoftBodyDef&) noexcept = default;
+};
+
 /// What World::particle_group_stats reports for a group.
 struct ParticleGroupStats {
   ParticleGroupType type = ParticleGroupType::rope;
@@ -119,6 +142,9 @@ struct ParticleGroupStats {
   /// how well the constraints hold.
   Fixed max_strain{};
   Fixed max_speed{};  ///< m/s, the fastest particle
+  /// A soft body's volume (m^3, the sum of its tetrahedra's) now and at rest; zero for the others.
+  Fixed volume{};
+  Fixed rest_volume{};
   bool awake = true;
 
   friend constexpr bool operator==(const ParticleGroupStats&,

@@ -281,6 +281,10 @@ class World {
   /// Creates a sheet of cloth (ClothDef), refused like create_rope (and for a pinned index out of
   /// range or not ascending, or an attach_body with nothing pinned).
   Expected<ParticleGroupId> create_cloth(const ClothDef& def);
+  /// Creates a soft body (SoftBodyDef), refused like create_rope (and for a shape that is not a
+  /// box or a convex hull of this world, a resolution outside 1..40, cells below 1 cm, or a
+  /// shape that holds fewer than two particles along an axis).
+  Expected<ParticleGroupId> create_soft_body(const SoftBodyDef& def);
   /// Removes a group; wakes the bodies it was attached to. Unknown IDs are an error.
   Status destroy_particle_group(ParticleGroupId id);
   /// Every group's ID, ascending.
@@ -293,6 +297,7 @@ class World {
   /// destroyed since), or an error for an unknown ID or a group of the other type.
   [[nodiscard]] Expected<RopeDef> rope_def(ParticleGroupId id) const;
   [[nodiscard]] Expected<ClothDef> cloth_def(ParticleGroupId id) const;
+  [[nodiscard]] Expected<SoftBodyDef> soft_body_def(ParticleGroupId id) const;
   /// A group's statistics (energy, strain, speed), or an error for an unknown ID.
   [[nodiscard]] Expected<ParticleGroupStats> particle_group_stats(ParticleGroupId id) const;
   /// A force (N, world frame) spread evenly over a group's free particles for the next step (wind,
