@@ -129,7 +129,9 @@ bool read_cloth(ByteReader& r, ClothDef& d, std::string& error) {
   return r.ok();
 }
 
-std::string check_record(const WorldState& s, const ParticleGroup& g) {
+}  // namespace
+
+std::string check_particle_record(const WorldState& s, const ParticleGroup& g) {
   const std::uint32_t n = static_cast<std::uint32_t>(g.size());
   for (std::size_t k = 0; k < g.attachments.size(); ++k) {
     const Attachment& a = g.attachments[k];
@@ -155,8 +157,6 @@ std::string check_record(const WorldState& s, const ParticleGroup& g) {
     return "tether impulse must be >= 0, got " + to_string(g.tether_impulse);
   return {};
 }
-
-}  // namespace
 
 void write_particles(const WorldState& s, ByteWriter& w) {
   w.u32(s.next_particle_group_id);
@@ -298,7 +298,7 @@ bool read_particles(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
       g.broken.push_back(last);
     }
     if (!r.ok()) break;
-    if (auto e = check_record(s, g); !e.empty()) return failed_at(at, name + e);
+    if (auto e = check_particle_record(s, g); !e.empty()) return failed_at(at, name + e);
     // The constraints, from the definition; the broken ones must be among them.
     build_group(g);
     if (!g.broken.empty() && g.broken.back() >= g.links.size())
