@@ -287,6 +287,32 @@ TEST(ParticleState, RefusesEachBadFieldNamingItAndChangesNothing) {
   }
 }
 
+// Every single-bit change of the section's payload (one bit of each byte, cycling through the
+// eight): refused with the world unchanged, or accepted and then saved back as exactly those bytes
+// (the encoding is canonical).
+TEST(ParticleState, EveryBitFlipIsRefusedOrCanonical) {
+  World w = stepped_scene();
+  const Bytes original = w.save();
+  const StateHashes hashes = w.hashes();
+  const Decoded d = decode(original);
+  ASSERT_TRUE(d.ok) << d.error;
+  std::size_t accepted = 0;
+  std::size_t refused = 0;
+  for (std::size_t at = d.payload_at[kParticles]; at < original.size(); ++at) {
+    Bytes bytes = original;
+    bytes[at] = static_cast<std::uint8_t>(bytes[at] ^ (1U << (at % 8)));
+    (restore_outcome_is_sound(w, bytes, original, hashes,
+                              "bit " + std::to_string(at % 8) + " of byte " + std::to_string(at))
+         ? accepted
+         : refused)++;
+  }
+  // Most bytes are particles' numbers, which any value within the limits leaves valid; the
+  // structure's bytes are refused.
+  EXPECT_GT(accepted, 0U);
+  EXPECT_GT(refused, 0U);
+  EXPECT_TRUE(w.save() == original);
+}
+
 TEST(ParticleState, AHugeGroupCountIsRefusedBeforeAnythingIsAllocated) {
   World w = stepped_scene();
   Bytes bytes = w.save();
