@@ -10,6 +10,7 @@
 
 #include <detsim/replay/bisect.hpp>
 #include <detsim/replay/scenario_replay.hpp>
+#include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/inject.hpp>
 
 #include "support/cli.hpp"
@@ -111,6 +112,43 @@ TEST(CliBisect, AJointsFieldIsNamedLikeABodysField) {
   r = detsim_cli("run --scenario chain --frames 100 --inject 50:0:joint[999].motor_speed:1");
   EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
   EXPECT_TRUE(has(r.err, "no joint with ID 999")) << r.err;
+}
+
+/// A particle's field (a cloth particle's height in the drape scenario) through the commands:
+/// bisection names the group, the particle and the field, in the "particles" subsystem.
+TEST(CliBisect, AParticlesFieldIsNamedLikeABodysField) {
+  if (find_scenario("drape") == nullptr) GTEST_SKIP() << "this build has no drape scenario";
+  TempFile faulty("faulty.dsr");
+  TempFile healthy_report("healthy.dsd");
+  TempFile faulty_report("faulty.dsd");
+  const std::string inject = "100:0:particle_group[1].particle[30].position.y:0.01";
+  auto r = detsim_cli("run --scenario drape --frames 200 --record " + faulty.path() + " --inject " +
+                      inject);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = detsim_cli("verify " + faulty.path() + " --report " + healthy_report.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "first_mismatch"), "100") << r.out;
+  r = detsim_cli("verify " + faulty.path() + " --inject " + inject + " --report " +
+                 faulty_report.path() + " --at 100");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = detsim_cli("bisect " + healthy_report.path() + " " + faulty_report.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "first_divergent_frame"), "100") << r.out;
+  EXPECT_TRUE(has(r.out, R"("subsystems":["particles"])")) << r.out;
+  EXPECT_TRUE(has(
+      r.out,
+      R"("diffs":[{"subsystem":"particles","body":0,"field":"particle_group[1].particle[30].position.y",)"))
+      << r.out;
+  EXPECT_TRUE(has(r.out, R"(}],"diffs_omitted":0)")) << "exactly one difference: " << r.out;
+
+  // A group or particle that does not exist is refused when the run reaches it.
+  r = detsim_cli("run --scenario drape --frames 20 --inject 10:0:particle_group[9].awake:1");
+  EXPECT_NE(r.exit_code, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "no particle group with ID 9")) << r.err;
+  const std::string beyond = "10:0:particle_group[1].particle[100000].position.x:1";
+  r = detsim_cli("run --scenario drape --frames 20 --inject " + beyond);
+  EXPECT_NE(r.exit_code, 0) << r.out << r.err;
+  EXPECT_TRUE(has(r.err, "not particle 100000")) << r.err;
 }
 
 /// A scene of registered geometry (level: a triangle mesh, convex rocks, compound tables) end to

@@ -101,7 +101,7 @@ TEST(Cli, RecordVerifyInfoAndATamperedReplay) {
     if (c.type != "FRAM" || test::get_u64(b, c.payload()) > 47) continue;
     const std::uint64_t first = test::get_u64(b, c.payload());
     if (first + test::get_u32(b, c.payload() + 8) <= 47) continue;
-    const std::size_t at = c.payload() + 12 + (47 - first) * 56;  // no players, total + 6 sections
+    const std::size_t at = c.payload() + 12 + (47 - first) * 64;  // no players, total + 7 sections
     b[at] = static_cast<std::uint8_t>(b[at] ^ 1U);
     test::reseal(b, c);
   }

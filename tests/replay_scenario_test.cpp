@@ -105,7 +105,7 @@ TEST(ScenarioReplay, VerifyNamesTheFirstFrameThatDiffers) {
   options.frames = 150;
   options.keyframe_interval = 50;
   ASSERT_TRUE(record(scenario, file.path(), options));
-  const std::size_t record_size = 3 * 3 + 8 * (1 + 6);  // inputs, total and six section hashes
+  const std::size_t record_size = 3 * 3 + 8 * (1 + 7);  // inputs, total and seven section hashes
   const auto original = read_bytes(file.path());
 
   // A recorded hash changed at frame 77 (the machine that recorded disagreed there).

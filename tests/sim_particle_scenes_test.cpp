@@ -75,7 +75,7 @@ TEST(WreckingRopeScenario, HoldsTheBallAtItsLengthAndKnocksTheBoxesOver) {
   EXPECT_GT(farthest, reach * 0.99);
   std::size_t moved = 0;
   for (const BodyState& b : boxes)
-    moved += d(::detsim::length(state(w, b.id).position - b.position)) > 1.0 ? 1 : 0;
+    moved += d(::detsim::length(state(w, b.id).position - b.position)) > 1.0 ? 1U : 0U;
   EXPECT_GE(moved, boxes.size() / 2);
 }
 

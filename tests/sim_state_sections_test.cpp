@@ -76,18 +76,18 @@ void expect_refused(const Bytes& bad, std::initializer_list<const char*> parts) 
   EXPECT_EQ(w.save(), before);
 }
 
-TEST(StateSections, AWorldsStateIsItsSixSectionsAndTheirHashes) {
+TEST(StateSections, AWorldsStateIsItsSevenSectionsAndTheirHashes) {
   const World w = sample_world();
   const Bytes state = w.save();
   auto found = read_state_sections(state);
   ASSERT_TRUE(found.ok()) << found.message();
   const StateHashes h = w.hashes();
-  ASSERT_EQ(found->size(), 6U);
-  ASSERT_EQ(h.sections.size(), 6U);
-  const char* names[] = {"globals", "rng", "geometry", "bodies", "contacts", "joints"};
-  const std::uint32_t versions[] = {1, 1, 1, 2, 2, 1};
-  std::size_t next = 9;  // magic, version, the count 6 in one byte
-  for (std::size_t i = 0; i < 6; ++i) {
+  ASSERT_EQ(found->size(), 7U);
+  ASSERT_EQ(h.sections.size(), 7U);
+  const char* names[] = {"globals", "rng", "geometry", "bodies", "contacts", "joints", "particles"};
+  const std::uint32_t versions[] = {1, 1, 1, 2, 2, 1, 1};
+  std::size_t next = 9;  // magic, version, the count 7 in one byte
+  for (std::size_t i = 0; i < 7; ++i) {
     const StateSection& s = (*found)[i];
     EXPECT_EQ(s.name, names[i]);
     EXPECT_EQ(s.version, versions[i]);
@@ -118,7 +118,7 @@ TEST(StateSections, TheListOfSectionsMustBeAWorlds) {
   expect_refused(container(swapped), {"section \"rng\"", "section \"globals\" was expected"});
 
   std::vector<Section> missing(good.begin(), good.end() - 1);
-  expect_refused(container(missing), {"section \"joints\" is missing"});
+  expect_refused(container(missing), {"section \"particles\" is missing"});
 
   std::vector<Section> newer = good;
   newer[3].version = 3;
@@ -161,7 +161,7 @@ TEST(StateSections, TheContainerIsChecked) {
   Bytes huge(state.begin(), state.begin() + 8);
   put_var(huge, 0xFFFFFFFFFFULL);
   expect_refused(huge, {"section count", "exceeds"});
-  expect_refused(container(good, 3), {"state encoding version 3, this build reads 5"});
+  expect_refused(container(good, 3), {"state encoding version 3, this build reads 6"});
 }
 
 }  // namespace

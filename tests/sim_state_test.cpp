@@ -37,23 +37,27 @@ TEST(StateFormat, DefaultWorldStartsWithMagicAndVersion) {
   EXPECT_EQ(bytes[1], 'S');
   EXPECT_EQ(bytes[2], 'I');
   EXPECT_EQ(bytes[3], 'M');
-  EXPECT_EQ((Bytes(bytes.begin() + 4, bytes.begin() + 8)), (Bytes{5, 0, 0, 0}));
+  EXPECT_EQ((Bytes(bytes.begin() + 4, bytes.begin() + 8)), (Bytes{6, 0, 0, 0}));
   EXPECT_EQ(state_encoding_version, 6U);
-  // Then the section count (var 6) and the first section's record: its name's length (7),
+  // Then the section count (var 7) and the first section's record: its name's length (7),
   // "globals", its version (var 1) and its payload's length: frame 8 + next ID 4 + definition 137
   // = 149 = 0x95 (u32); then frame 0 (u64) and the next body ID, 1 (u32).
   EXPECT_EQ((Bytes(bytes.begin() + 8, bytes.begin() + 22)),
-            (Bytes{6, 7, 'g', 'l', 'o', 'b', 'a', 'l', 's', 1, 0x95, 0, 0, 0}));
+            (Bytes{7, 7, 'g', 'l', 'o', 'b', 'a', 'l', 's', 1, 0x95, 0, 0, 0}));
   EXPECT_EQ((Bytes(bytes.begin() + 22, bytes.begin() + 34)),
             (Bytes{0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0}));
   // magic 4 + version 4 + count 1, each section's name length, name, version and payload length
-  // (1 + 7 + 1 + 4, 1 + 3 + 1 + 4, 1 + 8 + 1 + 4, 1 + 6 + 1 + 4, 1 + 8 + 1 + 4, 1 + 6 + 1 + 4),
-  // and the payloads: globals 149, RNG 32, geometry an empty var count 1, bodies two empty counts
-  // 8, contacts one empty count 4, joints the next joint ID 1 and an empty count, 8.
-  EXPECT_EQ(bytes.size(),
-            9U + 13 + 9 + 14 + 12 + 14 + 12 + (8 + 4 + kDefinitionBytes) + 32 + 1 + 8 + 4 + 8);
-  EXPECT_EQ(bytes.size(), 285U);
-  EXPECT_EQ((Bytes(bytes.end() - 8, bytes.end())), (Bytes{1, 0, 0, 0, 0, 0, 0, 0}));
+  // (1 + 7 + 1 + 4, 1 + 3 + 1 + 4, 1 + 8 + 1 + 4, 1 + 6 + 1 + 4, 1 + 8 + 1 + 4, 1 + 6 + 1 + 4,
+  // 1 + 9 + 1 + 4), and the payloads: globals 149, RNG 32, geometry an empty var count 1, bodies
+  // two empty counts 8, contacts one empty count 4, joints the next joint ID 1 and an empty count,
+  // 8, particles the next particle group ID 1 (u32) and an empty var count, 5.
+  EXPECT_EQ(bytes.size(), 9U + 13 + 9 + 14 + 12 + 14 + 12 + 15 + (8 + 4 + kDefinitionBytes) + 32 +
+                              1 + 8 + 4 + 8 + 5);
+  EXPECT_EQ(bytes.size(), 305U);
+  EXPECT_EQ((Bytes(bytes.end() - 28, bytes.end() - 5)),
+            (Bytes{1,   0,   0,   0,   0,   0,   0, 0, 9, 'p', 'a', 'r',
+                   't', 'i', 'c', 'l', 'e', 's', 1, 5, 0, 0,   0}));
+  EXPECT_EQ((Bytes(bytes.end() - 5, bytes.end())), (Bytes{1, 0, 0, 0, 0}));
 
   const Decoded d = decode(bytes);
   ASSERT_TRUE(d.ok) << d.error;
@@ -66,7 +70,11 @@ TEST(StateFormat, DefaultWorldStartsWithMagicAndVersion) {
   EXPECT_EQ(d.contact_count_at, d.body_count_at + 4 + 14);
   EXPECT_EQ(d.next_joint_id_at, d.contact_count_at + 4 + 12);
   EXPECT_EQ(d.next_joint_id, 1U);
-  EXPECT_TRUE(d.sets.empty() && d.bodies.empty() && d.contacts.empty() && d.joints.empty());
+  EXPECT_EQ(d.particles.next_group_id_at, d.next_joint_id_at + 8 + 15);
+  EXPECT_EQ(d.particles.next_group_id, 1U);
+  EXPECT_EQ(d.particles.group_count_at, bytes.size() - 1);
+  EXPECT_TRUE(d.sets.empty() && d.bodies.empty() && d.contacts.empty() && d.joints.empty() &&
+              d.particles.groups.empty());
   EXPECT_EQ(encode(d), bytes);
 }
 

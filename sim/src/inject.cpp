@@ -1,6 +1,7 @@
 // Fault injection (inject.hpp). Parsing checks the field's name and the delta's form; applying
-// changes a copy of the one thing touched (a body, the RNG state, a contact point), checks it as
-// restore() would, and only then writes it back, so a refused injection changes nothing.
+// changes a copy of the one thing touched (a body, the RNG state, a contact point, a joint, a
+// particle group), checks it as restore() would, and only then writes it back, so a refused
+// injection changes nothing.
 #include <detsim/sim/inject.hpp>
 
 #include <algorithm>
@@ -71,7 +72,11 @@ const std::string& fields_help() {
            "contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2 (DELTA a "
            "decimal; contact[OTHER/S/T] for the contact of BODY's sub-shape S with OTHER's "
            "sub-shape T); joint[J].FIELD (BODY 0; FIELD a field of the joint as diff names it: " +
-           joint_fields_help() + ")";
+           joint_fields_help() +
+           "); particle_group[G].particle[I].position.x|y|z, "
+           "particle_group[G].particle[I].velocity.x|y|z, particle_group[G].force.x|y|z, "
+           "particle_group[G].sleep_time, particle_group[G].tether_impulse (BODY 0; DELTA a "
+           "decimal, added), particle_group[G].awake (BODY 0; DELTA 1 toggles)";
   }();
   return help;
 }
@@ -81,7 +86,7 @@ enum class DeltaKind { fixed, toggle, integer, presence };
 /// What a field name refers to, once parsed.
 struct Target {
   DeltaKind kind = DeltaKind::fixed;
-  enum class Part { body, rng, contact, joint } part = Part::body;
+  enum class Part { body, rng, contact, joint, particles } part = Part::body;
   std::string base;             ///< "position", "sleep_time", "normal_impulse", ...
   int component = -1;           ///< x y z = 0 1 2, w = 3; the RNG word; -1: none
   std::uint32_t other = 0;      ///< contact: the other body
@@ -89,6 +94,8 @@ struct Target {
   std::uint32_t sub_other = 0;  ///< contact: OTHER's sub-shape
   std::size_t point = 0;        ///< contact: the point
   std::uint32_t joint = 0;      ///< joint: its ID
+  std::uint32_t group = 0;      ///< particles: the group's ID
+  std::optional<std::uint32_t> particle;  ///< particles: the particle (none: a group field)
 };
 
 /// A decimal without sign or leading zeros ("0" itself is fine).
@@ -195,6 +202,40 @@ Expected<Target> parse_field(std::string_view field) {
     t.kind = f->kind == JointFieldKind::flag  ? DeltaKind::toggle
              : f->kind == JointFieldKind::u64 ? DeltaKind::integer
                                               : DeltaKind::fixed;
+    return t;
+  }
+  if (field.starts_with("particle_group[")) {
+    // particle_group[G].particle[I].position|velocity.C, or a group field: force.C, sleep_time,
+    // tether_impulse, awake.
+    std::string_view rest;
+    auto group = indexed(field, "particle_group", rest);
+    if (!group || *group == 0 || *group > 0xFFFFFFFFU || !rest.starts_with(".")) return unknown();
+    rest.remove_prefix(1);
+    t.part = Target::Part::particles;
+    t.group = static_cast<std::uint32_t>(*group);
+    if (rest.starts_with("particle[")) {
+      std::string_view name;
+      auto particle = indexed(rest, "particle", name);
+      if (!particle || *particle > 0xFFFFFFFFU || !name.starts_with(".")) return unknown();
+      name.remove_prefix(1);
+      t.particle = static_cast<std::uint32_t>(*particle);
+      rest = name;
+    }
+    std::string_view base = rest;
+    int component = -1;
+    if (const std::size_t dot = rest.rfind('.');
+        dot != std::string_view::npos && dot + 2 == rest.size()) {
+      const char c = rest.back();
+      base = rest.substr(0, dot);
+      component = c >= 'x' && c <= 'z' ? c - 'x' : -2;
+    }
+    const bool vector = t.particle ? base == "position" || base == "velocity" : base == "force";
+    const bool scalar = !t.particle && (base == "sleep_time" || base == "tether_impulse");
+    const bool flag = !t.particle && base == "awake";
+    if (vector ? component < 0 : component != -1 || !(scalar || flag)) return unknown();
+    t.base = std::string(base);
+    t.component = component;
+    t.kind = flag ? DeltaKind::toggle : DeltaKind::fixed;
     return t;
   }
   if (field == "present") {
@@ -311,6 +352,39 @@ Status change_joint(const sim_detail::WorldState& s, JointState& j, const Target
   return Status::success();
 }
 
+// Changes one field of a particle group (a particle's or the group's own), checks the group as
+// restore() would, and only then writes the change: a copy of the one vector or value touched, so
+// a refused change leaves the group as it was.
+Status change_group(const sim_detail::WorldState& s, sim_detail::ParticleGroup& g, const Target& t,
+                    std::string_view delta) {
+  const Fixed d = t.kind == DeltaKind::fixed ? Fixed::parse(delta).value : Fixed::zero();
+  // The one value touched, by reference, and its old value to put back if refused.
+  const auto attempt = [&](auto& value, auto changed) -> Status {
+    const auto old = value;
+    value = changed;
+    if (auto e = sim_detail::check_particle_record(s, g); !e.empty()) {
+      value = old;
+      return Status::error("particle group " + std::to_string(g.id.value) +
+                           ": the change would leave an invalid state: " + e);
+    }
+    return Status::success();
+  };
+  if (t.particle) {
+    Vec3& v = t.base == "position" ? g.positions[*t.particle] : g.velocities[*t.particle];
+    Vec3 changed = v;
+    field_ref(changed, t.component) += d;
+    return attempt(v, changed);
+  }
+  if (t.base == "force") {
+    Vec3 changed = g.force;
+    field_ref(changed, t.component) += d;
+    return attempt(g.force, changed);
+  }
+  if (t.base == "sleep_time") return attempt(g.sleep_time, g.sleep_time + d);
+  if (t.base == "tether_impulse") return attempt(g.tether_impulse, g.tether_impulse + d);
+  return attempt(g.awake, !g.awake);  // awake
+}
+
 Status add_copy(World& world, const BodyState& of) {
   if (!sim_detail::shape_kind(of.shape.type).bounded)
     return Status::error("body " + std::to_string(of.id.value) + " is a " +
@@ -378,7 +452,10 @@ Expected<Injection> parse_injection(std::string_view spec) {
     return Status::error(where + "BODY must be 0 for an RNG field");
   if (target->part == Target::Part::joint && *body != 0)
     return Status::error(where + "BODY must be 0 for a joint field (the joint is named in it)");
-  if (target->part != Target::Part::rng && target->part != Target::Part::joint && *body == 0)
+  if (target->part == Target::Part::particles && *body != 0)
+    return Status::error(where +
+                         "BODY must be 0 for a particle group field (the group is named in it)");
+  if ((target->part == Target::Part::body || target->part == Target::Part::contact) && *body == 0)
     return Status::error(where + "BODY must be a body ID (IDs start at 1)");
   if (target->part == Target::Part::contact && target->other == *body)
     return Status::error(where + "a contact is between BODY and another body, not itself");
@@ -415,6 +492,20 @@ Status apply_injection(World& world, const Injection& injection) {
     if (Status st = change_joint(s, changed, t, injection.delta); !st)
       return Status::error(where + st.message());
     s.joints[static_cast<std::size_t>(j)] = changed;
+    return Status::success();
+  }
+
+  if (t.part == Target::Part::particles) {
+    const std::ptrdiff_t k = s.find_group(t.group);
+    if (k < 0) return Status::error(where + "no particle group with ID " + std::to_string(t.group));
+    sim_detail::ParticleGroup& group = s.particle_groups[static_cast<std::size_t>(k)];
+    if (t.particle && *t.particle >= group.size())
+      return Status::error(where + "particle group " + std::to_string(t.group) + " has " +
+                           std::to_string(group.size()) + " particles (0 .. " +
+                           std::to_string(group.size() - 1) + "), not particle " +
+                           std::to_string(*t.particle));
+    if (Status st = change_group(s, group, t, injection.delta); !st)
+      return Status::error(where + st.message());
     return Status::success();
   }
 

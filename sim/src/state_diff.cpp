@@ -17,6 +17,7 @@
 #include "body_fields.hpp"
 #include "geometry/geometry.hpp"
 #include "joint_fields.hpp"
+#include "world_state.hpp"
 
 namespace detsim {
 namespace {
@@ -50,6 +51,17 @@ std::string show(JointType t) {
       return "distance";
     case JointType::swing_twist:
       return "swing_twist";
+  }
+  return "unknown";
+}
+std::string show(ParticleGroupType t) {
+  switch (t) {
+    case ParticleGroupType::rope:
+      return "rope";
+    case ParticleGroupType::cloth:
+      return "cloth";
+    case ParticleGroupType::soft_body:
+      return "soft_body";
   }
   return "unknown";
 }
@@ -343,6 +355,84 @@ void diff_joints(Collector& c, const Sides& w) {
   }
 }
 
+std::string group_name(ParticleGroupId id) {
+  return "particle_group[" + std::to_string(id.value) + "]";
+}
+
+// A group's identity (type, definition), its state (flags, sleep time, force, tether impulse),
+// its attachments, its particles (particle[I].position / velocity) and its broken constraints
+// (constraint[K].broken, K an index into the constraints the definition builds). Groups belong
+// to no one body: their lines have body 0 and name the group in the field, the form --inject
+// takes (inject.hpp).
+void diff_group(Collector& c, const sim_detail::ParticleGroup& a,
+                const sim_detail::ParticleGroup& b) {
+  const std::string name = group_name(a.id) + ".";
+  const char* section = "particles";
+  c.field(0, name + "type", a.type, b.type, section);
+  if (a.type == b.type && !(a.def == b.def))
+    c.add(section, 0, name + "definition", "(differs)", "(differs)");
+  c.field(0, name + "awake", a.awake, b.awake, section);
+  c.field(0, name + "sleep_time", a.sleep_time, b.sleep_time, section);
+  c.vec(0, name + "force", a.force, b.force, section);
+  c.field(0, name + "tether_impulse", a.tether_impulse, b.tether_impulse, section);
+  c.field(0, name + "attachment_count", std::uint64_t{a.attachments.size()},
+          std::uint64_t{b.attachments.size()}, section);
+  for (std::size_t k = 0; k < std::min(a.attachments.size(), b.attachments.size()); ++k) {
+    const std::string at = name + "attachment[" + std::to_string(k) + "].";
+    const sim_detail::Attachment& x = a.attachments[k];
+    const sim_detail::Attachment& y = b.attachments[k];
+    c.field(0, at + "particle", std::uint64_t{x.particle}, std::uint64_t{y.particle}, section);
+    c.field(0, at + "body", std::uint64_t{x.body}, std::uint64_t{y.body}, section);
+    c.vec(0, at + "local", x.local, y.local, section);
+  }
+  c.field(0, name + "particle_count", std::uint64_t{a.size()}, std::uint64_t{b.size()}, section);
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    const std::string p = name + "particle[" + std::to_string(i) + "].";
+    c.vec(0, p + "position", a.positions[i], b.positions[i], section);
+    c.vec(0, p + "velocity", a.velocities[i], b.velocities[i], section);
+  }
+  c.field(0, name + "broken_count", std::uint64_t{a.broken.size()}, std::uint64_t{b.broken.size()},
+          section);
+  // A merge of both ascending lists: a constraint broken on one side only.
+  std::size_t i = 0;
+  std::size_t j = 0;
+  while (i < a.broken.size() || j < b.broken.size()) {
+    if (j == b.broken.size() || (i < a.broken.size() && a.broken[i] < b.broken[j])) {
+      c.add(section, 0, name + "constraint[" + std::to_string(a.broken[i]) + "].broken", "true",
+            "false");
+      ++i;
+    } else if (i == a.broken.size() || b.broken[j] < a.broken[i]) {
+      c.add(section, 0, name + "constraint[" + std::to_string(b.broken[j]) + "].broken", "false",
+            "true");
+      ++j;
+    } else {
+      ++i;
+      ++j;
+    }
+  }
+}
+
+// A merge of both ascending group ID lists; a group on one side only is "present".
+void diff_particles(Collector& c, const Sides& w) {
+  const auto& ga = sim_detail::WorldAccess::of(*w.a).particle_groups;
+  const auto& gb = sim_detail::WorldAccess::of(*w.b).particle_groups;
+  std::size_t i = 0;
+  std::size_t j = 0;
+  while (i < ga.size() || j < gb.size()) {
+    if (j == gb.size() || (i < ga.size() && ga[i].id < gb[j].id)) {
+      c.add("particles", 0, group_name(ga[i].id) + ".present", "present", "absent");
+      ++i;
+    } else if (i == ga.size() || gb[j].id < ga[i].id) {
+      c.add("particles", 0, group_name(gb[j].id) + ".present", "absent", "present");
+      ++j;
+    } else {
+      diff_group(c, ga[i], gb[j]);
+      ++i;
+      ++j;
+    }
+  }
+}
+
 struct SectionDiffer {
   std::string_view name;
   void (*diff)(Collector& c, const Sides& w);
@@ -351,8 +441,9 @@ struct SectionDiffer {
 
 /// A new section of the World's state adds its differ here.
 constexpr SectionDiffer kDiffers[] = {
-    {"globals", diff_globals}, {"geometry", diff_geometry, false}, {"rng", diff_rng},
-    {"bodies", diff_bodies},   {"contacts", diff_contact_cache},   {"joints", diff_joints},
+    {"globals", diff_globals},     {"geometry", diff_geometry, false}, {"rng", diff_rng},
+    {"bodies", diff_bodies},       {"contacts", diff_contact_cache},   {"joints", diff_joints},
+    {"particles", diff_particles},
 };
 
 /// The hashes of a state's sections from its bytes (a state that may not restore here), and its

@@ -33,6 +33,9 @@ bool read_particles(std::span<const std::uint8_t> bytes, ByteReader& r, WorldSta
 /// The checks restore() makes of a joint against the bodies of `s` ("" when valid): what --inject
 /// must keep.
 [[nodiscard]] std::string check_joint_record(const WorldState& s, const JointState& j);
+/// The checks restore() makes of a particle group's state (attachments, particles, force, sleep
+/// time, tether impulse) against the bodies of `s` ("" when valid): what --inject must keep.
+[[nodiscard]] std::string check_particle_record(const WorldState& s, const ParticleGroup& g);
 /// The checks restore() makes of a body's motion fields ("" when valid): what --inject must keep.
 [[nodiscard]] std::string check_body_record(const BodyState& b);
 

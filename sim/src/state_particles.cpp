@@ -3,7 +3,9 @@
 //
 // A record is the ID step, the type, the definition (its type's fields, then the settings), the
 // flags byte (bit 0: awake), the sleep time, the accumulated force, the tether's impulse, the
-// attachments, every particle's position and velocity, and the broken constraints. The
+// attachments, the particle count (what the definition makes: a soft body's depends on its
+// shape's lattice, so a reader need not build it to find the record's end), every particle's
+// position and velocity, and the broken constraints. The
 // constraints themselves are not written: build_group makes them again from the definition, the
 // same on every machine. The reader checks every field as create_rope / create_cloth would, and
 // the state's own parts (attachments, positions, velocities, broken indices) against the limits
@@ -167,7 +169,9 @@ bool read_soft_body(ByteReader& r, SoftBodyDef& d) {
   return r.ok();
 }
 
-std::string check_record(const WorldState& s, const ParticleGroup& g) {
+}  // namespace
+
+std::string check_particle_record(const WorldState& s, const ParticleGroup& g) {
   const std::uint32_t n = static_cast<std::uint32_t>(g.size());
   for (std::size_t k = 0; k < g.attachments.size(); ++k) {
     const Attachment& a = g.attachments[k];
@@ -194,8 +198,6 @@ std::string check_record(const WorldState& s, const ParticleGroup& g) {
   return {};
 }
 
-}  // namespace
-
 void write_particles(const WorldState& s, ByteWriter& w) {
   w.u32(s.next_particle_group_id);
   w.var(s.particle_groups.size());
@@ -215,6 +217,7 @@ void write_particles(const WorldState& s, ByteWriter& w) {
       w.var(a.body);
       w.vec3(a.local);
     }
+    w.var(g.size());
     for (std::size_t i = 0; i < g.size(); ++i) {
       w.vec3(g.positions[i]);
       w.vec3(g.velocities[i]);
@@ -317,6 +320,12 @@ bool read_particles(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
       g.attachments.push_back(att);
     }
     if (!r.ok()) break;
+    const std::size_t particles_at = r.offset();
+    const std::uint64_t particles = r.var("particle count");
+    if (!r.ok()) break;
+    if (particles != n)
+      return failed_at(particles_at, name + "particle count " + std::to_string(particles) +
+                                         ", but its definition makes " + std::to_string(n));
     if (std::size_t{n} * 48 > r.remaining())
       return failed_at(r.offset(),
                        name + std::to_string(n) + " particles exceed what the data can hold");
@@ -342,7 +351,7 @@ bool read_particles(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
       g.broken.push_back(last);
     }
     if (!r.ok()) break;
-    if (auto e = check_record(s, g); !e.empty()) return failed_at(at, name + e);
+    if (auto e = check_particle_record(s, g); !e.empty()) return failed_at(at, name + e);
     // The constraints, from the definition; the broken ones must be among them.
     build_group(s, g);
     if (!g.broken.empty() && g.broken.back() >= g.links.size())

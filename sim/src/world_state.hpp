@@ -143,6 +143,13 @@ struct WorldState {
   [[nodiscard]] std::size_t particle_total() const noexcept;
 };
 
+/// A World's state, for the library's own code outside World's members that reads what the
+/// public API does not show (state_diff.cpp: a particle group's sleep time, force, tether impulse
+/// and broken constraints).
+struct WorldAccess {
+  [[nodiscard]] static const WorldState& of(const World& w) noexcept { return *w.s_; }
+};
+
 /// Definition checks shared by World::create, create_body and restore. Empty string: valid.
 [[nodiscard]] std::string check_world_def(const WorldDef& def);
 [[nodiscard]] std::string check_shape(const GeometryTable& geometries, const Shape& shape,

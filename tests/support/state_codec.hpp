@@ -1,15 +1,16 @@
-// An independent codec of the v5 world-state layout (docs/STATE.md), for the world-state tests
+// An independent codec of the v6 world-state layout (docs/STATE.md), for the world-state tests
 // (support/state_helpers.hpp includes it).
 //
 // Written from docs/STATE.md, not from state_io.cpp, so that the two can disagree. In brief:
-//   "DSIM" u32 version=5 | var section count (6) | six sections, each: var name length, name,
+//   "DSIM" u32 version=6 | var section count (7) | seven sections, each: var name length, name,
 //   var section version (bodies 2, the others 1), u32 payload length, payload. The payloads, in
 //   this order: globals: u64 frame | u32 next ID | definition (fixed width);  rng: 4 x u64;
 //   geometry: var count, then per geometry u8 type (1 convex hull, 2 triangle mesh, 3 heightfield,
 //   4 compound), u64 content hash;
 //   bodies: u32 property-set count, sets in first-use order | u32 body count, bodies ascending by
 //   ID;  contacts: u32 contact count, contacts ascending by (a, b);  joints: u32 next joint ID,
-//   u32 joint count, joints ascending by ID.
+//   u32 joint count, joints ascending by ID;  particles: u32 next particle group ID, var group
+//   count, groups ascending by ID (support/state_codec_particles.hpp).
 // `var` is canonical LEB128 (at most 5 bytes for a 32-bit field, 10 for a 64-bit one); `vfixed` a
 // var of the zigzag raw value. A set: type u8, shape (type u8, then its vfixed sizes, or a convex
 // hull's, mesh's or heightfield's geometry ID var), mass, inertia, centre of mass (vec3), inertia
@@ -45,17 +46,19 @@
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/world.hpp>
 
+#include "state_codec_particles.hpp"
+
 namespace detsim::state_test {
 
 using Bytes = std::vector<std::uint8_t>;
 
 inline constexpr std::uint32_t kStateMagic = 0x4D495344U;
-inline constexpr std::uint32_t kStateVersion = 5;
+inline constexpr std::uint32_t kStateVersion = 6;
 /// A World's sections, in their order, and their versions.
-inline constexpr const char* kSectionNames[] = {"globals", "rng",      "geometry",
-                                                "bodies",  "contacts", "joints"};
-inline constexpr std::size_t kSectionCount = 6;
-inline constexpr std::uint32_t kSectionVersions[] = {1, 1, 1, 2, 2, 1};
+inline constexpr const char* kSectionNames[] = {"globals",  "rng",    "geometry", "bodies",
+                                                "contacts", "joints", "particles"};
+inline constexpr std::size_t kSectionCount = 7;
+inline constexpr std::uint32_t kSectionVersions[] = {1, 1, 1, 2, 2, 1, 1};
 // Each section's index in the lists above.
 inline constexpr std::size_t kGlobals = 0;
 inline constexpr std::size_t kRngSection = 1;
@@ -63,6 +66,7 @@ inline constexpr std::size_t kGeometry = 2;
 inline constexpr std::size_t kBodies = 3;
 inline constexpr std::size_t kContacts = 4;
 inline constexpr std::size_t kJoints = 5;
+inline constexpr std::size_t kParticles = 6;
 
 // Body flags.
 inline constexpr std::uint8_t kAwake = 1;
@@ -307,6 +311,7 @@ struct Decoded {
   std::vector<DecodedContact> contacts;
   std::uint32_t next_joint_id = 1;
   std::vector<DecodedJoint> joints;
+  DecodedParticles particles;  // next group ID, groups (and their offsets)
   // Offsets, filled by decode(): of each section's record (its name length), its u32 payload
   // length and its payload, in kSectionNames' order; then of the payloads' fields.
   std::array<std::size_t, kSectionCount> section_at{};
@@ -335,6 +340,7 @@ class StateReader {
   [[nodiscard]] const std::string& error() const { return error_; }
   [[nodiscard]] std::size_t at() const { return at_; }
   [[nodiscard]] bool at_end() const { return at_ == bytes_.size(); }
+  [[nodiscard]] std::size_t remaining() const { return bytes_.size() - at_; }
 
   /// Records the first error only.
   void fail(std::size_t at, const std::string& what) {
@@ -648,7 +654,7 @@ inline void read_joint(StateReader& r, Decoded& d, std::uint64_t& previous_id) {
   d.joints.push_back(j);
 }
 
-/// Decodes a whole v5 state; `ok` is false and `error` names the first problem otherwise (what was
+/// Decodes a whole v6 state; `ok` is false and `error` names the first problem otherwise (what was
 /// decoded up to there is kept).
 inline Decoded decode(std::span<const std::uint8_t> bytes) {
   Decoded d;
@@ -659,7 +665,7 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
   if (r.ok() && d.version != kStateVersion) r.fail(4, "version");
   const std::size_t count_at = r.at();
   const std::uint64_t sections = r.var("section count", 64);
-  if (r.ok() && sections != kSectionCount) r.fail(count_at, "section count: not 6");
+  if (r.ok() && sections != kSectionCount) r.fail(count_at, "section count: not 7");
   for (std::size_t i = 0; i < kSectionCount && r.ok(); ++i) {
     // The section's record: its name, its version, its payload's length; the payload must end
     // exactly where the length says.
@@ -734,6 +740,9 @@ inline Decoded decode(std::span<const std::uint8_t> bytes) {
           read_joint(r, d, previous_id);
         break;
       }
+      case kParticles:
+        read_particles_section(r, d.particles);
+        break;
       default: {
         d.contact_count_at = r.at();
         const std::uint32_t contact_count = r.u32("contact count");
@@ -881,7 +890,7 @@ inline void write_joint(StateWriter& w, const DecodedJoint& j) {
   if ((j.flags & kJointHasUserData) != 0) w.var(j.user_data);
 }
 
-/// The v5 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
+/// The v6 bytes of `d`'s wire fields (the offsets and derived IDs are ignored; the counts are the
 /// sizes of the vectors, the section lengths those of the payloads written).
 inline Bytes encode(const Decoded& d) {
   StateWriter payloads[kSectionCount];
@@ -924,6 +933,7 @@ inline Bytes encode(const Decoded& d) {
   payloads[kJoints].u32(static_cast<std::uint32_t>(d.joints.size()));
   for (const DecodedJoint& j : d.joints)
     write_joint(payloads[kJoints], j);
+  write_particles_section(payloads[kParticles], d.particles);
 
   StateWriter w;
   w.u32(d.magic);

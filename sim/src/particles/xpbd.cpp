@@ -396,11 +396,11 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
           sc.volume_compliance;
       if (denominator == Fixed::zero()) continue;
       const Fixed lambda = -violation / denominator;
-      const Fixed step = w * lambda;
-      g.positions[c[0]] += g0 * step;
-      g.positions[c[1]] += g1 * step;
-      g.positions[c[2]] += g2 * step;
-      g.positions[c[3]] += g3 * step;
+      const Fixed move = w * lambda;
+      g.positions[c[0]] += g0 * move;
+      g.positions[c[1]] += g1 * move;
+      g.positions[c[2]] += g2 * move;
+      g.positions[c[3]] += g3 * move;
     }
 
     // Long-range tethers: only pull, only the free particle moves.

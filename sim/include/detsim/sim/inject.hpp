@@ -24,9 +24,15 @@
 //                         is contact[OTHER/0/0]. Diff prints contacts in this form.
 //   joint[J].FIELD        BODY 0; FIELD a field of joint J as diff names it (anchor.x,
 //                         linear_impulse.y, motor_speed, broken, ...): DELTA as for its kind
+//   particle_group[G].particle[I].position.x|y|z  particle_group[G].particle[I].velocity.x|y|z
+//   particle_group[G].force.x|y|z  particle_group[G].sleep_time  particle_group[G].tether_impulse
+//                         BODY 0; particle I (0, 1, ...) of particle group G, or the group's own
+//                         field; DELTA: a decimal, added
+//   particle_group[G].awake
+//                         BODY 0; DELTA: 1 toggles the flag
 // Results that restore() would refuse (an orientation no longer a unit quaternion, a negative
-// sleep time, a static body awake, an all-zero RNG state, a joint's axis no longer a unit vector)
-// are refused, and the world is unchanged.
+// sleep time, a static body awake, an all-zero RNG state, a joint's axis no longer a unit vector,
+// a particle beyond +-2^30 m or m/s) are refused, and the world is unchanged.
 #pragma once
 
 #include <cstdint>
@@ -42,8 +48,8 @@ namespace detsim {
 
 struct Injection {
   std::uint64_t frame = 0;  ///< the state frame changed (1 or later: frame 0 is never stepped into)
-  std::uint32_t body = 0;   ///< the body; for contact fields either body of the pair; 0 for rng
-                            ///< and joint fields
+  std::uint32_t body = 0;   ///< the body; for contact fields either body of the pair; 0 for rng,
+                            ///< joint and particle group fields
   std::string field;        ///< as written, e.g. "position.y"
   std::string delta;        ///< as written, e.g. "0.001"
 

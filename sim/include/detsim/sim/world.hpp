@@ -30,7 +30,8 @@ namespace detsim {
 
 namespace sim_detail {
 struct WorldState;
-}
+struct WorldAccess;
+}  // namespace sim_detail
 struct Injection;
 
 /// A body's complete state as the world holds it (a copy: it does not follow later changes).
@@ -378,6 +379,7 @@ class World {
 
  private:
   friend Status apply_injection(World& world, const Injection& injection);
+  friend struct sim_detail::WorldAccess;  // the library's own tools (state_diff.cpp)
   explicit World(std::unique_ptr<sim_detail::WorldState> state) noexcept;
   std::unique_ptr<sim_detail::WorldState> s_;
 };
