@@ -553,6 +553,17 @@ TEST(ParticleState, BisectNamesAnInjectedParticlesField) {
   EXPECT_EQ(r->diffs[0].body, 0U);
   EXPECT_EQ(r->diffs[0].field, "particle_group[2].particle[20].position.x");
   EXPECT_EQ(r->diffs_omitted, 0U);
+  // The report's scene draws every particle (under 1000 a group) as a ball of its radius, after
+  // the bodies, titled "particle" on the page.
+  std::size_t drawn = 0;
+  for (const replay::ScenePose& p : r->scene_a)
+    drawn += p.id == 0 && p.shape.type == ShapeType::sphere ? 1U : 0U;
+  std::size_t particles = 0;
+  const World scene = particle_scene();
+  for (const ParticleGroupId id : scene.particle_group_ids())
+    particles += scene.particle_group_stats(id).value().particle_count;
+  EXPECT_EQ(drawn, particles);
+  EXPECT_NE(replay::bisect_html(*r).find("<title>particle ("), std::string::npos);
 }
 
 }  // namespace

@@ -262,6 +262,19 @@ std::vector<ScenePose> scene_of(const World& geometry, const State& state,
     if (auto outline = w.body_outline(id)) pose.outline = std::move(outline).value();
     out.push_back(std::move(pose));
   }
+  // Particles as balls of their radius (body ID 0, never labelled): at most 1000 a group, every
+  // k-th particle of a bigger one, so that a 10k-particle cloth still makes a readable page.
+  for (const ParticleGroupId id : w.particle_group_ids()) {
+    const ParticleGroupStats st = w.particle_group_stats(id).value();
+    const std::vector<Vec3> points = w.particle_positions(id).value();
+    const std::size_t every = points.size() / 1000 + 1;
+    for (std::size_t i = 0; i < points.size(); i += every) {
+      ScenePose pose;
+      pose.shape = Shape::sphere(st.radius);
+      pose.position = points[i];
+      out.push_back(std::move(pose));
+    }
+  }
   return out;
 }
 

@@ -231,8 +231,9 @@ std::string body_svg(const ScenePose& body, const Footprint& f) {
                      : body.type == BodyType::kinematic ? "k"
                                                         : "d";
   const std::string cls = std::string("class=\"") + type + (body.differs ? " x\"" : "\"");
-  const std::string title = "<title>body " + std::to_string(body.id) + " (" +
-                            dec3(body.position.x) + ", " + dec3(body.position.z) + ")</title>";
+  const std::string what = body.id == 0 ? "particle" : "body " + std::to_string(body.id);
+  const std::string title =
+      "<title>" + what + " (" + dec3(body.position.x) + ", " + dec3(body.position.z) + ")</title>";
   return footprint_svg(cls, title, f);
 }
 

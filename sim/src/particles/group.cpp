@@ -534,6 +534,7 @@ ParticleGroupStats group_stats(const ParticleGroup& g) {
   st.particle_count = static_cast<std::uint32_t>(g.size());
   st.constraint_count = static_cast<std::uint32_t>(g.links.size());
   st.broken_count = static_cast<std::uint32_t>(g.broken.size());
+  st.radius = g.radius;
   st.awake = g.awake;
   Fixed v2_sum;
   Fixed max_v2;

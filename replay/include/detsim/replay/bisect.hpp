@@ -112,7 +112,8 @@ struct BisectResult {
 
   /// Agreement over frames 0 .. max(frames_a, frames_b), in order, adjacent spans merged.
   std::vector<AgreementSpan> timeline;
-  /// Both sides' bodies at diff_frame (empty without a diff).
+  /// Both sides' bodies at diff_frame, then their particles (body ID 0; at most 1000 a group)
+  /// (empty without a diff).
   std::vector<ScenePose> scene_a;
   std::vector<ScenePose> scene_b;
 };

@@ -137,6 +137,7 @@ struct ParticleGroupStats {
   std::uint32_t particle_count = 0;
   std::uint32_t constraint_count = 0;  ///< distance constraints, broken ones included
   std::uint32_t broken_count = 0;      ///< constraints torn (cloth with tear_strain)
+  Fixed radius{};                      ///< m, each particle's, against bodies (what a viewer draws)
   Fixed kinetic_energy{};              ///< J, sum of m v^2 / 2 over the particles
   /// The largest relative stretch of an unbroken edge (|d| / rest - 1, 0 when none is stretched):
   /// how well the constraints hold.
