@@ -186,6 +186,29 @@ TEST(ParticleApi, SoftBodiesFillTheirShape) {
   EXPECT_LT(sh.particle_count, 288U);
 }
 
+// A ray down onto a rope lying along x meets the particle under it, on its ball's top; the
+// bodies' raycasts do not see particles, and a filter that leaves the group's layer out misses.
+TEST(ParticleApi, RaysMeetParticlesAsBalls) {
+  WorldDef def;
+  def.gravity = {};
+  World w = make_world(def);
+  RopeDef r = a_rope();  // particles every 1/8 m along x at y = 2, radius 0.05
+  const ParticleGroupId id = w.create_rope(r).value();
+  const auto hit = w.raycast_particles({0.25_fx, 3_fx, 0_fx}, {0_fx, -2_fx, 0_fx});
+  ASSERT_TRUE(hit.has_value());
+  EXPECT_EQ(hit->group, id);
+  EXPECT_EQ(hit->particle, 2U);
+  EXPECT_NEAR(hit->point.y.to_double(), 2.05, 1e-6);
+  EXPECT_NEAR(hit->fraction.to_double(), 0.475, 1e-6);  // (3 - 2.05) / 2
+  EXPECT_NEAR(hit->normal.y.to_double(), 1.0, 1e-6);
+  EXPECT_FALSE(w.raycast_closest({0.25_fx, 3_fx, 0_fx}, {0_fx, -2_fx, 0_fx}).has_value());
+  QueryFilter other;
+  other.layer = 2;
+  other.mask = 2;
+  EXPECT_FALSE(w.raycast_particles({0.25_fx, 3_fx, 0_fx}, {0_fx, -2_fx, 0_fx}, other));
+  EXPECT_FALSE(w.raycast_particles({5_fx, 3_fx, 0_fx}, {0_fx, -2_fx, 0_fx}));
+}
+
 TEST(ParticleApi, TheWorldsParticleLimitHolds) {
   World w = make_world();
   ClothDef d = a_cloth();

@@ -206,6 +206,18 @@ TEST(ParticleState, RestoredStepsLikeTheUninterruptedRun) {
 
 // ---- Hashes ----
 
+// A group's own hash changes when (and only when) that group changes.
+TEST(ParticleState, EachGroupHasItsOwnHash) {
+  World w = stepped_scene();
+  const std::uint64_t rope = w.particle_group_hash(kRopeId).value();
+  const std::uint64_t cloth = w.particle_group_hash(kClothId).value();
+  EXPECT_NE(rope, cloth);
+  EXPECT_FALSE(w.particle_group_hash(ParticleGroupId{99}).ok());
+  ASSERT_TRUE(w.apply_particle_force(kRopeId, {1_fx, 0_fx, 0_fx}).ok());
+  EXPECT_NE(w.particle_group_hash(kRopeId).value(), rope);
+  EXPECT_EQ(w.particle_group_hash(kClothId).value(), cloth);
+}
+
 TEST(ParticleState, TheParticlesSectionHasItsOwnHash) {
   const World w = stepped_scene();
   const Bytes bytes = w.save();

@@ -115,6 +115,30 @@ std::optional<RayHit> World::raycast_closest(Vec3 origin, Vec3 translation,
   return best;
 }
 
+std::optional<ParticleRayHit> World::raycast_particles(Vec3 origin, Vec3 translation,
+                                                       const QueryFilter& filter) const {
+  // Each particle is tested as a ball body would be (the same cull, containment and exact test),
+  // in ascending group and particle order; a later particle replaces the best only with a
+  // strictly lower fraction.
+  const Ray ray = make_ray(origin, translation);
+  std::optional<ParticleRayHit> best;
+  for (const sim_detail::ParticleGroup& g : s_->particle_groups) {
+    BodyState ball;
+    ball.shape = Shape::sphere(g.radius);
+    ball.layer = g.settings().layer;
+    ball.mask = g.settings().mask;
+    if (!passes(ball, filter)) continue;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      ball.position = g.positions[i];
+      const auto hit = cast_body(*s_, ball, ray);
+      if (hit && (!best || hit->fraction < best->fraction))
+        best = ParticleRayHit{g.id, static_cast<std::uint32_t>(i), hit->point, hit->normal,
+                              hit->fraction};
+    }
+  }
+  return best;
+}
+
 std::vector<RayHit> World::raycast_all(Vec3 origin, Vec3 translation,
                                        const QueryFilter& filter) const {
   const Ray ray = make_ray(origin, translation);

@@ -504,4 +504,12 @@ Expected<std::uint64_t> World::body_hash(BodyId id) const {
   return hash64(w.bytes());
 }
 
+Expected<std::uint64_t> World::particle_group_hash(ParticleGroupId id) const {
+  const std::ptrdiff_t k = s_->find_group(id.value);
+  if (k < 0) return Status::error("no particle group with ID " + std::to_string(id.value));
+  ByteWriter w;
+  sim_detail::write_particle_group(s_->particle_groups[static_cast<std::size_t>(k)], 0, w);
+  return hash64(w.bytes());
+}
+
 }  // namespace detsim

@@ -28,6 +28,8 @@ bool read_joints(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState&
                  std::string& error);
 /// The "particles" payload (state_particles.cpp), and its reader (bodies already read).
 void write_particles(const WorldState& s, ByteWriter& w);
+/// One group's record (its ID step from `previous_id`), as write_particles writes it.
+void write_particle_group(const ParticleGroup& g, std::uint32_t previous_id, ByteWriter& w);
 bool read_particles(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState& s,
                     std::string& error);
 /// The checks restore() makes of a joint against the bodies of `s` ("" when valid): what --inject

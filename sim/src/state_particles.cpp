@@ -198,36 +198,40 @@ std::string check_particle_record(const WorldState& s, const ParticleGroup& g) {
   return {};
 }
 
+void write_particle_group(const ParticleGroup& g, std::uint32_t previous_id, ByteWriter& w) {
+  w.var(g.id.value - previous_id);
+  w.u8(static_cast<std::uint8_t>(g.type));
+  std::visit([&](const auto& def) { write_def(def, w); }, g.def);
+  w.u8(g.awake ? kAwake : 0);
+  w.fixed(g.sleep_time);
+  w.vec3(g.force);
+  w.fixed(g.tether_impulse);
+  w.var(g.attachments.size());
+  for (const Attachment& a : g.attachments) {
+    w.var(a.particle);
+    w.var(a.body);
+    w.vec3(a.local);
+  }
+  w.var(g.size());
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    w.vec3(g.positions[i]);
+    w.vec3(g.velocities[i]);
+  }
+  w.var(g.broken.size());
+  std::uint32_t last = 0;
+  for (std::size_t k = 0; k < g.broken.size(); ++k) {
+    w.var(k == 0 ? g.broken[k] : g.broken[k] - last);
+    last = g.broken[k];
+  }
+}
+
 void write_particles(const WorldState& s, ByteWriter& w) {
   w.u32(s.next_particle_group_id);
   w.var(s.particle_groups.size());
   std::uint32_t previous = 0;
   for (const ParticleGroup& g : s.particle_groups) {
-    w.var(g.id.value - previous);
+    write_particle_group(g, previous, w);
     previous = g.id.value;
-    w.u8(static_cast<std::uint8_t>(g.type));
-    std::visit([&](const auto& def) { write_def(def, w); }, g.def);
-    w.u8(g.awake ? kAwake : 0);
-    w.fixed(g.sleep_time);
-    w.vec3(g.force);
-    w.fixed(g.tether_impulse);
-    w.var(g.attachments.size());
-    for (const Attachment& a : g.attachments) {
-      w.var(a.particle);
-      w.var(a.body);
-      w.vec3(a.local);
-    }
-    w.var(g.size());
-    for (std::size_t i = 0; i < g.size(); ++i) {
-      w.vec3(g.positions[i]);
-      w.vec3(g.velocities[i]);
-    }
-    w.var(g.broken.size());
-    std::uint32_t last = 0;
-    for (std::size_t k = 0; k < g.broken.size(); ++k) {
-      w.var(k == 0 ? g.broken[k] : g.broken[k] - last);
-      last = g.broken[k];
-    }
   }
 }
 

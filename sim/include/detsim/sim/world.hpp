@@ -139,6 +139,17 @@ struct RayHit {
   friend constexpr bool operator==(const RayHit&, const RayHit&) noexcept = default;
 };
 
+/// Where a ray met a particle (World::raycast_particles).
+struct ParticleRayHit {
+  ParticleGroupId group{};
+  std::uint32_t particle = 0;
+  Vec3 point{};  ///< world space
+  Vec3 normal{};  ///< unit, against the ray (zero if it starts inside the particle's ball)
+  Fixed fraction{};
+
+  friend constexpr bool operator==(const ParticleRayHit&, const ParticleRayHit&) noexcept = default;
+};
+
 /// A change of touch between two bodies during a step. For a pair of solid bodies, "touching" means
 /// that their surfaces are within the world's speculative distance (the contact exists for the
 /// solver); for a pair with a sensor, that the shapes overlap.
@@ -348,6 +359,12 @@ class World {
   /// Every body the ray meets, one hit per body (its first), by ascending fraction then ID.
   [[nodiscard]] std::vector<RayHit> raycast_all(Vec3 origin, Vec3 translation,
                                                 const QueryFilter& filter = {}) const;
+  /// The first particle the ray meets (each a ball of its group's radius; the lowest fraction,
+  /// ties to the lower group ID, then the lower index), or nothing: the bodies' raycasts do not
+  /// see particles, this one sees only them. Groups are filtered by their settings' layer and
+  /// mask like bodies. The same precision and containment rules as raycast_closest.
+  [[nodiscard]] std::optional<ParticleRayHit> raycast_particles(
+      Vec3 origin, Vec3 translation, const QueryFilter& filter = {}) const;
   /// The IDs, ascending, of the bodies whose shapes overlap `shape` placed at `position` with
   /// `orientation` (a unit quaternion; touching surfaces count as overlapping). A shape that a
   /// dynamic body could not have (a plane, a non-positive size, ...) or an orientation that
@@ -367,6 +384,10 @@ class World {
   [[nodiscard]] StateHashes hashes() const;
   /// save() and hashes() from one encoding: the bytes go to `bytes` (replacing its contents).
   StateHashes save(std::vector<std::uint8_t>& bytes) const;
+  /// XXH3-64 of one particle group's record in the "particles" section (as if it were the only
+  /// group: its ID step counted from 0), or an error for an unknown ID: what a peer compares to
+  /// find which rope or sheet diverged.
+  [[nodiscard]] Expected<std::uint64_t> particle_group_hash(ParticleGroupId id) const;
   /// XXH3-64 of one body's canonical bytes, or an error for an unknown ID.
   [[nodiscard]] Expected<std::uint64_t> body_hash(BodyId id) const;
   /// Checks the world's invariants (docs/ARCHITECTURE.md): body IDs ascending and below the next
