@@ -301,6 +301,7 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
     return Fixed::zero();
   }();
   const std::vector<bool>& fixed_particle = sc.fixed;
+  const Fixed push_step = s_.def.contact_push_max * h;
 
   // Where each attached particle's body puts it now (the bodies moved in this sub-step); the
   // small steps move it there in equal parts.
@@ -337,7 +338,7 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
     for (std::uint32_t i = 0; i < g.size(); ++i) {
       sc.previous[i] = g.positions[i];
       if (fixed_particle[i]) continue;
-      g.velocities[i] = (g.velocities[i] + kick) * drag;
+      g.velocities[i] = limit_speed((g.velocities[i] + kick) * drag, s_.def.max_linear_speed);
       g.positions[i] += g.velocities[i] * h;
     }
     const Fixed part = Fixed::from_int(static_cast<std::int32_t>(step + 1)) /
@@ -420,8 +421,15 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
     for (const ParticleContact& c : sc.contacts) {
       if (fixed_particle[c.particle]) continue;
       Vec3& x = g.positions[c.particle];
-      const Fixed depth = g.radius - dot(x - c.point, c.normal);
+      Fixed depth = g.radius - dot(x - c.point, c.normal);
       if (depth <= Fixed::zero()) continue;
+      // What the small step's own motion pushed in is undone at once; an overlap the particle
+      // already had (created inside a body, or pushed in by its neighbours) comes out at most at
+      // the bodies' contact_push_max, so that a body made inside another is not torn apart by
+      // particles leaving through different faces.
+      const Fixed before_step = g.radius - dot(sc.previous[c.particle] - c.point, c.normal);
+      if (before_step > Fixed::zero())
+        depth = min(depth, max(depth - before_step, Fixed::zero()) + push_step);
       const Vec3 before = x;
       x += c.normal * depth;
       const BodyState& b = s_.bodies[c.body];
@@ -444,7 +452,8 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
     // Velocities from the positions.
     for (std::uint32_t i = 0; i < g.size(); ++i) {
       if (is_pinned(g, i)) continue;
-      g.velocities[i] = (g.positions[i] - sc.previous[i]) * inv_h;
+      g.velocities[i] =
+          limit_speed((g.positions[i] - sc.previous[i]) * inv_h, s_.def.max_linear_speed);
     }
   }
 }

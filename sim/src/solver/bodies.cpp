@@ -119,6 +119,10 @@ void SolverBodies::integrate_velocities() {
 }
 
 // The speed limits hold for every velocity a body moves with and keeps, not only after forces.
+Vec3 limit_speed(Vec3 v, Fixed limit) {
+  return clamp_speed(v, limit);
+}
+
 void SolverBodies::clamp_speeds() {
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
     if (!awake_dynamic(s.bodies[i])) continue;

@@ -16,6 +16,10 @@
 
 namespace detsim::sim_detail {
 
+/// v, or v scaled down to length `limit` when it is longer (the bodies' speed limit, for the
+/// particles' velocities too).
+[[nodiscard]] Vec3 limit_speed(Vec3 v, Fixed limit);
+
 /// Per-step solver data of every body, and the body stages of a sub-step.
 struct SolverBodies {
   /// Loads every body's velocities and the step's constants (h = dt / substeps).
