@@ -2,7 +2,9 @@
 // (create_body with any shape, size, mass, density, velocity and orientation, destroy_body,
 // set_type, set_transform, set_*_velocity, the forces and impulses, wake, step, save, restore,
 // create_joint with any type, bodies, anchor, axis, limits, motor, lengths, spring and break
-// thresholds, destroy_joint, set_joint_motor).
+// thresholds, destroy_joint, set_joint_motor, the geometry registrations, and the particle groups:
+// create_rope, create_cloth, create_soft_body with any values, apply_particle_force,
+// destroy_particle_group, raycast_particles).
 //
 // Properties checked beyond the sanitizers' (no crash, no undefined behaviour, no leak):
 // - a refused call changes nothing: the world's saved bytes are those from before the call;
@@ -13,6 +15,7 @@
 //   docs/DETERMINISM.md).
 // Work is bounded per input (at most 64 bodies, 64 joints, 16 steps, and a budget of solver passes)
 // so that one input runs in milliseconds even under the sanitizers.
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -24,6 +27,7 @@
 #include <vector>
 
 #include <detsim/sim/joint.hpp>
+#include <detsim/sim/particles.hpp>
 #include <detsim/sim/world.hpp>
 
 namespace {
@@ -45,7 +49,8 @@ constexpr std::size_t kMaxJoints = 64;
 constexpr int kMaxSteps = 16;
 constexpr int kMaxCalls = 256;
 constexpr std::size_t kMaxGeometries = 16;
-constexpr int kOps = 24;  // the calls' opcodes, op % kOps
+constexpr int kOps = 28;                    // the calls' opcodes, op % kOps
+constexpr std::size_t kMaxParticles = 600;  // what the groups of one input may hold in all
 // Sub-steps x iterations x (bodies + joints + 1), summed over the steps: what the steps of one
 // input may cost in total.
 constexpr std::uint64_t kStepBudget = 40000;
@@ -336,6 +341,87 @@ detsim::JointDef joint_def(Input& in, const World& world) {
 }
 
 /// An existing joint most of the time (by index), else any ID (usually unknown).
+// ---- Particle groups: any values, but sizes kept small (a count byte, with the refused 0 and 1
+// among them) so that one input stays fast.
+
+std::size_t particles_in(const World& world) {
+  std::size_t n = 0;
+  for (const detsim::ParticleGroupId id : world.particle_group_ids())
+    n += world.particle_group_stats(id).value().particle_count;
+  return n;
+}
+
+detsim::ParticleSettings particle_settings(Input& in) {
+  detsim::ParticleSettings p;
+  p.friction = in.fixed();
+  p.damping = in.fixed();
+  p.substeps = in.byte() % 18;  // 0 and 17 are refused
+  p.layer = in.u32();
+  p.mask = in.u32();
+  return p;
+}
+
+detsim::Status create_particles(Input& in, World& world, int kind) {
+  const std::size_t room = kMaxParticles - std::min(kMaxParticles, particles_in(world));
+  if (kind == 0) {
+    detsim::RopeDef r;
+    r.start = in.vec3();
+    r.end = in.vec3();
+    r.segments = in.byte() % 40;
+    r.length = in.fixed();
+    r.mass = in.fixed();
+    r.radius = in.fixed();
+    r.compliance = in.fixed();
+    r.bending_compliance = in.fixed();
+    r.attach_start = body_id(in, world);
+    r.attach_end = body_id(in, world);
+    r.settings = particle_settings(in);
+    if (r.segments + 1U > room) return detsim::Status::success();
+    auto id = world.create_rope(r);
+    return id ? detsim::Status::success() : id.status();
+  }
+  if (kind == 1) {
+    detsim::ClothDef c;
+    c.origin = in.vec3();
+    c.axis_u = in.vec3();
+    c.axis_v = in.vec3();
+    c.columns = in.byte() % 12;
+    c.rows = in.byte() % 12;
+    c.mass = in.fixed();
+    c.thickness = in.fixed();
+    c.stretch_compliance = in.fixed();
+    c.bend_compliance = in.fixed();
+    for (std::uint8_t k = in.byte() % 4; k > 0; --k)
+      c.pinned.push_back(in.byte());
+    if (in.byte() % 2 == 0) c.attach_body = body_id(in, world);
+    c.tear_strain = in.fixed();
+    c.settings = particle_settings(in);
+    if (std::size_t{c.columns} * c.rows > room) return detsim::Status::success();
+    auto id = world.create_cloth(c);
+    return id ? detsim::Status::success() : id.status();
+  }
+  detsim::SoftBodyDef b;
+  b.shape = shape(in);
+  b.position = in.vec3();
+  b.orientation = in.quat();
+  b.resolution = in.byte() % 10;
+  b.mass = in.fixed();
+  b.edge_compliance = in.fixed();
+  b.volume_compliance = in.fixed();
+  b.settings = particle_settings(in);
+  if (std::size_t{b.resolution} * b.resolution * b.resolution > room)
+    return detsim::Status::success();
+  auto id = world.create_soft_body(b);
+  return id ? detsim::Status::success() : id.status();
+}
+
+detsim::ParticleGroupId group_id(Input& in, const World& world) {
+  const std::vector<detsim::ParticleGroupId> ids = world.particle_group_ids();
+  const std::uint8_t pick = in.byte();
+  if (ids.empty() || pick == 255) return detsim::ParticleGroupId{pick};  // unknown IDs too
+  return ids[pick % ids.size()];
+}
+
 detsim::JointId joint_id(Input& in, const World& world) {
   const std::uint8_t pick = in.byte();
   const std::vector<detsim::JointId> ids = world.joint_ids();
@@ -483,7 +569,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       case 13:
       case 14: {
-        const std::uint64_t cost = step_cost * (world.body_count() + world.joint_ids().size() + 1);
+        const std::uint64_t cost =
+            step_cost * (world.body_count() + world.joint_ids().size() + particles_in(world) + 1);
         if (steps >= kMaxSteps || spent + cost > kStepBudget) break;
         ++steps;
         spent += cost;
@@ -525,6 +612,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                  : kind == 21 ? create_mesh(in, world)
                  : kind == 22 ? create_heightfield(in, world)
                               : create_compound(in, world);
+        break;
+      }
+      case 24:
+        status = create_particles(in, world, in.byte() % 3);
+        break;
+      case 25: {
+        const detsim::ParticleGroupId id = group_id(in, world);
+        status = world.apply_particle_force(id, in.vec3());
+        break;
+      }
+      case 26:
+        status = world.destroy_particle_group(group_id(in, world));
+        break;
+      case 27: {
+        const Vec3 origin = in.vec3();
+        (void)world.raycast_particles(origin, in.vec3());
         break;
       }
       default: {

@@ -49,6 +49,15 @@ inline std::atomic<std::size_t> g_largest_allocation{0};
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }
+// The nothrow form too (std::stable_sort's buffer comes from it and goes back through the plain
+// delete above): left to the runtime's, ASan reports a new/free mismatch.
+[[gnu::noinline]] void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+  try {
+    return ::operator new(size);
+  } catch (...) {
+    return nullptr;
+  }
+}
 [[gnu::noinline]] void operator delete(void* p) noexcept {
   std::free(p);
 }

@@ -218,21 +218,35 @@ void ParticleStepper::prepare_group(ParticleGroup& g, GroupScratch& sc) {
   const Shape ball = Shape::sphere(g.radius);
   const Fixed friction = g.settings().friction;
   std::vector<SubManifold> found;
+  // What each near body contributes to every test, computed once.
+  struct Near {
+    std::uint32_t index;
+    const Geometry* geometry;
+    Fixed speed;
+    Mat3 to_local;
+    Fixed friction;
+  };
+  std::vector<Near> near;
+  near.reserve(g.near_bodies.size());
   for (std::uint32_t bi : g.near_bodies) {
     const BodyState& b = s_.bodies[bi];
     const Derived& d = s_.derived[bi];
-    const Geometry* geometry = s_.geometry(b.shape);
-    const Fixed body_speed = length(b.linear_velocity) + d.rim_speed;
-    const Mat3 to_local = transpose(d.pose.rotation);
-    const Fixed mix = sqrt(friction * b.friction);
-    for (std::uint32_t i = 0; i < g.size(); ++i) {
-      const Vec3 p = g.positions[i];
-      const Fixed margin =
-          s_.def.speculative_distance + travel(s_, length(g.velocities[i]) + body_speed);
+    near.push_back({bi, s_.geometry(b.shape), length(b.linear_velocity) + d.rim_speed,
+                    transpose(d.pose.rotation), sqrt(friction * b.friction)});
+  }
+  // Ascending particle, then body, then sub-shape (collide_all's order): the order they are
+  // solved in.
+  for (std::uint32_t i = 0; i < g.size(); ++i) {
+    const Vec3 p = g.positions[i];
+    const Fixed own_speed = length(g.velocities[i]);
+    for (const Near& n : near) {
+      const BodyState& b = s_.bodies[n.index];
+      const Derived& d = s_.derived[n.index];
+      const Fixed margin = s_.def.speculative_distance + travel(s_, own_speed + n.speed);
       const Fixed reach = g.radius + margin;
       if (!overlaps(p - Vec3{reach, reach, reach}, p + Vec3{reach, reach, reach}, d)) continue;
       const Pose at{p, Mat3::identity()};
-      collide_all(PosedShape{ball, nullptr, at}, PosedShape{b.shape, geometry, d.pose}, margin,
+      collide_all(PosedShape{ball, nullptr, at}, PosedShape{b.shape, n.geometry, d.pose}, margin,
                   found);
       for (const SubManifold& m : found) {
         // The deepest point; the normal points from the particle into the body.
@@ -244,10 +258,10 @@ void ParticleStepper::prepare_group(ParticleGroup& g, GroupScratch& sc) {
         const Vec3 surface = cp.point + m.manifold.normal * (cp.separation * Fixed::half());
         ParticleContact c;
         c.particle = i;
-        c.body = bi;
-        c.local_normal = to_local * -m.manifold.normal;
-        c.local_point = to_local * (surface - b.position);
-        c.friction = mix;
+        c.body = n.index;
+        c.local_normal = n.to_local * -m.manifold.normal;
+        c.local_point = n.to_local * (surface - b.position);
+        c.friction = n.friction;
         sc.contacts.push_back(c);
       }
     }
@@ -257,10 +271,6 @@ void ParticleStepper::prepare_group(ParticleGroup& g, GroupScratch& sc) {
     bodies_.in_contact[c.body] = true;
   for (std::uint32_t bi : sc.attached_body)
     bodies_.in_contact[bi] = true;
-  // Ascending particle, then body (the bodies were walked in the outer loop).
-  std::stable_sort(
-      sc.contacts.begin(), sc.contacts.end(),
-      [](const ParticleContact& x, const ParticleContact& y) { return x.particle < y.particle; });
 }
 
 void ParticleStepper::substep() {
