@@ -486,13 +486,25 @@ Attachment attach(const WorldState& s, std::uint32_t particle, BodyId id, Vec3 p
 
 }  // namespace
 
-ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const RopeDef& def) {
+namespace {
+
+// A group of `def` at rest at `positions`; the caller adds its attachments, then builds it.
+template <class Def>
+ParticleGroup new_group(ParticleGroupId id, ParticleGroupType type, const Def& def,
+                        std::vector<Vec3> positions) {
   ParticleGroup g;
   g.id = id;
-  g.type = ParticleGroupType::rope;
+  g.type = type;
   g.def = def;
-  g.positions = rest_positions(def);
+  g.positions = std::move(positions);
   g.velocities.assign(g.positions.size(), Vec3{});
+  return g;
+}
+
+}  // namespace
+
+ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const RopeDef& def) {
+  ParticleGroup g = new_group(id, ParticleGroupType::rope, def, rest_positions(def));
   const auto last = static_cast<std::uint32_t>(g.positions.size() - 1);
   if (!def.attach_start.is_null())
     g.attachments.push_back(attach(s, 0, def.attach_start, g.positions[0]));
@@ -503,12 +515,7 @@ ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const RopeDef&
 }
 
 ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const ClothDef& def) {
-  ParticleGroup g;
-  g.id = id;
-  g.type = ParticleGroupType::cloth;
-  g.def = def;
-  g.positions = rest_positions(def);
-  g.velocities.assign(g.positions.size(), Vec3{});
+  ParticleGroup g = new_group(id, ParticleGroupType::cloth, def, rest_positions(def));
   if (!def.attach_body.is_null()) {
     for (std::uint32_t p : def.pinned)
       g.attachments.push_back(attach(s, p, def.attach_body, g.positions[p]));
@@ -518,12 +525,7 @@ ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const ClothDef
 }
 
 ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const SoftBodyDef& def) {
-  ParticleGroup g;
-  g.id = id;
-  g.type = ParticleGroupType::soft_body;
-  g.def = def;
-  g.positions = rest_positions(s, def);
-  g.velocities.assign(g.positions.size(), Vec3{});
+  ParticleGroup g = new_group(id, ParticleGroupType::soft_body, def, rest_positions(s, def));
   build_group(s, g);
   return g;
 }
