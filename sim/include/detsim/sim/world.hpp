@@ -82,8 +82,9 @@ struct SectionHash {
 /// Hashes of a state: of all its bytes, and of each section (docs/STATE.md).
 struct StateHashes {
   std::uint64_t total = 0;  ///< the frame's state hash: covers every section
-  /// In the state's order. A World's: "globals" (frame, ID counter, definition), "rng", "bodies"
-  /// (every body), "contacts" (the contact cache with its warm-start impulses).
+  /// In the state's order. A World's: "globals" (frame, ID counter, definition), "rng",
+  /// "geometry" (registered geometry by content hash), "bodies" (every body), "contacts" (the
+  /// contact cache with its warm-start impulses), "joints", "particles" (docs/STATE.md).
   std::vector<SectionHash> sections;
 
   /// The hash of the section called `name`, or 0 when there is none.
@@ -254,7 +255,7 @@ class World {
   Status set_linear_velocity(BodyId id, Vec3 velocity);
   Status set_angular_velocity(BodyId id, Vec3 velocity);
 
-  // ---- Joints (work in progress: docs/JOINTS-WIP.md; not yet in save/restore/hashes) ----
+  // ---- Joints (docs/JOINTS-WIP.md: what is done, what is not yet) ----
 
   /// Creates a joint; its ID is the next in joint sequence. An invalid definition (unknown or
   /// identical bodies, two static bodies, an axis that is not a unit vector, lower > upper,
