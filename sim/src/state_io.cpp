@@ -279,9 +279,9 @@ struct WorldSection {
 /// The World's sections, in the order a state lists them: a new kind of state (joints, particle
 /// groups, controllers) is a row here, after the bodies it refers to.
 constexpr WorldSection kSections[] = {
-    {"globals", 1, write_globals, read_globals},    {"rng", 1, write_rng_section, read_rng},
-    {"geometry", 1, write_geometry, read_geometry}, {"bodies", 2, write_bodies, read_bodies},
-    {"contacts", 2, write_contacts, read_contacts}, {"joints", 1, write_joints, read_joints},
+    {"globals", 1, write_globals, read_globals},       {"rng", 1, write_rng_section, read_rng},
+    {"geometry", 1, write_geometry, read_geometry},    {"bodies", 2, write_bodies, read_bodies},
+    {"contacts", 2, write_contacts, read_contacts},    {"joints", 1, write_joints, read_joints},
     {"particles", 1, write_particles, read_particles},
 };
 constexpr std::size_t kSectionCount = std::size(kSections);

@@ -10,8 +10,9 @@ namespace detsim::golden {
 
 /// Every scenario, each long enough to have a hash at frame 1000, and small enough for the
 /// emulated 32-bit legs of the determinism matrix, which run ~50x slower than x86-64: the piles
-/// have 64 bodies, the pyramid 8 rows, the rocks 30 hulls, the drape a 12 x 12 sheet, and the resting scenes fall asleep long
-/// before their last frame, after which a frame costs almost nothing.
+/// have 64 bodies, the pyramid 8 rows, the rocks 30 hulls, the drape a 12 x 12 sheet, and the
+/// resting scenes fall asleep long before their last frame, after which a frame costs almost
+/// nothing.
 struct GoldenRun {
   const char* scenario;
   ScenarioParams params;

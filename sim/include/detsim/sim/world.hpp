@@ -144,7 +144,7 @@ struct RayHit {
 struct ParticleRayHit {
   ParticleGroupId group{};
   std::uint32_t particle = 0;
-  Vec3 point{};  ///< world space
+  Vec3 point{};   ///< world space
   Vec3 normal{};  ///< unit, against the ray (zero if it starts inside the particle's ball)
   Fixed fraction{};
 
