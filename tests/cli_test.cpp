@@ -243,8 +243,9 @@ TEST(Cli, HelpNamesTheSubShapeContactSyntaxAndDiffsScenario) {
 }
 
 TEST(Cli, SynctestPassesOnEveryKindOfScene) {
-  for (const char* scene : {"arena --players 3", "spray", "dominoes", "flag", "jelly --count 2",
-                            "rope_bridge --count 3", "drape --count 8", "wrecking_rope"}) {
+  for (const char* scene :
+       {"arena --players 3", "spray", "dominoes", "flag", "jelly --count 2",
+        "rope_bridge --count 3", "drape --count 8", "wrecking_rope", "dam_break --count 3"}) {
     const Result r = detsim_cli(std::string("synctest --scenario ") + scene +
                                 " --frames 40 --check-distance 7 --json");
     EXPECT_EQ(r.exit_code, 0) << scene << r.err;

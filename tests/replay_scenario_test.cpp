@@ -10,6 +10,7 @@
 #include <detsim/replay.hpp>
 
 #include "support/replay_files.hpp"
+#include "support/scenario_counts.hpp"
 
 namespace detsim::replay {
 namespace {
@@ -44,7 +45,9 @@ TEST(ScenarioReplay, EveryScenarioRecordsAndVerifies) {
   for (const ScenarioInfo& info : scenario_list()) {
     SCOPED_TRACE(std::string(info.name));
     const ScenarioParams params{
-        .seed = 9, .players = 0, .count = std::min(info.default_count, 27U)};
+        .seed = 9,
+        .players = 0,
+        .count = test::scenario_test_count(info, std::min(info.default_count, 27U))};
     Scenario scenario = make(std::string(info.name), params);
     const std::uint32_t frames = std::min<std::uint32_t>(info.default_frames, 90);
     TempFile file(std::string(info.name) + ".dsr");

@@ -8,6 +8,7 @@
 #include <detsim/detsim.hpp>
 
 #include "support/mixed_scene.hpp"
+#include "support/scenario_counts.hpp"
 
 namespace detsim {
 namespace {
@@ -16,7 +17,7 @@ TEST(WorldInvariants, HoldAfterEveryStepOfEveryScenario) {
   for (const ScenarioInfo& info : scenario_list()) {
     ScenarioParams params;
     params.players = info.default_players;
-    params.count = std::min(info.max_count, 27U);  // 0: the scene takes no count
+    params.count = test::scenario_test_count(info, 27);  // 0: the scene takes no count
     auto scenario = Scenario::create(info.name, params);
     ASSERT_TRUE(scenario.ok()) << info.name << ": " << scenario.message();
     std::vector<PlayerInput> inputs(params.players);

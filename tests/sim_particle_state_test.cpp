@@ -252,7 +252,7 @@ TEST(ParticleState, RefusesEachBadFieldNamingItAndChangesNothing) {
   const Decoded d = decode(good);
   ASSERT_TRUE(d.ok) << d.error;
   const BadGroup cases[] = {
-      {"particle group type", [](Decoded& x) { x.particles.groups[0].type = 3; },
+      {"particle group type", [](Decoded& x) { x.particles.groups[0].type = 4; },
        [](const Decoded& x) { return x.particles.groups[0].type_at; }},
       {"particle group ID step 0", [](Decoded& x) { x.particles.groups[1].id_step = 0; },
        [](const Decoded& x) { return x.particles.groups[1].at; }},
@@ -338,6 +338,92 @@ TEST(ParticleState, EveryBitFlipIsRefusedOrCanonical) {
   EXPECT_GT(accepted, 0U);
   EXPECT_GT(refused, 0U);
   EXPECT_TRUE(w.save() == original);
+}
+
+// ---- A fluid ----
+
+/// A ground plane, a static box, and a 4 x 6 x 4 block of water (group 1) falling beside it.
+World fluid_scene() {
+  World w = make_world(WorldDef{});
+  BodyDef ground;
+  ground.type = BodyType::static_body;
+  ground.shape = Shape::plane();
+  add(w, ground);
+  BodyDef box;
+  box.type = BodyType::static_body;
+  box.shape = Shape::box({0.2_fx, 0.2_fx, 0.2_fx});
+  box.position = {0.4_fx, 0.2_fx, 0.1_fx};
+  add(w, box);
+  FluidDef water;
+  water.min = {0_fx, 0.3_fx, 0_fx};
+  water.max = {0.2_fx, 0.6_fx, 0.2_fx};
+  water.spacing = 0.05_fx;
+  water.particle_radius = 0.025_fx;
+  water.viscosity = 0.02_fx;
+  water.settings.substeps = 2;
+  EXPECT_TRUE(w.create_fluid(water).ok());
+  return w;
+}
+
+// A fluid's record is its definition (docs/STATE.md) and its particles; a restored world steps on
+// exactly like the uninterrupted one while the water splashes.
+TEST(ParticleState, AFluidIsSavedAndRestoredExactly) {
+  World w = fluid_scene();
+  (void)run_hashes(w, 20);
+  const Bytes saved = w.save();
+  const Decoded d = decode(saved);
+  ASSERT_TRUE(d.ok) << d.error;
+  EXPECT_EQ(encode(d), saved);
+  ASSERT_EQ(d.particles.groups.size(), 1U);
+  const DecodedParticleGroup& g = d.particles.groups[0];
+  const FluidDef def = w.fluid_def(ParticleGroupId{1}).value();
+  EXPECT_EQ(g.type, kFluid);
+  EXPECT_EQ(g.fluid.min, def.min);
+  EXPECT_EQ(g.fluid.max, def.max);
+  EXPECT_EQ(g.fluid.spacing, def.spacing);
+  EXPECT_EQ(g.fluid.rest_density, def.rest_density);
+  EXPECT_EQ(g.fluid.viscosity, def.viscosity);
+  EXPECT_EQ(g.fluid.particle_radius, def.particle_radius);
+  EXPECT_EQ(g.settings.substeps, 2U);
+  EXPECT_EQ(g.positions.size(), 4U * 6U * 4U);
+  EXPECT_EQ(g.positions, positions(w, ParticleGroupId{1}));
+  const std::vector<StateHashes> expected = run_hashes(w, 40);
+  World fresh;
+  ASSERT_TRUE(fresh.restore(saved).ok());
+  const std::vector<StateHashes> got = run_hashes(fresh, 40);
+  for (std::size_t f = 0; f < expected.size(); ++f)
+    ASSERT_EQ(got[f], expected[f]) << "differs " << f + 1 << " frames after restore";
+  EXPECT_NE(expected.front().total, expected.back().total);
+}
+
+TEST(ParticleState, AFluidsBadFieldsAreRefusedNamingThem) {
+  World w = fluid_scene();
+  (void)run_hashes(w, 5);
+  const Bytes good = w.save();
+  const Decoded d = decode(good);
+  ASSERT_TRUE(d.ok) << d.error;
+  const BadGroup cases[] = {
+      {"spacing must be within", [](Decoded& x) { x.particles.groups[0].fluid.spacing = 0_fx; },
+       [](const Decoded& x) { return x.particles.groups[0].def_at; }},
+      {"particle_radius must be within",
+       [](Decoded& x) { x.particles.groups[0].fluid.particle_radius = 1_fx; },
+       [](const Decoded& x) { return x.particles.groups[0].def_at; }},
+      {"rest_density must be within",
+       [](Decoded& x) { x.particles.groups[0].fluid.rest_density = -1_fx; },
+       [](const Decoded& x) { return x.particles.groups[0].def_at; }},
+      // One more column of particles than the record holds.
+      {"particle count 96, but its definition makes 120",
+       [](Decoded& x) { x.particles.groups[0].fluid.max.x = 0.25_fx; },
+       [](const Decoded& x) { return x.particles.groups[0].particle_count_at; }},
+  };
+  for (const BadGroup& c : cases) {
+    Decoded bad = d;
+    c.change(bad);
+    const std::string message = expect_rejected(w, encode(bad));
+    EXPECT_TRUE(contains(message, c.what)) << "expected '" << c.what << "' in: " << message;
+    EXPECT_TRUE(names_one_of(message, {c.byte(d)}))
+        << c.what << ": expected byte " << c.byte(d) << " in: " << message;
+  }
 }
 
 TEST(ParticleState, AHugeGroupCountIsRefusedBeforeAnythingIsAllocated) {

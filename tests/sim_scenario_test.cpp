@@ -11,6 +11,7 @@
 #include <detsim/detsim.hpp>
 
 #include "support/scale.hpp"
+#include "support/scenario_counts.hpp"
 
 namespace detsim {
 namespace {
@@ -22,10 +23,11 @@ bool contains(const std::string& text, const std::string& part) {
 TEST(ScenarioRegistry, ListsEveryScenarioOnceSortedByName) {
   const auto list = scenario_list();
   const std::vector<std::string> expected{
-      "arena",       "bounce",     "bridge",       "bullet_wall", "chain",         "dominoes",
-      "drape",       "flag",       "furniture",    "jelly",       "level",         "motors",
-      "pendulum",    "pile_boxes", "pile_spheres", "pyramid",     "ragdolls",      "rocks",
-      "rope_bridge", "slope",      "spray",        "stack",       "wrecking_ball", "wrecking_rope"};
+      "arena",        "bounce",   "bridge",   "bullet_wall",   "chain",
+      "dam_break",    "dominoes", "drape",    "flag",          "furniture",
+      "jelly",        "level",    "motors",   "pendulum",      "pile_boxes",
+      "pile_spheres", "pyramid",  "ragdolls", "rocks",         "rope_bridge",
+      "slope",        "spray",    "stack",    "wrecking_ball", "wrecking_rope"};
   ASSERT_EQ(list.size(), expected.size());
   for (std::size_t i = 0; i < list.size(); ++i) {
     EXPECT_EQ(std::string(list[i].name), expected[i]);
@@ -157,7 +159,8 @@ struct Recorded {
 // The piles at 5^3 bodies: the same code paths as 1000 in a test-sized run (the pyramid keeps its
 // default 20 rows); the rocks, whose hulls cost more per pair, at 30.
 std::uint32_t test_count(const ScenarioInfo& info) {
-  return std::min(info.default_count, info.name == "rocks" ? 30U : 125U);
+  return test::scenario_test_count(info,
+                                   std::min(info.default_count, info.name == "rocks" ? 30U : 125U));
 }
 
 ScenarioParams small(const ScenarioInfo& info) {

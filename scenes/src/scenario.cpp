@@ -57,6 +57,12 @@ constexpr std::array entries{
            1200, 0, 0, 0, 30, 1000, false, "links"},
           scenes_detail::build_chain,
           nullptr},
+    Entry{{"dam_break",
+           "a block of water N particles wide, 2N high and 2N deep (default 10: 4000 particles) "
+           "released at one end of a tank with an obstacle",
+           600, 0, 0, 0, 10, 16, false, "particles across the block"},
+          scenes_detail::build_dam_break,
+          nullptr},
     Entry{{"dominoes", "30 dominoes in a row; the first is tipped over", 600, 0, 0, 0, 0, 0, false},
           scenes_detail::build_dominoes,
           nullptr},

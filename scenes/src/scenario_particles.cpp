@@ -1,6 +1,7 @@
 // The scenes with particles: rope_bridge (planks hung on ropes between two posts), flag (cloth on
-// a pole in RNG gusts of wind), drape (cloth falling over a sphere and a box) and wrecking_rope
-// (a heavy ball on a rope swinging into boxes).
+// a pole in RNG gusts of wind), drape (cloth falling over a sphere and a box), jelly (soft cubes
+// down stairs), dam_break (a block of water released in a tank with an obstacle) and
+// wrecking_rope (a heavy ball on a rope swinging into boxes).
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -168,6 +169,36 @@ void build_jelly(World& w, const ScenarioParams& p) {
     cube.settings.friction = 0.3_fx;
     (void)w.create_soft_body(cube).value();
   }
+}
+
+// ---- dam_break ----
+
+void build_dam_break(World& w, const ScenarioParams& p) {
+  using namespace dam_break;
+  // Martin and Moyce's column (1952): a block of water a wide and 2a high (here as deep as it is
+  // high) at one end of a tank, released at once. a = count spacings.
+  const Fixed a = spacing * fx(p.count);
+  const Fixed length = a * Fixed::from_int(tank_length);
+  const Fixed depth = a * 2_fx;
+  const Fixed height = a * 2_fx;
+  // The tank: a floor and four walls (static boxes), inside [0, length] x [0, ...) x [0, depth].
+  fixed_box(w, {length / 2_fx + wall * 2_fx, wall, depth / 2_fx + wall * 2_fx},
+            {length / 2_fx, -wall, depth / 2_fx});
+  for (const Fixed x : {-wall, length + wall})
+    fixed_box(w, {wall, height, depth / 2_fx + wall * 2_fx}, {x, height, depth / 2_fx});
+  for (const Fixed z : {-wall, depth + wall})
+    fixed_box(w, {length / 2_fx, height, wall}, {length / 2_fx, height, z});
+  // The obstacle, in the middle of the tank's width, a block width beyond the dam.
+  fixed_box(w, obstacle_half, {a * 2_fx + obstacle_half.x, obstacle_half.y, depth / 2_fx});
+  FluidDef water;
+  water.min = {};
+  water.max = {a, height, depth};
+  water.spacing = spacing;
+  water.particle_radius = spacing / 2_fx;
+  water.rest_density = 1000_fx;
+  water.viscosity = 0.01_fx;
+  water.settings.substeps = 2;
+  (void)w.create_fluid(water).value();
 }
 
 // ---- wrecking_rope ----

@@ -42,6 +42,7 @@ void build_flag(World& w, const ScenarioParams& p);
 void build_drape(World& w, const ScenarioParams& p);
 void build_wrecking_rope(World& w, const ScenarioParams& p);
 void build_jelly(World& w, const ScenarioParams& p);
+void build_dam_break(World& w, const ScenarioParams& p);
 
 // Per-frame logic, run before each step. Reads only the World and the inputs.
 void control_spray(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
@@ -182,6 +183,15 @@ inline constexpr std::uint32_t resolution = 4;
 inline constexpr Fixed mass = 2_fx;
 inline constexpr Fixed edge_compliance = 0.001_fx;
 }  // namespace jelly
+
+namespace dam_break {
+inline constexpr Fixed spacing = 0.05_fx;  ///< m, between the fluid's particles
+inline constexpr Fixed wall = 0.1_fx;      ///< half the tank walls' thickness
+/// The tank, inside: tank_length block widths long, tank_depth wide; the obstacle a block width
+/// from the dam.
+inline constexpr std::int32_t tank_length = 6;
+inline constexpr Vec3 obstacle_half{0.1_fx, 0.2_fx, 0.15_fx};
+}  // namespace dam_break
 
 namespace wrecking_rope {
 inline constexpr Vec3 pivot{0_fx, 7_fx, 0_fx};

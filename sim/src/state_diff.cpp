@@ -62,6 +62,8 @@ std::string show(ParticleGroupType t) {
       return "cloth";
     case ParticleGroupType::soft_body:
       return "soft_body";
+    case ParticleGroupType::fluid:
+      return "fluid";
   }
   return "unknown";
 }

@@ -169,6 +169,28 @@ bool read_soft_body(ByteReader& r, SoftBodyDef& d) {
   return r.ok();
 }
 
+void write_def(const FluidDef& d, ByteWriter& w) {
+  w.vec3(d.min);
+  w.vec3(d.max);
+  w.fixed(d.spacing);
+  w.fixed(d.rest_density);
+  w.fixed(d.viscosity);
+  w.fixed(d.particle_radius);
+  write_settings(d.settings, w);
+}
+
+FluidDef read_fluid(ByteReader& r) {
+  FluidDef d;
+  d.min = r.vec3("fluid min");
+  d.max = r.vec3("fluid max");
+  d.spacing = r.fixed("fluid spacing");
+  d.rest_density = r.fixed("fluid rest density");
+  d.viscosity = r.fixed("fluid viscosity");
+  d.particle_radius = r.fixed("fluid particle radius");
+  d.settings = read_settings(r);
+  return d;
+}
+
 }  // namespace
 
 std::string check_particle_record(const WorldState& s, const ParticleGroup& g) {
@@ -268,8 +290,8 @@ bool read_particles(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
     const std::string name = "particle group " + std::to_string(g.id.value) + ": ";
     const std::size_t type_at = r.offset();
     const std::uint8_t type = r.u8("particle group type");
-    if (r.ok() && type > static_cast<std::uint8_t>(ParticleGroupType::soft_body))
-      r.fail_at(type_at, "particle group type", "0-2 (rope, cloth, soft body)");
+    if (r.ok() && type > static_cast<std::uint8_t>(ParticleGroupType::fluid))
+      r.fail_at(type_at, "particle group type", "0-3 (rope, cloth, soft body, fluid)");
     if (!r.ok()) break;
     g.type = static_cast<ParticleGroupType>(type);
     const std::size_t def_at = r.offset();
@@ -279,6 +301,12 @@ bool read_particles(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
       const RopeDef def = read_rope(r);
       if (!r.ok()) break;
       check = check_rope_def(s, def, false);
+      n = particle_count(def);
+      g.def = def;
+    } else if (g.type == ParticleGroupType::fluid) {
+      const FluidDef def = read_fluid(r);
+      if (!r.ok()) break;
+      check = check_fluid_def(def);
       n = particle_count(def);
       g.def = def;
     } else if (g.type == ParticleGroupType::soft_body) {

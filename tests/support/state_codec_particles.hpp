@@ -2,7 +2,7 @@
 // written from docs/STATE.md ("particles", version 1), not from state_particles.cpp.
 //
 // In brief: u32 next particle group ID (>= 1) | var group count | each group, ascending by ID:
-// ID step var, type u8 (0 rope, 1 cloth, 2 soft body), the definition:
+// ID step var, type u8 (0 rope, 1 cloth, 2 soft body, 3 fluid), the definition:
 //   rope:  start, end (fvec3), segments var, length, mass, radius, compliance, bending compliance
 //          (fixed), attach start var, attach end var;
 //   cloth: origin, axis u, axis v (fvec3), columns var, rows var, mass, thickness, stretch
@@ -11,6 +11,7 @@
 //   soft body: shape type u8 (2 box: half extents fvec3; 6 convex hull: geometry ID var),
 //          position fvec3, orientation (w, x, y, z fixed), resolution var, mass, edge compliance,
 //          volume compliance (fixed);
+//   fluid: min, max (fvec3), spacing, rest density, viscosity, particle radius (fixed);
 // then the settings: friction, damping (fixed), substeps var, layer u32, mask u32; flags u8 (bit 0
 // awake), sleep time fixed, force fvec3, tether impulse fixed, attachment count var, each
 // attachment: particle var, body var, local point fvec3; particle count var; per particle:
@@ -40,6 +41,7 @@ inline constexpr std::uint8_t kGroupAwake = 1;
 inline constexpr std::uint8_t kRope = 0;
 inline constexpr std::uint8_t kCloth = 1;
 inline constexpr std::uint8_t kSoftBody = 2;
+inline constexpr std::uint8_t kFluid = 3;
 /// The bytes of one particle (position and velocity, fvec3 each).
 inline constexpr std::size_t kParticleBytes = 48;
 
@@ -94,6 +96,15 @@ struct DecodedSoftBody {
   Fixed volume_compliance{};
 };
 
+struct DecodedFluid {
+  Vec3 min{};
+  Vec3 max{};
+  Fixed spacing{};
+  Fixed rest_density{};
+  Fixed viscosity{};
+  Fixed particle_radius{};
+};
+
 struct DecodedAttachment {
   std::uint64_t particle = 0;
   std::uint64_t body = 0;
@@ -102,10 +113,11 @@ struct DecodedAttachment {
 
 struct DecodedParticleGroup {
   std::uint64_t id_step = 0;  // the ID minus the previous group's
-  std::uint8_t type = kRope;  // any byte; encode() writes the rope's fields unless it is kCloth
+  std::uint8_t type = kRope;  // any byte; encode() writes the rope's fields for any other
   DecodedRope rope;           // when type is kRope
   DecodedCloth cloth;         // when type is kCloth
   DecodedSoftBody soft_body;  // when type is kSoftBody
+  DecodedFluid fluid;         // when type is kFluid
   DecodedParticleSettings settings;
   std::uint8_t flags = 0;  // kGroupAwake
   Fixed sleep_time{};
@@ -202,9 +214,17 @@ void read_particle_group(Reader& r, DecodedParticles& d, std::uint64_t& previous
   g.id = static_cast<std::uint32_t>(id);
   g.type_at = r.at();
   g.type = r.u8("particle group type");
-  if (r.ok() && g.type > kSoftBody) r.fail(g.type_at, "particle group type: not 0, 1 or 2");
+  if (r.ok() && g.type > kFluid) r.fail(g.type_at, "particle group type: not 0, 1, 2 or 3");
   g.def_at = r.at();
-  if (g.type == kSoftBody) {
+  if (g.type == kFluid) {
+    DecodedFluid& f = g.fluid;
+    f.min = read_fvec3(r, "fluid min");
+    f.max = read_fvec3(r, "fluid max");
+    f.spacing = r.fixed("fluid spacing");
+    f.rest_density = r.fixed("fluid rest density");
+    f.viscosity = r.fixed("fluid viscosity");
+    f.particle_radius = r.fixed("fluid particle radius");
+  } else if (g.type == kSoftBody) {
     DecodedSoftBody& soft = g.soft_body;
     const std::size_t shape_at = r.at();
     soft.shape_type = r.u8("soft body shape type");
@@ -323,7 +343,13 @@ template <class Writer>
 void write_particle_group(Writer& w, const DecodedParticleGroup& g) {
   w.var(g.id_step);
   w.u8(g.type);
-  if (g.type == kSoftBody) {
+  if (g.type == kFluid) {
+    const DecodedFluid& f = g.fluid;
+    write_fvec3(w, f.min);
+    write_fvec3(w, f.max);
+    for (const Fixed x : {f.spacing, f.rest_density, f.viscosity, f.particle_radius})
+      w.fixed(x);
+  } else if (g.type == kSoftBody) {
     const DecodedSoftBody& soft = g.soft_body;
     w.u8(soft.shape_type);
     if (soft.shape_type == 6)

@@ -53,6 +53,9 @@ std::size_t count_of(const sim_detail::WorldState&, const ClothDef& def) {
 std::size_t count_of(const sim_detail::WorldState& s, const SoftBodyDef& def) {
   return sim_detail::particle_count(s, def);
 }
+std::size_t count_of(const sim_detail::WorldState&, const FluidDef& def) {
+  return sim_detail::particle_count(def);
+}
 
 template <class Def>
 Expected<ParticleGroupId> create_group(sim_detail::WorldState& s, const Def& def, std::string check,
@@ -89,6 +92,10 @@ Expected<ParticleGroupId> World::create_cloth(const ClothDef& def) {
 
 Expected<ParticleGroupId> World::create_soft_body(const SoftBodyDef& def) {
   return create_group(*s_, def, sim_detail::check_soft_body_def(*s_, def), "soft body");
+}
+
+Expected<ParticleGroupId> World::create_fluid(const FluidDef& def) {
+  return create_group(*s_, def, sim_detail::check_fluid_def(def), "fluid");
 }
 
 Status World::destroy_particle_group(ParticleGroupId id) {
@@ -143,6 +150,10 @@ Expected<ClothDef> World::cloth_def(ParticleGroupId id) const {
 
 Expected<SoftBodyDef> World::soft_body_def(ParticleGroupId id) const {
   return def_of<SoftBodyDef>(*s_, id, "soft body");
+}
+
+Expected<FluidDef> World::fluid_def(ParticleGroupId id) const {
+  return def_of<FluidDef>(*s_, id, "fluid");
 }
 
 Expected<ParticleGroupStats> World::particle_group_stats(ParticleGroupId id) const {

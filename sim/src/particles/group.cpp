@@ -10,6 +10,7 @@
 #include "../limits.hpp"
 #include "../shapes.hpp"
 #include "../world_state.hpp"
+#include "fluid.hpp"
 
 namespace detsim::sim_detail {
 
@@ -316,6 +317,88 @@ std::vector<Vec3> rest_positions(const WorldState& s, const SoftBodyDef& def) {
   return out;
 }
 
+namespace {
+
+// A fluid's particles along one axis: as many centres min + spacing * (i + 1/2) as fit whole in
+// [min, max], allowing 1/1024 of a spacing (so that max = min + 20 * spacing makes 20 when the
+// spacing, 0.05 say, has no exact binary value); 0 when none does.
+std::uint64_t fluid_axis(Fixed lo, Fixed hi, Fixed spacing) {
+  if (hi <= lo) return 0;
+  const auto s = static_cast<std::uint64_t>(spacing.raw());
+  return (static_cast<std::uint64_t>((hi - lo).raw()) + s / 1024) / s;
+}
+
+std::array<std::uint64_t, 3> fluid_counts(const FluidDef& def) {
+  return {fluid_axis(def.min.x, def.max.x, def.spacing),
+          fluid_axis(def.min.y, def.max.y, def.spacing),
+          fluid_axis(def.min.z, def.max.z, def.spacing)};
+}
+
+// The densest and lightest fluids: water is 1000 kg/m^3, mercury 13 534, air 1.2.
+constexpr Fixed kMinDensity = Fixed::one();
+constexpr Fixed kMaxDensity = Fixed::from_int(100000);
+constexpr Fixed kMaxSpacing = Fixed::from_int(10);
+
+}  // namespace
+
+std::uint32_t particle_count(const FluidDef& def) noexcept {
+  if (def.spacing <= Fixed::zero()) return 0;
+  const auto c = fluid_counts(def);
+  const std::uint64_t limit = max_particles_per_group;
+  if (c[0] > limit || c[1] > limit || c[2] > limit || c[0] * c[1] > limit ||
+      c[0] * c[1] * c[2] > limit)
+    return 0;
+  return static_cast<std::uint32_t>(c[0] * c[1] * c[2]);
+}
+
+std::string check_fluid_def(const FluidDef& def) {
+  if (auto e = check_components("min", def.min, max_position, "m"); !e.empty()) return e;
+  if (auto e = check_components("max", def.max, max_position, "m"); !e.empty()) return e;
+  if (auto e = in_range("spacing", def.spacing, kMinLink, kMaxSpacing, "m"); !e.empty()) return e;
+  const Vec3 span = def.max - def.min;
+  if (beyond(span.x, kMaxExtent) || beyond(span.y, kMaxExtent) || beyond(span.z, kMaxExtent))
+    return "max - min must be within +-" + num(kMaxExtent) + " m per component";
+  const auto c = fluid_counts(def);
+  static constexpr std::array<const char*, 3> kAxis{"x", "y", "z"};
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (c[k] == 0)
+      return std::string("max.") + kAxis[k] + " - min." + kAxis[k] +
+             " must be at least the spacing (" + num(def.spacing) + " m): no particle fits";
+  }
+  if (particle_count(def) == 0)
+    return std::to_string(c[0]) + " x " + std::to_string(c[1]) + " x " + std::to_string(c[2]) +
+           " particles: above max_particles_per_group " + std::to_string(max_particles_per_group);
+  if (auto e = in_range("rest_density", def.rest_density, kMinDensity, kMaxDensity, "kg/m^3");
+      !e.empty())
+    return e;
+  const Fixed mass = def.rest_density * def.spacing * def.spacing * def.spacing;
+  if (mass < kMinParticleMass || mass > kMaxMass)
+    return "rest_density * spacing^3 (each particle's mass) must be within " +
+           num(kMinParticleMass) + " .. " + num(kMaxMass) + " kg, got " + num(mass);
+  if (auto e = in_range("viscosity", def.viscosity, Fixed::zero(), Fixed::one(), ""); !e.empty())
+    return e;
+  if (def.particle_radius <= Fixed::zero() || def.particle_radius > def.spacing)
+    return "particle_radius must be within 0 (excluded) .. the spacing " + num(def.spacing) +
+           " m, got " + num(def.particle_radius);
+  return check_settings(def.settings);
+}
+
+std::vector<Vec3> rest_positions(const FluidDef& def) {
+  const auto c = fluid_counts(def);
+  std::vector<Vec3> out;
+  out.reserve(particle_count(def));
+  const Fixed s = def.spacing;
+  const auto at = [&](Fixed lo, std::uint64_t i) {
+    return lo + s * Fixed::from_int(static_cast<std::int32_t>(i)) + s * Fixed::half();
+  };
+  // Index = (y * nz + z) * nx + x: layer by layer from the bottom.
+  for (std::uint64_t y = 0; y < c[1]; ++y)
+    for (std::uint64_t z = 0; z < c[2]; ++z)
+      for (std::uint64_t x = 0; x < c[0]; ++x)
+        out.push_back({at(def.min.x, x), at(def.min.y, y), at(def.min.z, z)});
+  return out;
+}
+
 std::vector<Vec3> rest_positions(const RopeDef& def) {
   const std::uint32_t n = particle_count(def);
   std::vector<Vec3> out(n);
@@ -458,14 +541,20 @@ void build_group(const WorldState& s, ParticleGroup& g) {
   const std::uint32_t n = static_cast<std::uint32_t>(g.positions.size());
   std::visit(
       [&](const auto& def) {
-        g.particle_mass = def.mass / count_fx(n);
         using Def = std::decay_t<decltype(def)>;
-        if constexpr (std::is_same_v<Def, RopeDef>) {
-          build_rope(g, def);
-        } else if constexpr (std::is_same_v<Def, ClothDef>) {
-          build_cloth(g, def);
+        if constexpr (std::is_same_v<Def, FluidDef>) {
+          g.particle_mass = def.rest_density * def.spacing * def.spacing * def.spacing;
+          g.radius = def.particle_radius;
+          build_fluid_kernel(g, def.spacing);
         } else {
-          build_soft_body(s, g, def);
+          g.particle_mass = def.mass / count_fx(n);
+          if constexpr (std::is_same_v<Def, RopeDef>) {
+            build_rope(g, def);
+          } else if constexpr (std::is_same_v<Def, ClothDef>) {
+            build_cloth(g, def);
+          } else {
+            build_soft_body(s, g, def);
+          }
         }
       },
       g.def);
@@ -530,6 +619,12 @@ ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const SoftBody
   return g;
 }
 
+ParticleGroup make_group(const WorldState& s, ParticleGroupId id, const FluidDef& def) {
+  ParticleGroup g = new_group(id, ParticleGroupType::fluid, def, rest_positions(def));
+  build_group(s, g);
+  return g;
+}
+
 ParticleGroupStats group_stats(const ParticleGroup& g) {
   ParticleGroupStats st;
   st.type = g.type;
@@ -556,6 +651,10 @@ ParticleGroupStats group_stats(const ParticleGroup& g) {
   }
   st.volume = st.volume / Fixed::from_int(6);
   st.rest_volume = st.rest_volume / Fixed::from_int(6);
+  if (g.type == ParticleGroupType::fluid) {
+    for (Fixed density : fluid_densities(g))
+      st.max_density_error = max(st.max_density_error, density - Fixed::one());
+  }
   for (std::size_t k = 0; k < g.links.size(); ++k) {
     const Link& l = g.links[k];
     if (g.link_broken[k] || l.kind == LinkKind::bend || l.kind == LinkKind::shear) continue;

@@ -68,7 +68,7 @@ struct Tetrahedron {
 struct ParticleGroup {
   ParticleGroupId id{};
   ParticleGroupType type = ParticleGroupType::rope;
-  std::variant<RopeDef, ClothDef, SoftBodyDef> def;
+  std::variant<RopeDef, ClothDef, SoftBodyDef, FluidDef> def;
 
   // State: the particles, parallel arrays by index.
   std::vector<Vec3> positions;
@@ -91,6 +91,12 @@ struct ParticleGroup {
   std::vector<Tetrahedron> tetrahedra;  ///< a soft body's, by cube then Freudenthal order
   std::vector<bool> pinned;             ///< held in space (cloth's pinned without a body)
   std::vector<bool> link_broken;        ///< parallel to links, from `broken`
+  // A fluid's kernel (fluid.hpp): its support H (two spacings), the kernel's sum over a particle
+  // and its neighbours at rest (what a particle's density is divided by), and the relaxation
+  // added to each density constraint's denominator (1/m^2).
+  Fixed kernel_radius;
+  Fixed kernel_rest_sum;
+  Fixed kernel_relaxation;
 
   // Step scratch (not saved; stale between steps): the bodies whose boxes overlap the group's
   // (indices into WorldState::bodies, ascending), found by prepare_particles.
@@ -109,12 +115,16 @@ struct ParticleGroup {
 [[nodiscard]] std::string check_cloth_def(const WorldState& s, const ClothDef& def,
                                           bool bodies = true);
 [[nodiscard]] std::string check_soft_body_def(const WorldState& s, const SoftBodyDef& def);
+[[nodiscard]] std::string check_fluid_def(const FluidDef& def);
 
 /// The particle count a valid definition makes.
 [[nodiscard]] std::uint32_t particle_count(const RopeDef& def) noexcept;
 [[nodiscard]] std::uint32_t particle_count(const ClothDef& def) noexcept;
 /// A soft body's particle count depends on its shape's geometry (a hull's cells).
 [[nodiscard]] std::uint32_t particle_count(const WorldState& s, const SoftBodyDef& def);
+/// A fluid's: its particles along each axis, multiplied (0 for a definition that makes none, or
+/// more than max_particles_per_group).
+[[nodiscard]] std::uint32_t particle_count(const FluidDef& def) noexcept;
 
 /// A new group of a valid definition: particles at rest where the definition lays them out,
 /// attachments in the bodies' frames at their present poses, and the constraints.
@@ -123,11 +133,14 @@ struct ParticleGroup {
                                        const ClothDef& def);
 [[nodiscard]] ParticleGroup make_group(const WorldState& s, ParticleGroupId id,
                                        const SoftBodyDef& def);
+[[nodiscard]] ParticleGroup make_group(const WorldState& s, ParticleGroupId id,
+                                       const FluidDef& def);
 
 /// The particles' rest layout of a definition (where make_group puts them).
 [[nodiscard]] std::vector<Vec3> rest_positions(const RopeDef& def);
 [[nodiscard]] std::vector<Vec3> rest_positions(const ClothDef& def);
 [[nodiscard]] std::vector<Vec3> rest_positions(const WorldState& s, const SoftBodyDef& def);
+[[nodiscard]] std::vector<Vec3> rest_positions(const FluidDef& def);
 
 /// Rebuilds what is derived from the definition and `broken` (mass, radius, links, tethers,
 /// pins): what make_group and restore both do, so that a restored group steps exactly like the

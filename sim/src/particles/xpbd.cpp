@@ -216,6 +216,9 @@ void ParticleStepper::prepare_group(ParticleGroup& g, GroupScratch& sc) {
   // Contact planes: each particle, as a ball of the group's radius, against each near body whose
   // box its own box meets, with a margin that covers the step's relative motion.
   const Shape ball = Shape::sphere(g.radius);
+  const Fixed wall_reach = g.type == ParticleGroupType::fluid
+                               ? max(g.kernel_radius - g.radius, Fixed::zero())
+                               : Fixed::zero();
   const Fixed friction = g.settings().friction;
   std::vector<SubManifold> found;
   // What each near body contributes to every test, computed once.
@@ -242,7 +245,9 @@ void ParticleStepper::prepare_group(ParticleGroup& g, GroupScratch& sc) {
     for (const Near& n : near) {
       const BodyState& b = s_.bodies[n.index];
       const Derived& d = s_.derived[n.index];
-      const Fixed margin = s_.def.speculative_distance + travel(s_, own_speed + n.speed);
+      // A fluid's particles feel walls within its kernel's reach (fluid.hpp).
+      const Fixed margin =
+          s_.def.speculative_distance + travel(s_, own_speed + n.speed) + wall_reach;
       const Fixed reach = g.radius + margin;
       if (!overlaps(p - Vec3{reach, reach, reach}, p + Vec3{reach, reach, reach}, d)) continue;
       const Pose at{p, Mat3::identity()};
@@ -342,6 +347,26 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
     c.point = b.position + rotate(b.orientation, c.local_point);
   }
 
+  // A fluid's neighbours, once per sub-step, within the kernel's reach and a skin of a quarter
+  // spacing that covers the particles' usual motion in its small steps.
+  const auto* fluid = std::get_if<FluidDef>(&g.def);
+  const Fixed fluid_move = g.kernel_radius / Fixed::from_int(4);
+  const Fixed fluid_skin = g.kernel_radius / Fixed::from_int(8);
+  if (fluid != nullptr) {
+    find_fluid_pairs(g.positions, g.kernel_radius + fluid_skin, sc.fluid);
+    build_fluid_neighbours(g.size(), sc.fluid);
+    // Its walls: the contact planes, particle by particle.
+    FluidScratch& f = sc.fluid;
+    f.wall_start.assign(g.size() + 1, 0);
+    f.walls.clear();
+    for (const ParticleContact& c : sc.contacts) {
+      ++f.wall_start[c.particle + 1];
+      f.walls.push_back({c.normal, c.point, c.body, Vec3{}, Vec3{}});
+    }
+    for (std::size_t i = 0; i < g.size(); ++i)
+      f.wall_start[i + 1] += f.wall_start[i];
+  }
+
   for (std::uint32_t step = 0; step < small_steps; ++step) {
     // Predict: free particles move by their velocity after gravity, forces and damping; attached
     // ones by their body's motion.
@@ -356,6 +381,9 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
     for (std::size_t k = 0; k < g.attachments.size(); ++k)
       g.positions[g.attachments[k].particle] =
           sc.target_from[k] + (sc.targets[k] - sc.target_from[k]) * part;
+
+    // A fluid's density constraints: one Gauss-Seidel pass (fluid.hpp).
+    if (fluid != nullptr) solve_fluid_density(g, sc.fluid, fluid_move);
 
     // Distance links: lambda = -C / (w_a + w_b + compliance / h^2), one pass, no accumulation.
     // With n = delta / |delta|, x_a -= w_a lambda n and x_b += w_b lambda n are the link's delta
@@ -464,6 +492,18 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
       if (is_pinned(g, i)) continue;
       g.velocities[i] =
           limit_speed((g.positions[i] - sc.previous[i]) * inv_h, s_.def.max_linear_speed);
+    }
+    if (fluid != nullptr) apply_fluid_viscosity(g, sc.fluid, fluid->viscosity);
+  }
+  // The walls' share of the fluid's pressure pushes their bodies back, as the contacts do.
+  if (fluid != nullptr) {
+    const Fixed impulse = g.particle_mass * inv_h;
+    for (std::uint32_t i = 0; i < g.size(); ++i) {
+      for (std::uint32_t k = sc.fluid.wall_start[i]; k < sc.fluid.wall_start[i + 1]; ++k) {
+        const FluidWall& wall = sc.fluid.walls[k];
+        if (wall.moved != Vec3{} && takes_pushes(s_.bodies[wall.body]))
+          push_body(wall.body, -wall.moved * impulse, g.positions[i] - wall.normal * g.radius);
+      }
     }
   }
 }

@@ -19,6 +19,7 @@
 
 #include "../solver/bodies.hpp"
 #include "../world_state.hpp"
+#include "fluid.hpp"
 
 namespace detsim::sim_detail {
 
@@ -59,6 +60,7 @@ class ParticleStepper {
     Fixed inv_h;
     std::vector<Fixed> link_factor;  ///< per link: 1 / (w_a + w_b + compliance / h^2)
     Fixed volume_compliance;         ///< a soft body's volume compliance / h^2
+    FluidScratch fluid;              ///< a fluid's neighbours and kernel sums
   };
 
   void prepare_group(ParticleGroup& g, GroupScratch& scratch);

@@ -1,11 +1,11 @@
-// Particles: ropes and cloth stepped by extended position-based dynamics (XPBD) inside
-// World::step, coupled both ways with rigid bodies (docs/PARTICLES.md).
+// Particles: ropes, cloth, soft bodies and fluids stepped by extended position-based dynamics
+// (XPBD) inside World::step, coupled both ways with rigid bodies (docs/PARTICLES.md).
 //
-// A particle group is one rope or one sheet of cloth: its particles are arrays of their own
-// (structure of arrays), stepped in small sub-steps of one constraint pass each (Macklin et al.,
-// "Small Steps in Physics Simulation", 2019), in ascending group and particle index order. Groups
-// have IDs of their own, never reused, assigned in creation order. Everything a group does is
-// saved, hashed and diffed like a body ("particles" state section, docs/STATE.md).
+// A particle group is one rope, sheet of cloth, soft body or fluid: its particles are arrays of
+// their own (structure of arrays), stepped in small sub-steps of one constraint pass each (Macklin
+// et al., "Small Steps in Physics Simulation", 2019), in ascending group and particle index order.
+// Groups have IDs of their own, never reused, assigned in creation order. Everything a group does
+// is saved, hashed and diffed like a body ("particles" state section, docs/STATE.md).
 #pragma once
 
 #include <compare>
@@ -35,6 +35,7 @@ enum class ParticleGroupType : std::uint8_t {
   rope = 0,
   cloth = 1,
   soft_body = 2,
+  fluid = 3,
 };
 
 /// Hard limits (refused beyond them, with a message naming the field).
@@ -131,6 +132,29 @@ struct SoftBodyDef {
   friend constexpr bool operator==(const SoftBodyDef&, const SoftBodyDef&) noexcept = default;
 };
 
+/// A fluid: a block of particles filling the box [min, max] at `spacing` (particle centres at
+/// min + spacing * (i + 1/2) along each axis, as many as fit whole), stepped as position-based
+/// fluids (Macklin and Mueller, 2013): each particle's density, estimated from its neighbours
+/// within two spacings, is held at `rest_density` (compressions only: a free surface does not
+/// pull), with XSPH viscosity. Each particle weighs rest_density * spacing^3. Neighbours are found
+/// within the group only: two fluid groups pass through each other.
+struct FluidDef {
+  Vec3 min{};
+  Vec3 max{Fixed::one(), Fixed::one(), Fixed::one()};
+  /// m, between neighbouring particles at rest: 2^-7 (7.8 mm) .. 10 m.
+  Fixed spacing = 0.1_fx;
+  Fixed rest_density = Fixed::from_int(1000);  ///< kg/m^3, 1 .. 100000 (water: 1000)
+  /// XSPH viscosity, 0 .. 1: the fraction of the difference from its neighbours' mean velocity a
+  /// particle gives up per small step (0: inviscid; water: about 0.01).
+  Fixed viscosity = 0.01_fx;
+  /// m, each particle's against bodies, 0 < radius <= spacing (half the spacing: the particles
+  /// touch at rest).
+  Fixed particle_radius = 0.05_fx;
+  ParticleSettings settings{};
+
+  friend constexpr bool operator==(const FluidDef&, const FluidDef&) noexcept = default;
+};
+
 /// What World::particle_group_stats reports for a group.
 struct ParticleGroupStats {
   ParticleGroupType type = ParticleGroupType::rope;
@@ -146,6 +170,9 @@ struct ParticleGroupStats {
   /// A soft body's volume (m^3, the sum of its tetrahedra's) now and at rest; zero for the others.
   Fixed volume{};
   Fixed rest_volume{};
+  /// A fluid's constraint error: its most compressed particle's density over the rest density,
+  /// minus one (0 when none is compressed); zero for the others.
+  Fixed max_density_error{};
   bool awake = true;
 
   friend constexpr bool operator==(const ParticleGroupStats&,

@@ -283,7 +283,7 @@ class World {
   /// new list; restore() clears it (output, not state, like contact_events()).
   [[nodiscard]] std::span<const JointEvent> joint_events() const noexcept;
 
-  // ---- Particles: ropes and cloth (docs/PARTICLES.md) ----
+  // ---- Particles: ropes, cloth, soft bodies and fluids (docs/PARTICLES.md) ----
 
   /// Creates a rope (RopeDef); its ID is the next in particle-group sequence. Refused, with a
   /// message naming the field and changing nothing: a value outside its documented range, an
@@ -298,6 +298,9 @@ class World {
   /// box or a convex hull of this world, a resolution outside 1..40, cells below 1 cm, or a
   /// shape that holds fewer than two particles along an axis).
   Expected<ParticleGroupId> create_soft_body(const SoftBodyDef& def);
+  /// Creates a fluid (FluidDef), refused like create_rope (and for max not above min + spacing
+  /// on every axis, or a particle_radius above the spacing).
+  Expected<ParticleGroupId> create_fluid(const FluidDef& def);
   /// Removes a group; wakes the bodies it was attached to. Unknown IDs are an error.
   Status destroy_particle_group(ParticleGroupId id);
   /// Every group's ID, ascending.
@@ -306,11 +309,12 @@ class World {
   /// unknown ID.
   [[nodiscard]] Expected<std::vector<Vec3>> particle_positions(ParticleGroupId id) const;
   [[nodiscard]] Expected<std::vector<Vec3>> particle_velocities(ParticleGroupId id) const;
-  /// The definition a rope or a sheet was created from (attach bodies as given then, even if
+  /// The definition a group was created from (attach bodies as given then, even if
   /// destroyed since), or an error for an unknown ID or a group of the other type.
   [[nodiscard]] Expected<RopeDef> rope_def(ParticleGroupId id) const;
   [[nodiscard]] Expected<ClothDef> cloth_def(ParticleGroupId id) const;
   [[nodiscard]] Expected<SoftBodyDef> soft_body_def(ParticleGroupId id) const;
+  [[nodiscard]] Expected<FluidDef> fluid_def(ParticleGroupId id) const;
   /// A group's statistics (energy, strain, speed), or an error for an unknown ID.
   [[nodiscard]] Expected<ParticleGroupStats> particle_group_stats(ParticleGroupId id) const;
   /// A force (N, world frame) spread evenly over a group's free particles for the next step (wind,
