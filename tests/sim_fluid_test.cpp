@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <iostream>
+
 #include <gtest/gtest.h>
 #include <detsim/detsim.hpp>
 
@@ -98,9 +100,13 @@ TEST(Fluid, AtRestKeepsItsDensityAndAFlatSurfaceInsideTheTank) {
   for (double h : heights)
     mean += h / static_cast<double>(heights.size());
   EXPECT_NEAR(mean, expected, 0.02 * expected) << "mean density off by " << expected / mean - 1;
+  std::cout << "measured: surface " << mean << " m for " << expected << " m (density "
+            << expected / mean - 1 << " off)\n";
   const auto [lowest, highest] = std::minmax_element(heights.begin(), heights.end());
   EXPECT_LE(*highest - *lowest, kS / 2) << "surface between " << *lowest << " and " << *highest;
   const ParticleGroupStats st = w.particle_group_stats(*id).value();
+  std::cout << "measured: surface spread " << *highest - *lowest << " m, most compressed "
+            << d(st.max_density_error) << "\n";
   EXPECT_EQ(st.type, ParticleGroupType::fluid);
   EXPECT_LT(d(st.max_density_error), 0.02);
   for (const Vec3& q : p) {
@@ -149,6 +155,8 @@ TEST(Fluid, DamBreakFrontFollowsMartinAndMoyce) {
     const auto k = static_cast<std::size_t>(frame);
     const double z = front[k] + (front[k + 1] - front[k]) * (frame - static_cast<double>(k));
     EXPECT_NEAR(z, m.z, 0.1 * m.z) << "at T = " << m.t << " (t = " << t << " s)";
+    std::cout << "measured: T " << m.t << " Z " << z << " (experiment " << m.z << ", "
+              << 100 * (z / m.z - 1) << " %)\n";
   }
 }
 
@@ -177,10 +185,14 @@ TEST(Fluid, ABoxFloatsAtTheDepthArchimedesGivesAndADenserOneSinks) {
       const double surface = (n * kS * kS * kS + mass / 1000) / (l * l);
       const double expected = surface - mass / (1000 * box * box) + box / 2;
       EXPECT_NEAR(y, expected, kS / 4) << "density " << density;
+      std::cout << "measured: box of " << density << " kg/m^3 floats at " << y << " m, " << expected
+                << " m expected\n";
     } else {
       // Wholly under: it displaces its whole volume.
       const double surface = (n * kS * kS * kS + box * box * box) / (l * l);
       EXPECT_LT(y + box / 2, surface) << "density " << density << ": it should sink";
+      std::cout << "measured: box of " << density << " kg/m^3: top at " << y + box / 2
+                << " m, surface at " << surface << " m\n";
     }
   }
 }
