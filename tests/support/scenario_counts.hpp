@@ -9,11 +9,11 @@
 namespace detsim::test {
 
 /// `wanted`, within the scene's max_count (0 for a scene without a count), except the dam break's
-/// block, at most 4 particles across (256 particles): its default, 10 across, is 4000 fluid
+/// block, at most 3 particles across (108 particles): its default, 10 across, is 4000 fluid
 /// particles, seconds a frame under the sanitizers.
 inline std::uint32_t scenario_test_count(const ScenarioInfo& info, std::uint32_t wanted) {
   const std::uint32_t n = std::min(wanted, info.max_count);
-  return info.name == "dam_break" ? std::min(n, 4U) : n;
+  return info.name == "dam_break" ? std::min(n, 3U) : n;
 }
 
 }  // namespace detsim::test
