@@ -9,10 +9,12 @@
 
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -213,70 +215,74 @@ TEST(CliNetplay, TwoProcessesPlayTheSameMatchAndRecordTheSameReplay) {
   EXPECT_EQ(json_value(verify.out, "final_hash"), json_value(out_a, "final_hash"));
 }
 
-/// A relay between two netplay processes that removes every hash check from their datagrams
-/// (resealing them: the checksum is no key). Player 0 talks to `to_b` as if it were player 1,
-/// player 1 to `to_a` as if it were player 0.
-class CheckStripper {
+/// A relay between two netplay processes: player 0 talks to it as if it were player 1 and player
+/// 1 as if it were player 0. Each datagram goes through `edit(direction, n, bytes, out)`
+/// (direction 0: from A to B; n counts that direction's datagrams), which appends what to forward
+/// to `out`: nothing (drop), the bytes changed, copies, or datagrams held back from before.
+class Relay {
  public:
-  static std::optional<CheckStripper> open(std::uint16_t port_a, std::uint16_t port_b,
-                                           std::uint16_t relay_port) {
+  using Bytes = std::vector<std::uint8_t>;
+  using Edit =
+      std::function<void(int direction, std::uint64_t n, const Bytes& in, std::vector<Bytes>& out)>;
+  static std::optional<Relay> open(std::uint16_t port_a, std::uint16_t port_b,
+                                   std::uint16_t relay_port, Edit edit) {
     const auto at = [](std::uint16_t port) { return net::parse_endpoint(endpoint(port)).value(); };
     const net::UdpPeer a[] = {{0, at(port_a)}};
     const net::UdpPeer b[] = {{1, at(port_b)}};
     auto to_b = net::UdpTransport::open(at(relay_port), a);  // receives from A, sends to A
     auto to_a = net::UdpTransport::open(at(static_cast<std::uint16_t>(relay_port + 1)), b);
     if (!to_b || !to_a) return std::nullopt;
-    return CheckStripper(std::move(to_b.value()), std::move(to_a.value()));
+    return Relay(std::move(to_b.value()), std::move(to_a.value()), std::move(edit));
   }
-  /// Forwards what arrived, without its checks; returns how many checks it removed so far.
-  std::uint64_t pump() {
-    forward(from_a_, from_b_, 1);
-    forward(from_b_, from_a_, 0);
-    return stripped_;
+  /// Forwards what arrived since the last call.
+  void pump() {
+    forward(from_a_, from_b_, 1, 0);
+    forward(from_b_, from_a_, 0, 1);
   }
 
  private:
-  CheckStripper(net::UdpTransport a, net::UdpTransport b)
-      : from_a_(std::move(a)), from_b_(std::move(b)) {}
-  void forward(net::UdpTransport& in, net::UdpTransport& out, net::PeerId to) {
+  Relay(net::UdpTransport a, net::UdpTransport b, Edit edit)
+      : from_a_(std::move(a)), from_b_(std::move(b)), edit_(std::move(edit)) {}
+  void forward(net::UdpTransport& in, net::UdpTransport& out, net::PeerId to, int direction) {
     inbox_.clear();
     in.receive(inbox_);
     for (const net::Datagram& d : inbox_) {
-      net::protocol::Packet p;
-      std::vector<std::uint8_t> bytes = d.bytes;
-      if (net::protocol::decode(d.bytes, 3, p) == net::protocol::DecodeError::none &&
-          p.header.type == net::protocol::PacketType::input && !p.input.checks.empty()) {
-        stripped_ += p.input.checks.size();
-        p.input.checks.clear();
-        if (!net::protocol::encode(p, 3, bytes)) continue;
-      }
-      out.send(to, bytes);
+      outbox_.clear();
+      edit_(direction, count_[direction]++, d.bytes, outbox_);
+      for (const Bytes& bytes : outbox_)
+        out.send(to, bytes);
     }
   }
   net::UdpTransport from_a_;
   net::UdpTransport from_b_;
+  Edit edit_;
+  std::uint64_t count_[2] = {0, 0};
   std::vector<net::Datagram> inbox_;
-  std::uint64_t stripped_ = 0;
+  std::vector<Bytes> outbox_;
 };
 
-TEST(CliNetplay, ARelayThatStripsTheHashChecksMakesBothPeersExitUnverified) {
-  // Before: every frame "passed" with no check compared at all. Now each peer says which checks
-  // never arrived and exits 1, like a desync.
+/// Two netplay processes, players 0 and 1, talking through a relay that `edit`s their datagrams
+/// (`common` are both processes' further arguments), run until both exit or 60 s passed.
+struct RelayedPair {
+  std::unique_ptr<Process> a;
+  std::unique_ptr<Process> b;
+  bool finished = false;
+};
+
+RelayedPair run_through_relay(const std::vector<std::string>& common, const Relay::Edit& edit,
+                              const std::string& name) {
   for (int attempt = 0; attempt < 6; ++attempt) {
     const std::uint16_t base = port_for(attempt + 20);
-    auto relay = CheckStripper::open(base, static_cast<std::uint16_t>(base + 1),
-                                     static_cast<std::uint16_t>(base + 2));
+    auto relay = Relay::open(base, static_cast<std::uint16_t>(base + 1),
+                             static_cast<std::uint16_t>(base + 2), edit);
     if (!relay) continue;
-    const std::vector<std::string> common = {"--players", "2",      "--frames",  "600", "--fps",
-                                             "1000",      "--json", "--timeout", "3"};
-    std::vector<std::string> a = {"netplay",
-                                  "--me",
-                                  "0",
-                                  "--bind",
-                                  endpoint(base),
-                                  "--peer",
-                                  "1=" + endpoint(static_cast<std::uint16_t>(base + 2))};
+    std::vector<std::string> a = {
+        "netplay",      "--players", "2",
+        "--me",         "0",         "--bind",
+        endpoint(base), "--peer",    "1=" + endpoint(static_cast<std::uint16_t>(base + 2))};
     std::vector<std::string> b = {"netplay",
+                                  "--players",
+                                  "2",
                                   "--me",
                                   "1",
                                   "--bind",
@@ -285,32 +291,56 @@ TEST(CliNetplay, ARelayThatStripsTheHashChecksMakesBothPeersExitUnverified) {
                                   "0=" + endpoint(static_cast<std::uint16_t>(base + 3))};
     a.insert(a.end(), common.begin(), common.end());
     b.insert(b.end(), common.begin(), common.end());
-    Process pa(a, "strip_a");
-    Process pb(b, "strip_b");
+    RelayedPair pair{std::make_unique<Process>(a, name + "_a"),
+                     std::make_unique<Process>(b, name + "_b"), false};
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    std::uint64_t stripped = 0;
     bool done_a = false;
     bool done_b = false;
     while (!(done_a && done_b) && std::chrono::steady_clock::now() < deadline) {
-      stripped = relay->pump();
-      done_a = done_a || pa.poll();
-      done_b = done_b || pb.poll();
+      relay->pump();
+      done_a = done_a || pair.a->poll();
+      done_b = done_b || pair.b->poll();
       std::this_thread::sleep_for(std::chrono::microseconds(200));
     }
-    if (bind_failed(pa) || bind_failed(pb)) continue;
-    ASSERT_TRUE(done_a && done_b) << "killed after 60 s\nA: " << pa.err() << "\nB: " << pb.err();
-    EXPECT_GT(stripped, 10U);
-    for (const Process* p : {&pa, &pb}) {
-      EXPECT_EQ(p->exit_code(), 1) << p->out() << p->err();
-      EXPECT_EQ(json_value(p->out(), "frames"), "600") << p->out();
-      EXPECT_EQ(json_value(p->out(), "desyncs"), "0") << p->out();
-      EXPECT_EQ(json_value(p->out(), "unverified"), "1") << p->out();
-      EXPECT_TRUE(has(p->err(), "UNVERIFIED")) << p->err();
-      EXPECT_TRUE(has(p->err(), "checks of frames 1 .. 600")) << p->err();
-    }
-    return;
+    if (bind_failed(*pair.a) || bind_failed(*pair.b)) continue;
+    pair.finished = done_a && done_b;
+    return pair;
   }
-  FAIL() << "no free ports after 6 attempts";
+  ADD_FAILURE() << "no free ports after 6 attempts";
+  return {};
+}
+
+TEST(CliNetplay, ARelayThatStripsTheHashChecksMakesBothPeersExitUnverified) {
+  // Before: every frame "passed" with no check compared at all. Now each peer says which checks
+  // never arrived and exits 1, like a desync. Plain framing: the relay decodes each datagram and
+  // reseals it without its checks (the checksum is no key).
+  std::uint64_t stripped = 0;
+  const Relay::Edit strip = [&stripped](int, std::uint64_t, const Relay::Bytes& in,
+                                        std::vector<Relay::Bytes>& out) {
+    net::protocol::Packet p;
+    Relay::Bytes bytes = in;
+    if (net::protocol::decode(in, 3, p) == net::protocol::DecodeError::none &&
+        p.header.type == net::protocol::PacketType::input && !p.input.checks.empty()) {
+      stripped += p.input.checks.size();
+      p.input.checks.clear();
+      if (!net::protocol::encode(p, 3, bytes)) return;
+    }
+    out.push_back(bytes);
+  };
+  const RelayedPair pair = run_through_relay(
+      {"--frames", "600", "--fps", "1000", "--json", "--timeout", "3"}, strip, "strip");
+  ASSERT_TRUE(pair.a && pair.b);
+  ASSERT_TRUE(pair.finished) << "killed after 60 s\nA: " << pair.a->err()
+                             << "\nB: " << pair.b->err();
+  EXPECT_GT(stripped, 10U);
+  for (const Process* p : {pair.a.get(), pair.b.get()}) {
+    EXPECT_EQ(p->exit_code(), 1) << p->out() << p->err();
+    EXPECT_EQ(json_value(p->out(), "frames"), "600") << p->out();
+    EXPECT_EQ(json_value(p->out(), "desyncs"), "0") << p->out();
+    EXPECT_EQ(json_value(p->out(), "unverified"), "1") << p->out();
+    EXPECT_TRUE(has(p->err(), "UNVERIFIED")) << p->err();
+    EXPECT_TRUE(has(p->err(), "checks of frames 1 .. 600")) << p->err();
+  }
 }
 
 TEST(CliNetplay, AnInjectedPeerDesyncsAndBisectNamesTheFrameBodyAndField) {
@@ -389,6 +419,68 @@ TEST(CliNetplay, WithAKeyThePeersPlaySealedAndAnotherKeyIsRefusedByName) {
                     "the same --key"))
         << p->err();
   }
+}
+
+TEST(CliNetplay, ASealedMatchThroughARelayThatRewritesReplaysAndReordersEndsHonest) {
+  // With a key, between two processes: the relay flips a byte of every 7th datagram, cuts 9
+  // bytes (a hash check's worth) out of every 11th, sends every 5th twice and again with a copy
+  // of one from 30 datagrams before, and swaps every 4th with the next. Every altered datagram
+  // fails its tag and every copy is caught by the replay window before decryption: the match
+  // plays on what the players sent, every check compared.
+  if (!net::protection::available()) GTEST_SKIP() << "built without libsodium: no --key";
+  std::vector<std::deque<Relay::Bytes>> history(2);
+  std::vector<std::optional<Relay::Bytes>> held(2);
+  std::uint64_t altered = 0;
+  std::uint64_t copies = 0;
+  const Relay::Edit edit = [&](int d, std::uint64_t n, const Relay::Bytes& in,
+                               std::vector<Relay::Bytes>& out) {
+    const auto direction = static_cast<std::size_t>(d);
+    Relay::Bytes bytes = in;
+    if (n % 7 == 3) {
+      bytes[n % bytes.size()] ^= 0x20;
+      ++altered;
+    } else if (n % 11 == 5 && bytes.size() > 30) {
+      bytes.erase(bytes.begin() + 10, bytes.begin() + 19);
+      ++altered;
+    }
+    if (n % 4 == 1) {
+      held[direction] = bytes;  // sent after the next one
+      return;
+    }
+    out.push_back(bytes);
+    if (held[direction]) {
+      out.push_back(*held[direction]);
+      held[direction].reset();
+    }
+    std::deque<Relay::Bytes>& past = history[direction];
+    if (n % 5 == 0) {
+      out.push_back(bytes);
+      ++copies;
+      if (past.size() == 30) {
+        out.push_back(past.front());
+        ++copies;
+      }
+    }
+    past.push_back(in);
+    if (past.size() > 30) past.pop_front();
+  };
+  const RelayedPair pair = run_through_relay(
+      {"--frames", "600", "--fps", "1000", "--json", "--key", test_key}, edit, "sealed_relay");
+  ASSERT_TRUE(pair.a && pair.b);
+  ASSERT_TRUE(pair.finished) << "killed after 60 s\nA: " << pair.a->err()
+                             << "\nB: " << pair.b->err();
+  EXPECT_GT(altered, 100U);
+  EXPECT_GT(copies, 100U);
+  for (const Process* p : {pair.a.get(), pair.b.get()}) {
+    EXPECT_EQ(p->exit_code(), 0) << p->out() << p->err();
+    EXPECT_EQ(json_value(p->out(), "protected"), "true") << p->out();
+    EXPECT_EQ(json_value(p->out(), "frames"), "600") << p->out();
+    EXPECT_EQ(json_value(p->out(), "desyncs"), "0") << p->out();
+    EXPECT_EQ(json_value(p->out(), "unverified"), "0") << p->out();
+    EXPECT_NE(json_value(p->out(), "dropped_unauthenticated"), "0") << p->out();
+    EXPECT_NE(json_value(p->out(), "dropped_replayed"), "0") << p->out();
+  }
+  EXPECT_EQ(json_value(pair.a->out(), "final_hash"), json_value(pair.b->out(), "final_hash"));
 }
 
 TEST(CliNetplay, ASpectatorReachesThePlayersHashAndRecordsTheSameReplay) {
