@@ -32,12 +32,12 @@
 //
 //   auto net = SimNetwork::create(2, /*seed=*/42, {.latency_us = 30'000, .loss_ppm = 20'000});
 //   if (!net) { report(net.message()); return; }
-//   Transport& a = net.value().endpoint(0);
+//   Transport& a = net.value().endpoint(0);  // give each to its side: Session::create(.., a)
 //   Transport& b = net.value().endpoint(1);
 //   for (std::uint64_t t = 0; t < 10'000'000; t += 1'000) {
-//     net.value().advance_to(t);
-//     session_a.poll(a);  // any code taking a Transport&
-//     session_b.poll(b);
+//     net.value().advance_to(t);  // delivers what is due by virtual time t
+//     session_a.poll(t);          // each side reads its endpoint, on the same clock
+//     session_b.poll(t);
 //   }
 #pragma once
 

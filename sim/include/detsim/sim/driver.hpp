@@ -59,7 +59,7 @@ struct Transform {
 ///
 /// Typical frame:
 ///
-///     driver.advance(world, elapsed_ns, [&](detsim::World& w) { game.apply_inputs(w); });
+///     driver.advance(world, elapsed_ns, [&](World& w) { game.apply_inputs(w, w.frame()); });
 ///     for (BodyId id : visible) draw(*driver.interpolated(world, id));
 ///
 /// Rendering is the one place where leaving Fixed is right: convert the interpolated transform's
