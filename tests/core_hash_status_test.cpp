@@ -1,4 +1,4 @@
-// detsim::core's hash and error values. hash64 and Hash64Stream are the one hash every module uses
+// detsim::core's hash and error values. hash_bytes and Hash64Stream are the one hash every module uses
 // (state hashes, checksums, replay hash chains), so they are checked against xxHash's own XXH3-64
 // called directly; Expected's operators are checked for reaching the value in place.
 #include <cstdint>
@@ -25,19 +25,19 @@ TEST(Hash64, IsXxh3WithSeedZero) {
   // Lengths around XXH3's internal boundaries (16, 128, 240 bytes, one stripe block).
   for (std::size_t n : {0U, 1U, 3U, 8U, 16U, 17U, 128U, 129U, 240U, 241U, 1024U, 5000U}) {
     const auto bytes = counting_bytes(n);
-    EXPECT_EQ(hash64(bytes), XXH3_64bits(bytes.data(), bytes.size())) << n << " bytes";
+    EXPECT_EQ(hash_bytes(bytes), XXH3_64bits(bytes.data(), bytes.size())) << n << " bytes";
   }
 }
 
 TEST(Hash64Stream, EqualsTheHashOfTheConcatenation) {
   const auto bytes = counting_bytes(3000);
   Hash64Stream stream;
-  EXPECT_EQ(stream.digest(), hash64({}));
+  EXPECT_EQ(stream.digest(), hash_bytes({}));
   std::size_t at = 0;
   for (std::size_t piece : {0U, 1U, 7U, 64U, 500U, 1000U, 1428U}) {
     stream.update({bytes.data() + at, piece});
     at += piece;
-    EXPECT_EQ(stream.digest(), hash64({bytes.data(), at})) << at << " bytes";
+    EXPECT_EQ(stream.digest(), hash_bytes({bytes.data(), at})) << at << " bytes";
   }
   EXPECT_EQ(at, bytes.size());
 }
@@ -48,10 +48,10 @@ TEST(Hash64Stream, CopiesContinueIndependently) {
   a.update({bytes.data(), 40});
   Hash64Stream b = a;
   a.update({bytes.data() + 40, 60});
-  EXPECT_EQ(a.digest(), hash64(bytes));
-  EXPECT_EQ(b.digest(), hash64({bytes.data(), 40}));
+  EXPECT_EQ(a.digest(), hash_bytes(bytes));
+  EXPECT_EQ(b.digest(), hash_bytes({bytes.data(), 40}));
   b = a;
-  EXPECT_EQ(b.digest(), hash64(bytes));
+  EXPECT_EQ(b.digest(), hash_bytes(bytes));
 }
 
 TEST(Expected, NonConstAccessChangesTheValueInPlace) {

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -133,6 +134,42 @@ TEST(ReplayFile, WhatIsWrittenReadsBackExactly) {
   EXPECT_EQ(seen, (std::vector<std::uint64_t>{58, 59, 60, 61, 62, 63}));
   EXPECT_FALSE(r.frame(0));
   EXPECT_FALSE(r.frame(174));
+}
+
+TEST(ReplayFile, SessionFingerprintsDifferWhenAnythingPeersShareDiffers) {
+  // Every field that makes two runs differ changes the handshake value, and so do the match
+  // bytes a game adds; the keyframe interval, each machine's own choice, does not.
+  const Fingerprint base = sample_fingerprint();
+  const std::uint64_t reference = session_fingerprint(base);
+  const std::vector<std::function<void(Fingerprint&)>> changes = {
+      [](Fingerprint& f) { f.detsim_version = "0.1.1"; },
+      [](Fingerprint& f) { f.fixed_fraction_bits = 16; },
+      [](Fingerprint& f) { f.state_version += 1; },
+      [](Fingerprint& f) { f.state_sections.pop_back(); },
+      [](Fingerprint& f) { f.scenario = "arena2"; },
+      [](Fingerprint& f) { f.params.seed += 1; },
+      [](Fingerprint& f) { f.params.players += 1; },
+      [](Fingerprint& f) { f.params.count += 1; },
+      [](Fingerprint& f) { f.dt = Fixed::from_raw(f.dt.raw() + 1); },
+      [](Fingerprint& f) { f.substeps += 1; },
+      [](Fingerprint& f) { f.iterations += 1; },
+      [](Fingerprint& f) { f.players += 1; },
+      [](Fingerprint& f) { f.input_size += 1; },
+      [](Fingerprint& f) { f.initial_hash ^= 1; },
+  };
+  for (std::size_t i = 0; i < changes.size(); ++i) {
+    Fingerprint f = base;
+    changes[i](f);
+    EXPECT_NE(session_fingerprint(f), reference) << "change " << i;
+  }
+  Fingerprint other_interval = base;
+  other_interval.keyframe_interval = 600;
+  EXPECT_EQ(session_fingerprint(other_interval), reference);
+  const std::uint8_t rollback_600[] = {0, 0x58, 0x02};
+  const std::uint8_t lockstep_600[] = {1, 0x58, 0x02};
+  EXPECT_NE(session_fingerprint(base, rollback_600), reference);
+  EXPECT_NE(session_fingerprint(base, rollback_600), session_fingerprint(base, lockstep_600));
+  EXPECT_EQ(session_fingerprint(base, rollback_600), session_fingerprint(base, rollback_600));
 }
 
 TEST(ReplayFile, ChainHashIsXxh3OfTheLittleEndianFrameHashes) {

@@ -207,6 +207,32 @@ TEST(SimWorld, ImpulsesChangeVelocityByImpulseOverMass) {
   EXPECT_EQ(w.body(id)->linear_velocity.x, 2.25_fx);
 }
 
+TEST(SimWorld, UserDataIsSetSavedAndHashedWithoutWakingTheBody) {
+  World w = make_world();
+  add_ground(w);
+  BodyDef d = box_at(0_fx, 0.5_fx, 0_fx);
+  d.user_data = 7;
+  const BodyId box = add(w, d);
+  for (int i = 0; i < 120; ++i)
+    w.step();
+  ASSERT_FALSE(w.body(box)->awake);
+  const std::uint64_t before = w.hashes().total;
+  const std::vector<std::uint8_t> saved = w.save();
+  ASSERT_TRUE(w.set_user_data(box, 0xFEED'0000'0000'0042ULL).ok());
+  EXPECT_EQ(w.body(box)->user_data, 0xFEED'0000'0000'0042ULL);
+  EXPECT_FALSE(w.body(box)->awake) << "a tag is not a push";
+  EXPECT_NE(w.hashes().total, before) << "the game's tag is part of the state peers compare";
+  const std::vector<std::uint8_t> tagged = w.save();
+  ASSERT_TRUE(w.restore(saved).ok());
+  EXPECT_EQ(w.body(box)->user_data, 7U);
+  ASSERT_TRUE(w.restore(tagged).ok());
+  EXPECT_EQ(w.body(box)->user_data, 0xFEED'0000'0000'0042ULL);
+  const Status unknown = w.set_user_data(BodyId{999}, 1);
+  EXPECT_FALSE(unknown.ok());
+  EXPECT_TRUE(contains_text(unknown.message(), "999")) << unknown.message();
+  EXPECT_EQ(w.save(), tagged) << "a refusal changes nothing";
+}
+
 TEST(SimWorld, LayersAndMasksFilterCollisions) {
   World w = make_world();
   BodyDef ground;

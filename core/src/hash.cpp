@@ -5,7 +5,7 @@
 
 namespace detsim {
 
-std::uint64_t hash64(std::span<const std::uint8_t> bytes) noexcept {
+std::uint64_t hash_bytes(std::span<const std::uint8_t> bytes) noexcept {
   return XXH3_64bits(bytes.data(), bytes.size());
 }
 

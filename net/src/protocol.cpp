@@ -94,7 +94,7 @@ void put(std::vector<std::uint8_t>& out, std::uint64_t v, std::size_t n) {
 }
 
 std::uint32_t checksum(std::span<const std::uint8_t> bytes) noexcept {
-  return static_cast<std::uint32_t>(hash64(bytes));
+  return static_cast<std::uint32_t>(hash_bytes(bytes));
 }
 
 // Run-length tokens over the XOR deltas: t < 128 -> t + 1 literals follow; t >= 128 -> t - 127

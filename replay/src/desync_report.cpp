@@ -135,7 +135,7 @@ Status write_desync_report(const std::string& path, const DesyncReport& report) 
   file.u32(desync_report_version);
   file.u64(payload.size());
   file.raw(payload.bytes());
-  file.u64(hash64(payload.bytes()));
+  file.u64(hash_bytes(payload.bytes()));
 
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> out(std::fopen(path.c_str(), "wb"), &std::fclose);
   if (!out) return Status::error("desync report " + path + ": cannot create the file");
@@ -170,7 +170,7 @@ Expected<DesyncReport> parse_desync_report(std::span<const std::uint8_t> bytes,
   const std::span<const std::uint8_t> payload =
       bytes.subspan(kHeaderSize, static_cast<std::size_t>(size));
   ByteReader trailer(bytes.last(kTrailerSize));
-  if (trailer.u64("checksum") != hash64(payload))
+  if (trailer.u64("checksum") != hash_bytes(payload))
     return fail(bytes.size() - kTrailerSize,
                 "the payload's XXH3 checksum does not match (corrupted)");
 

@@ -65,6 +65,20 @@ void write_fingerprint(const Fingerprint& f, ByteWriter& w) {
   w.u64(f.initial_hash);
 }
 
+}  // namespace detail
+
+std::uint64_t session_fingerprint(const Fingerprint& f, std::span<const std::uint8_t> match) {
+  Fingerprint shared = f;
+  shared.keyframe_interval = 0;
+  ByteWriter w;
+  w.raw({reinterpret_cast<const std::uint8_t*>("detsim session"), 14});
+  detail::write_fingerprint(shared, w);
+  w.raw(match);
+  return hash_bytes(w.bytes());
+}
+
+namespace detail {
+
 bool read_fingerprint(ByteReader& r, Fingerprint& f) {
   const auto str = [&r](const char* what) {
     const std::uint8_t n = r.u8(what);
@@ -217,7 +231,7 @@ struct ReplayWriter::Impl {
     w.u32(type);
     w.u32(static_cast<std::uint32_t>(payload.size()));
     w.raw(payload);
-    w.u64(hash64(w.bytes()));
+    w.u64(hash_bytes(w.bytes()));
     if (std::fwrite(w.bytes().data(), 1, w.size(), file.get()) != w.size() ||
         std::fflush(file.get()) != 0)
       return fail("cannot write: " + os_error());
@@ -399,7 +413,7 @@ struct ReplayReader::Impl {
     std::uint64_t stored = 0;
     for (int i = 0; i < 8; ++i)
       stored |= std::uint64_t{bytes[body + static_cast<std::size_t>(i)]} << (8 * i);
-    const std::uint64_t computed = hash64({bytes.data(), body});
+    const std::uint64_t computed = detsim::hash_bytes({bytes.data(), body});
     if (stored != computed)
       return error_at(offset, "chunk " + chunk_name(type) + " of " + std::to_string(length) +
                                   " bytes: checksum " + hex64(stored) +

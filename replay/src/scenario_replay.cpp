@@ -285,7 +285,7 @@ Expected<VerifyResult> verify(const ReplayReader& reader, const VerifyOptions& o
         stop_error = state.status();
         return false;
       }
-      if (hash64(state.value()) != record.hashes.total) {
+      if (hash_bytes(state.value()) != record.hashes.total) {
         stop_error = Status::error(reader.path() + ": the keyframe of frame " +
                                    std::to_string(record.frame) +
                                    " does not hash to its frame's recorded hash");

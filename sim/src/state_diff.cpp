@@ -452,7 +452,7 @@ constexpr SectionDiffer kDiffers[] = {
 /// frame: the first field of "globals" (state_io.cpp), 0 when unreadable.
 StateHashes hashes_of(std::span<const std::uint8_t> bytes, std::uint64_t& frame) {
   StateHashes h;
-  h.total = hash64(bytes);
+  h.total = hash_bytes(bytes);
   frame = 0;
   if (auto sections = read_state_sections(bytes)) {
     for (const StateSection& s : *sections) {

@@ -380,7 +380,7 @@ bool valid_section_name(std::string_view name) noexcept {
 }
 
 std::uint64_t section_hash(const StateSection& section) noexcept {
-  return hash64(section.record);
+  return hash_bytes(section.record);
 }
 
 Expected<std::vector<StateSection>> read_state_sections(std::span<const std::uint8_t> bytes) {
@@ -489,9 +489,9 @@ StateHashes World::save(std::vector<std::uint8_t>& out) const {
   for (std::size_t i = 0; i < sim_detail::kSectionCount; ++i) {
     const std::size_t from = e.starts[i];
     h.sections.push_back(
-        {sim_detail::kSections[i].name, hash64({bytes + from, e.starts[i + 1] - from})});
+        {sim_detail::kSections[i].name, hash_bytes({bytes + from, e.starts[i + 1] - from})});
   }
-  h.total = hash64({bytes, e.w.size()});
+  h.total = hash_bytes({bytes, e.w.size()});
   out = e.w.take();
   return h;
 }
@@ -501,7 +501,7 @@ Expected<std::uint64_t> World::body_hash(BodyId id) const {
   if (i < 0) return Status::error("no body with ID " + std::to_string(id.value));
   ByteWriter w;
   sim_detail::write_body(s_->bodies[static_cast<std::size_t>(i)], w);
-  return hash64(w.bytes());
+  return hash_bytes(w.bytes());
 }
 
 Expected<std::uint64_t> World::particle_group_hash(ParticleGroupId id) const {
@@ -509,7 +509,7 @@ Expected<std::uint64_t> World::particle_group_hash(ParticleGroupId id) const {
   if (k < 0) return Status::error("no particle group with ID " + std::to_string(id.value));
   ByteWriter w;
   sim_detail::write_particle_group(s_->particle_groups[static_cast<std::size_t>(k)], 0, w);
-  return hash64(w.bytes());
+  return hash_bytes(w.bytes());
 }
 
 }  // namespace detsim

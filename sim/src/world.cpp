@@ -399,6 +399,13 @@ Status World::set_angular_velocity(BodyId id, Vec3 velocity) {
   });
 }
 
+Status World::set_user_data(BodyId id, std::uint64_t user_data) {
+  return with_body(*s_, id, false, [&](BodyState& b) {
+    b.user_data = user_data;
+    return ok();
+  });
+}
+
 Status World::apply_force(BodyId id, Vec3 force) {
   return with_body(*s_, id, true, [&](BodyState& b) {
     Vec3 f;

@@ -75,25 +75,11 @@ void put_text(std::vector<std::uint8_t>& out, std::string_view text) {
 
 std::uint64_t session_fingerprint(const Scenario& scenario, net::SessionMode mode,
                                   std::uint64_t frames) {
-  const replay::Fingerprint f = replay::fingerprint_of(scenario);
-  std::vector<std::uint8_t> bytes;
-  put_text(bytes, "detsim netplay 1");
-  put_text(bytes, f.detsim_version);
-  put_u64(bytes, f.fixed_fraction_bits);
-  put_u64(bytes, f.state_version);
-  put_text(bytes, f.scenario);
-  put_u64(bytes, f.params.seed);
-  put_u64(bytes, f.params.players);
-  put_u64(bytes, f.params.count);
-  put_u64(bytes, static_cast<std::uint64_t>(f.dt.raw()));
-  put_u64(bytes, f.substeps);
-  put_u64(bytes, f.iterations);
-  put_u64(bytes, f.players);
-  put_u64(bytes, f.input_size);
-  put_u64(bytes, f.initial_hash);
-  put_u64(bytes, static_cast<std::uint64_t>(mode));
-  put_u64(bytes, frames);
-  return hash64(bytes);
+  std::vector<std::uint8_t> match;
+  put_text(match, "detsim netplay 2");
+  put_u64(match, static_cast<std::uint64_t>(mode));
+  put_u64(match, frames);
+  return replay::session_fingerprint(replay::fingerprint_of(scenario), match);
 }
 
 // ---- detsim scenarios ---------------------------------------------------------------------------

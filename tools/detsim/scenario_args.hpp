@@ -34,9 +34,8 @@ std::string describe(const Scenario& scenario);
 /// Every scenario's name, comma-separated.
 std::string scenario_names();
 
-/// What the peers of a session must share to play together (SessionConfig::fingerprint): XXH3-64
-/// of the replay fingerprint's fields (detsim version, number format, state version, scenario and
-/// parameters, step settings, players, input size, initial state hash), the session mode and the
+/// What the peers of a session must share to play together (SessionConfig::fingerprint):
+/// replay::session_fingerprint of the scenario's replay fingerprint, with the session mode and the
 /// match's length in frames (peers that stop at different frames would record different replays).
 std::uint64_t session_fingerprint(const Scenario& scenario, net::SessionMode mode,
                                   std::uint64_t frames);

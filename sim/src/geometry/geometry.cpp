@@ -40,7 +40,7 @@ std::shared_ptr<const Geometry> make_hull_geometry(Hull hull) {
   ByteWriter w;
   w.u8(static_cast<std::uint8_t>(g->type));
   write_hull_content(hull, w);
-  g->hash = hash64(w.bytes());
+  g->hash = hash_bytes(w.bytes());
   g->data = std::move(hull);
   return g;
 }
@@ -53,7 +53,7 @@ std::shared_ptr<const Geometry> make_mesh_geometry(Mesh mesh) {
   ByteWriter w;
   w.u8(static_cast<std::uint8_t>(g->type));
   write(mesh, w);
-  g->hash = hash64(w.bytes());
+  g->hash = hash_bytes(w.bytes());
   g->data = std::move(mesh);
   return g;
 }
@@ -64,7 +64,7 @@ std::shared_ptr<const Geometry> make_heightfield_geometry(Heightfield hf) {
   ByteWriter w;
   w.u8(static_cast<std::uint8_t>(g->type));
   write(hf, w);
-  g->hash = hash64(w.bytes());
+  g->hash = hash_bytes(w.bytes());
   g->data = std::move(hf);
   return g;
 }
@@ -90,7 +90,7 @@ std::shared_ptr<const Geometry> make_compound_geometry(Compound compound) {
   ByteWriter w;
   w.u8(static_cast<std::uint8_t>(g->type));
   write_compound_content(compound, w);
-  g->hash = hash64(w.bytes());
+  g->hash = hash_bytes(w.bytes());
   g->data = std::move(compound);
   return g;
 }

@@ -9,14 +9,15 @@
 
 namespace detsim {
 
-/// XXH3-64 with seed 0 of `bytes` (the empty span included).
-[[nodiscard]] std::uint64_t hash64(std::span<const std::uint8_t> bytes) noexcept;
+/// XXH3-64 with seed 0 of `bytes` (the empty span included): what a game whose state lives beside
+/// the World returns from net::Game::save() for its own bytes, so its hashes are detsim's.
+[[nodiscard]] std::uint64_t hash_bytes(std::span<const std::uint8_t> bytes) noexcept;
 
 /// XXH3-64 of bytes that arrive in pieces: after any sequence of update() calls, digest() equals
-/// hash64() of their concatenation. Copies continue independently from the same point.
+/// hash_bytes() of their concatenation. Copies continue independently from the same point.
 class Hash64Stream {
  public:
-  /// An empty stream (digest() == hash64({})). Throws std::bad_alloc when out of memory.
+  /// An empty stream (digest() == hash_bytes({})). Throws std::bad_alloc when out of memory.
   Hash64Stream();
   Hash64Stream(const Hash64Stream& other);
   Hash64Stream& operator=(const Hash64Stream& other);

@@ -58,6 +58,14 @@ struct Fingerprint {
 [[nodiscard]] Fingerprint fingerprint_of(
     const Scenario& scenario, std::uint32_t keyframe_interval = default_keyframe_interval);
 
+/// What the peers of a session must agree on before they play (net::SessionConfig::fingerprint):
+/// XXH3-64 of every field of `f` but keyframe_interval (each machine's own choice), followed by
+/// `match`: bytes the game adds for what the fingerprint does not hold (the session mode, the
+/// match's length, its own rules and settings). Peers with different values refuse each other at
+/// the handshake, naming the fingerprint, instead of desyncing at the first frame.
+[[nodiscard]] std::uint64_t session_fingerprint(const Fingerprint& f,
+                                                std::span<const std::uint8_t> match = {});
+
 /// One frame: the inputs of the step that produced it (players * input_size bytes, player order)
 /// and the hashes of the state after that step. Frame numbers start at 1.
 struct FrameRecord {

@@ -254,6 +254,9 @@ class World {
   Status set_transform(BodyId id, Vec3 position, Quat orientation);
   Status set_linear_velocity(BodyId id, Vec3 velocity);
   Status set_angular_velocity(BodyId id, Vec3 velocity);
+  /// Changes a body's user data (BodyDef::user_data: the game's own tag, saved and hashed with
+  /// the body, so a game may keep an entity index or a team in it). Does not wake the body.
+  Status set_user_data(BodyId id, std::uint64_t user_data);
 
   // ---- Joints (docs/JOINTS-WIP.md: what is done, what is not yet) ----
 
