@@ -1,6 +1,6 @@
 // FixedStepDriver: the same states whatever the host's frame rate and jitter, exact step counts
-// over long runs, alpha, the frame clamp and the step cap, the before_step callback, interpolation,
-// and configuration errors.
+// over long runs, alpha, the frame clamp and the step cap, the before_step and after_step
+// callbacks, interpolation (also of a world a session steps), and configuration errors.
 //
 // Expected step counts and alphas come from the definition, not from the driver's tick unit: after
 // T ns of accepted time there have been floor(T / (dt.raw() * 10^9 / 2^32 ns)) steps, computed
@@ -436,6 +436,30 @@ TEST(SimDriver, BeforeStepRunsOncePerStepAtTheFrameAboutToBeStepped) {
   EXPECT_EQ(world.rng().state(), expected.state());
 }
 
+TEST(SimDriver, AfterStepRunsOncePerStepAtTheFrameJustStepped) {
+  // before_step sees frame f, the step makes f + 1, after_step sees f + 1 — in that order, once
+  // per step, any callable.
+  World world = make_world();
+  FixedStepDriver driver = make_driver();
+  std::vector<std::int64_t> log;  // +frame for before_step, -frame for after_step
+  std::uint64_t steps = 0;
+  for (const std::int64_t elapsed : {40'000'000, 0, 16'666'667, 100'000'000}) {
+    steps += driver.advance(
+        world, elapsed, [&](World& w) { log.push_back(static_cast<std::int64_t>(w.frame())); },
+        [&](World& w) { log.push_back(-static_cast<std::int64_t>(w.frame())); });
+  }
+  ASSERT_GT(steps, 4U);
+  ASSERT_EQ(log.size(), 2 * steps);
+  for (std::size_t i = 0; i < steps; ++i) {
+    EXPECT_EQ(log[2 * i], static_cast<std::int64_t>(i));
+    EXPECT_EQ(log[2 * i + 1], -static_cast<std::int64_t>(i + 1));
+  }
+  const std::uint64_t before = world.frame();
+  const std::uint64_t more =
+      driver.advance(world, 50'000'000, FixedStepDriver::NoInput{}, count_call);
+  EXPECT_EQ(world.frame(), before + more);
+}
+
 TEST(SimDriver, AnExceptionFromBeforeStepLeavesTheStepUntaken) {
   World world = make_world(def_with_dt(dt_64));
   FixedStepDriver driver = make_driver();
@@ -477,6 +501,38 @@ Spinner make_spinner() {
 Transform pose(const World& w, BodyId id) {
   const BodyState b = test::state(w, id);
   return {b.position, b.orientation};
+}
+
+TEST(SimDriver, TakeDueStepsCountsLikeAdvanceAndInterpolatesWhatSomethingElseStepped) {
+  // Two hosts with the same frame times: one lets the driver step its world, the other takes
+  // the due count and steps the world itself (as a session does), capturing the poses before
+  // the last step. Same counts, same counters, same alpha, the same interpolated poses.
+  Spinner driven = make_spinner();
+  Spinner stepped = make_spinner();
+  FixedStepDriver a = make_driver();
+  FixedStepDriver b = make_driver();
+  std::mt19937_64 random(17);
+  for (int frame = 0; frame < 200; ++frame) {
+    SCOPED_TRACE(frame);
+    const auto elapsed = static_cast<std::int64_t>(random() % 40'000'000);
+    const std::uint32_t n = a.advance(driven.world, elapsed);
+    const std::uint32_t due = b.take_due_steps(stepped.world, elapsed);
+    ASSERT_EQ(due, n);
+    for (std::uint32_t i = 0; i < due; ++i) {
+      if (i + 1 == due) b.capture_poses(stepped.world);
+      stepped.world.step();
+    }
+    ASSERT_EQ(stepped.world.frame(), driven.world.frame());
+    EXPECT_EQ(b.alpha(), a.alpha());
+    EXPECT_EQ(b.total_steps(), a.total_steps());
+    EXPECT_EQ(b.interpolated(stepped.world, stepped.id), a.interpolated(driven.world, driven.id));
+  }
+  // A host that did not step after capturing (a session at its prediction limit) is drawn where
+  // its world is: no blend towards a frame that never came.
+  ASSERT_EQ(b.take_due_steps(stepped.world, step_64_ns * 3 / 2), 1U);
+  b.capture_poses(stepped.world);
+  EXPECT_EQ(b.interpolated(stepped.world, stepped.id), pose(stepped.world, stepped.id));
+  EXPECT_EQ(b.take_due_steps(stepped.world, -5), 0U) << "time going backwards adds nothing";
 }
 
 TEST(SimDriver, InterpolationStartsAtThePreviousPoseAndApproachesTheCurrentOne) {

@@ -51,8 +51,7 @@ Expected<FixedStepDriver> FixedStepDriver::create(const DriverConfig& config) {
   return FixedStepDriver(config);
 }
 
-std::uint32_t FixedStepDriver::advance_erased(World& world, std::int64_t elapsed_ns,
-                                              void* before_step, void (*call)(void*, World&)) {
+std::uint64_t FixedStepDriver::take_time(const World& world, std::int64_t elapsed_ns) {
   const std::int64_t dt_raw = world.def().dt.raw();
   // World validates dt in (0, 1] s; refusing anything else keeps the division below defined even
   // if that ever changed.
@@ -74,9 +73,14 @@ std::uint32_t FixedStepDriver::advance_erased(World& world, std::int64_t elapsed
     skipped_steps_ += due - steps;
     accumulator_ticks_ -= (due - steps) * step_ticks_;
   }
+  return steps;
+}
 
+std::uint32_t FixedStepDriver::advance_erased(World& world, std::int64_t elapsed_ns, Hook before,
+                                              Hook after) {
+  const std::uint64_t steps = take_time(world, elapsed_ns);
   for (std::uint64_t i = 0; i < steps; ++i) {
-    call(before_step, world);
+    before.call(before.callable, world);
     if (i + 1 == steps) {
       // The poses the last step starts from, after the game's inputs (a teleport in before_step
       // is then not drawn as a sweep across the world).
@@ -87,8 +91,22 @@ std::uint32_t FixedStepDriver::advance_erased(World& world, std::int64_t elapsed
     accumulator_ticks_ -= step_ticks_;
     ++total_steps_;
     if (i + 1 == steps) interpolation_frame_ = world.frame();
+    after.call(after.callable, world);
   }
   return static_cast<std::uint32_t>(steps);
+}
+
+std::uint32_t FixedStepDriver::take_due_steps(const World& world, std::int64_t elapsed_ns) {
+  const std::uint64_t steps = take_time(world, elapsed_ns);
+  accumulator_ticks_ -= steps * step_ticks_;
+  total_steps_ += steps;
+  if (steps > 0) interpolation_frame_ = 0;  // until capture_poses() names the new start
+  return static_cast<std::uint32_t>(steps);
+}
+
+void FixedStepDriver::capture_poses(const World& world) {
+  capture_previous_poses(world);
+  interpolation_frame_ = world.frame() + 1;
 }
 
 void FixedStepDriver::capture_previous_poses(const World& world) {

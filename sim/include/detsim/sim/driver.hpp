@@ -66,7 +66,7 @@ struct Transform {
 /// components with Fixed::to_double() for the graphics API; never feed such values back.
 class FixedStepDriver {
  public:
-  /// The default before_step: applies no input.
+  /// The default before_step and after_step: does nothing.
   struct NoInput {
     void operator()(World&) const noexcept {}
   };
@@ -83,38 +83,49 @@ class FixedStepDriver {
   /// dropped_ns()) and steps `world` once per whole world.def().dt in the accumulator, up to
   /// config().max_steps_per_advance times. Before each step it calls `before_step(world)` (a
   /// callable taking World&), where the game applies its inputs for the frame about to be stepped
-  /// (world.frame() is that frame). Returns the number of steps taken.
+  /// (world.frame() is that frame), and after it `after_step(world)`, where the game reads what
+  /// the step did (events, scores kept beside the world) while world.frame() is the new frame.
+  /// Returns the number of steps taken.
   ///
   /// Zero or negative elapsed time (a clock that went backwards) adds no time and is not counted
   /// anywhere; it takes a step only if an interrupted advance left one pending.
   /// An exception from `before_step` propagates; the steps taken until then are accounted for and
-  /// the step it interrupted is not taken.
-  template <class BeforeStep = NoInput>
-  std::uint32_t advance(World& world, std::int64_t elapsed_ns, BeforeStep&& before_step = {}) {
-    static_assert(std::is_invocable_v<BeforeStep&, World&>,
-                  "before_step must be callable as before_step(world) with a World&");
-    using Callable = std::remove_reference_t<BeforeStep>;
-    if constexpr (std::is_function_v<Callable>) {
-      // A plain function: pass its address, an object the type-erased call can point to.
-      Callable* function = &before_step;
-      return advance(world, elapsed_ns, function);
-    } else {
-      // The callable lives until this call returns, so a pointer to it is enough (no allocation,
-      // unlike std::function). The const_cast only erases the type: the call below restores it.
-      return advance_erased(
-          world, elapsed_ns,
-          const_cast<void*>(static_cast<const void*>(std::addressof(before_step))),
-          [](void* callable, World& w) { (*static_cast<Callable*>(callable))(w); });
-    }
+  /// the step it interrupted is not taken. One from `after_step` propagates after its step.
+  template <class BeforeStep = NoInput, class AfterStep = NoInput>
+  std::uint32_t advance(World& world, std::int64_t elapsed_ns, BeforeStep&& before_step = {},
+                        AfterStep&& after_step = {}) {
+    auto&& before = as_object(before_step);  // a function becomes a pointer kept alive here
+    auto&& after = as_object(after_step);
+    return advance_erased(world, elapsed_ns, hook(before), hook(after));
   }
 
   /// advance() with a std::chrono duration (anything implicitly convertible to nanoseconds).
-  template <class BeforeStep = NoInput>
+  template <class BeforeStep = NoInput, class AfterStep = NoInput>
   std::uint32_t advance(World& world, std::chrono::nanoseconds elapsed,
-                        BeforeStep&& before_step = {}) {
+                        BeforeStep&& before_step = {}, AfterStep&& after_step = {}) {
     return advance(world, static_cast<std::int64_t>(elapsed.count()),
-                   std::forward<BeforeStep>(before_step));
+                   std::forward<BeforeStep>(before_step), std::forward<AfterStep>(after_step));
   }
+
+  /// The clock without the stepping, for a world that something else steps — a net::Session,
+  /// which steps it in net::Game::advance and re-simulates on rollback. Adds `elapsed_ns` exactly
+  /// as advance() does and returns how many frames are due now (the same number advance() would
+  /// step); the host advances its session that many times, calling capture_poses(world) right
+  /// before the last, and interpolated() then blends from those poses:
+  ///
+  ///     const std::uint32_t due = driver.take_due_steps(world, elapsed_ns);
+  ///     for (std::uint32_t i = 0; i < due; ++i) {
+  ///       if (i + 1 == due) driver.capture_poses(world);
+  ///       (void)session.advance_frame(my_input);
+  ///     }
+  ///     for (BodyId id : visible) draw(*driver.interpolated(world, id));
+  ///
+  /// A rollback inside that last advance moves bodies from where they were drawn to where they
+  /// are: the blend hides the correction. `world` is only read (its dt).
+  [[nodiscard]] std::uint32_t take_due_steps(const World& world, std::int64_t elapsed_ns);
+  /// The poses to interpolate from: interpolated() blends from them to the current pose while
+  /// `world` is one frame past the frame it is at now (else it returns the current pose).
+  void capture_poses(const World& world);
 
   /// How far the accumulated time is into the next step, in [0, 1): the remainder divided by dt,
   /// rounded down (so never 1). 0 before the first advance().
@@ -151,8 +162,31 @@ class FixedStepDriver {
 
   explicit FixedStepDriver(const DriverConfig& config) noexcept : config_(config) {}
 
-  std::uint32_t advance_erased(World& world, std::int64_t elapsed_ns, void* before_step,
-                               void (*call)(void*, World&));
+  /// A callable by address and how to call it: the callable lives until advance() returns, so a
+  /// pointer is enough (no allocation, unlike std::function).
+  struct Hook {
+    void* callable;
+    void (*call)(void*, World&);
+  };
+  template <class F>
+  static decltype(auto) as_object(F& f) noexcept {
+    if constexpr (std::is_function_v<F>) {
+      return &f;
+    } else {
+      return (f);
+    }
+  }
+  template <class F>
+  static Hook hook(F& f) noexcept {
+    static_assert(std::is_invocable_v<F&, World&>,
+                  "before_step and after_step must be callable as f(world) with a World&");
+    // The const_cast only erases the type: the call restores it.
+    return Hook{const_cast<void*>(static_cast<const void*>(std::addressof(f))),
+                [](void* callable, World& w) { (*static_cast<F*>(callable))(w); }};
+  }
+  /// Adds the elapsed time and drops the steps beyond the cap; returns the steps due now.
+  std::uint64_t take_time(const World& world, std::int64_t elapsed_ns);
+  std::uint32_t advance_erased(World& world, std::int64_t elapsed_ns, Hook before, Hook after);
   void capture_previous_poses(const World& world);
 
   DriverConfig config_{};
