@@ -1,6 +1,6 @@
-// detsim::core's hash and error values. hash_bytes and Hash64Stream are the one hash every module uses
-// (state hashes, checksums, replay hash chains), so they are checked against xxHash's own XXH3-64
-// called directly; Expected's operators are checked for reaching the value in place.
+// detsim::core's hash and error values. hash_bytes and Hash64Stream are the one hash every module
+// uses (state hashes, checksums, replay hash chains), so they are checked against xxHash's own
+// XXH3-64 called directly; Expected's operators are checked for reaching the value in place.
 #include <cstdint>
 #include <string>
 #include <vector>
