@@ -76,17 +76,21 @@ const std::string& fields_help() {
            "); particle_group[G].particle[I].position.x|y|z, "
            "particle_group[G].particle[I].velocity.x|y|z, particle_group[G].force.x|y|z, "
            "particle_group[G].sleep_time, particle_group[G].tether_impulse (BODY 0; DELTA a "
-           "decimal, added), particle_group[G].awake (BODY 0; DELTA 1 toggles)";
+           "decimal, added), particle_group[G].awake (BODY 0; DELTA 1 toggles); game.NAME (BODY "
+           "0; a field of the world's game state description, DELTA added at its width), "
+           "game.byte[N] (BODY 0; DELTA an integer, added mod 256)";
   }();
   return help;
 }
 
-enum class DeltaKind { fixed, toggle, integer, presence };
+/// `number`: a decimal for a Fixed field, an integer for the others (a game state's field, whose
+/// type only the world's description knows when the injection is applied).
+enum class DeltaKind { fixed, toggle, integer, presence, number };
 
 /// What a field name refers to, once parsed.
 struct Target {
   DeltaKind kind = DeltaKind::fixed;
-  enum class Part { body, rng, contact, joint, particles } part = Part::body;
+  enum class Part { body, rng, contact, joint, particles, game } part = Part::body;
   std::string base;             ///< "position", "sleep_time", "normal_impulse", ...
   int component = -1;           ///< x y z = 0 1 2, w = 3; the RNG word; -1: none
   std::uint32_t other = 0;      ///< contact: the other body
@@ -238,6 +242,22 @@ Expected<Target> parse_field(std::string_view field) {
     t.kind = flag ? DeltaKind::toggle : DeltaKind::fixed;
     return t;
   }
+  if (field.starts_with("game.")) {
+    // game.byte[N] or game.NAME, a field of the world's description (World::describe_game_state).
+    const std::string_view name = field.substr(5);
+    t.part = Target::Part::game;
+    std::string_view rest;
+    if (auto byte = indexed(name, "byte", rest); byte && rest.empty()) {
+      if (*byte >= max_game_state_size) return unknown();
+      t.point = static_cast<std::size_t>(*byte);
+      t.kind = DeltaKind::integer;
+      return t;
+    }
+    if (name.empty()) return unknown();
+    t.base = std::string(name);
+    t.kind = DeltaKind::number;
+    return t;
+  }
   if (field == "present") {
     t.base = "present";
     t.kind = DeltaKind::presence;
@@ -285,7 +305,51 @@ Status check_delta(const Target& t, std::string_view delta) {
       if (delta != "-1" && delta != "+1" && delta != "1")
         return Status::error("DELTA for present must be -1 (remove the body) or +1 (add a copy)");
       return Status::success();
+    case DeltaKind::number:
+      if (!parse_i64(delta) && !Fixed::parse(delta))
+        return Status::error("DELTA \"" + std::string(delta) + "\" is not a number");
+      return Status::success();
   }
+  return Status::success();
+}
+
+/// Adds `delta` to a byte or a described field of the game state (wrapping at the field's width;
+/// a Fixed field saturating like Fixed's addition).
+Status change_game_state(sim_detail::WorldState& s, const Target& t, std::string_view delta) {
+  std::vector<std::uint8_t>& game = s.game;
+  if (t.base.empty()) {  // game.byte[N]
+    if (t.point >= game.size())
+      return Status::error("the game state has " + std::to_string(game.size()) +
+                           " bytes, no byte " + std::to_string(t.point));
+    game[t.point] =
+        static_cast<std::uint8_t>(game[t.point] + static_cast<std::uint64_t>(*parse_i64(delta)));
+    return Status::success();
+  }
+  const auto f = std::find_if(s.game_fields.begin(), s.game_fields.end(),
+                              [&t](const GameField& g) { return g.name == t.base; });
+  if (f == s.game_fields.end())
+    return Status::error("the world's game state description has no field \"" + t.base + "\"");
+  const std::size_t size = game_field_size(f->type);
+  if (std::size_t{f->offset} + size > game.size())
+    return Status::error("field \"" + t.base + "\" ends past the game state (" +
+                         std::to_string(game.size()) + " bytes)");
+  std::uint64_t raw = 0;
+  for (std::size_t k = 0; k < size; ++k)
+    raw |= std::uint64_t{game[f->offset + k]} << (8 * k);
+  if (f->type == GameFieldType::fixed) {
+    const ParseResult d = Fixed::parse(delta);
+    if (!d) return Status::error("DELTA \"" + std::string(delta) + "\": " + describe(d.error));
+    raw = static_cast<std::uint64_t>(
+        (Fixed::from_raw(static_cast<std::int64_t>(raw)) + d.value).raw());
+  } else {
+    const auto d = parse_i64(delta);
+    if (!d)
+      return Status::error("DELTA \"" + std::string(delta) +
+                           "\" for an integer field must be an integer");
+    raw += static_cast<std::uint64_t>(*d);
+  }
+  for (std::size_t k = 0; k < size; ++k)
+    game[f->offset + k] = static_cast<std::uint8_t>(raw >> (8 * k));
   return Status::success();
 }
 
@@ -452,6 +516,8 @@ Expected<Injection> parse_injection(std::string_view spec) {
     return Status::error(where + "BODY must be 0 for an RNG field");
   if (target->part == Target::Part::joint && *body != 0)
     return Status::error(where + "BODY must be 0 for a joint field (the joint is named in it)");
+  if (target->part == Target::Part::game && *body != 0)
+    return Status::error(where + "BODY must be 0 for a field of the game state");
   if (target->part == Target::Part::particles && *body != 0)
     return Status::error(where +
                          "BODY must be 0 for a particle group field (the group is named in it)");
@@ -482,6 +548,12 @@ Status apply_injection(World& world, const Injection& injection) {
         static_cast<std::uint64_t>(*parse_i64(injection.delta));
     if (!s.rng.set_state(state))
       return Status::error(where + "the change would leave the all-zero RNG state");
+    return Status::success();
+  }
+
+  if (t.part == Target::Part::game) {
+    if (Status st = change_game_state(s, t, injection.delta); !st)
+      return Status::error(where + st.message());
     return Status::success();
   }
 

@@ -441,11 +441,86 @@ struct SectionDiffer {
   bool needs_worlds = true;  ///< reads the restored worlds (else only the bytes)
 };
 
+/// A described field's value in a game state (little-endian), or "absent" past its end.
+std::string game_value(std::span<const std::uint8_t> bytes, const GameField& f) {
+  const std::size_t size = game_field_size(f.type);
+  if (std::size_t{f.offset} + size > bytes.size()) return "absent";
+  std::uint64_t raw = 0;
+  for (std::size_t k = 0; k < size; ++k)
+    raw |= std::uint64_t{bytes[f.offset + k]} << (8 * k);
+  const auto sign_extended = [raw, size]() {
+    const unsigned shift = static_cast<unsigned>(64 - 8 * size);
+    return static_cast<std::int64_t>(raw << shift) >> shift;
+  };
+  switch (f.type) {
+    case GameFieldType::i8:
+    case GameFieldType::i16:
+    case GameFieldType::i32:
+    case GameFieldType::i64:
+      return std::to_string(sign_extended()) + " (" + hex(raw) + ")";
+    case GameFieldType::fixed:
+      return show(Fixed::from_raw(static_cast<std::int64_t>(raw)));
+    default:
+      return show(raw);
+  }
+}
+
+/// Bytes [from, to) as hex digits, "0a0b0c".
+std::string hex_bytes(std::span<const std::uint8_t> bytes, std::size_t from, std::size_t to) {
+  std::string out;
+  for (std::size_t i = from; i < to; ++i) {
+    char digits[3];
+    std::snprintf(digits, sizeof digits, "%02x", bytes[i]);
+    out += digits;
+  }
+  return out;
+}
+
+// The game's own state: its size, then each described field (World::describe_game_state) in the
+// description's order, then the differing runs of bytes no field covers ("bytes[12..15]").
+void diff_game(Collector& c, const Sides& w) {
+  const std::span<const std::uint8_t> a = w.a->game_state();
+  const std::span<const std::uint8_t> b = w.b->game_state();
+  if (a.size() != b.size())
+    c.add("game", 0, "size", show(std::uint64_t{a.size()}), show(std::uint64_t{b.size()}));
+  const std::span<const GameField> fields = w.a->game_state_fields();
+  const std::size_t common = std::min(a.size(), b.size());
+  std::vector<bool> covered(common, false);
+  for (const GameField& f : fields) {
+    const std::string va = game_value(a, f);
+    const std::string vb = game_value(b, f);
+    if (va != vb) c.add("game", 0, f.name, va, vb);
+    const std::size_t end = std::min(common, std::size_t{f.offset} + game_field_size(f.type));
+    for (std::size_t i = f.offset; i < end; ++i)
+      covered[i] = true;
+  }
+  constexpr std::size_t longest_shown = 16;  // bytes of a run printed; a longer one is cut
+  for (std::size_t i = 0; i < common;) {
+    if (covered[i] || a[i] == b[i]) {
+      ++i;
+      continue;
+    }
+    std::size_t end = i + 1;
+    while (end < common && !covered[end] && a[end] != b[end])
+      ++end;
+    const std::size_t shown = std::min(end, i + longest_shown);
+    const std::string more = shown < end ? "..." : "";
+    c.add("game", 0, "bytes[" + std::to_string(i) + ".." + std::to_string(end - 1) + "]",
+          hex_bytes(a, i, shown) + more, hex_bytes(b, i, shown) + more);
+    i = end;
+  }
+}
+
 /// A new section of the World's state adds its differ here.
 constexpr SectionDiffer kDiffers[] = {
-    {"globals", diff_globals},     {"geometry", diff_geometry, false}, {"rng", diff_rng},
-    {"bodies", diff_bodies},       {"contacts", diff_contact_cache},   {"joints", diff_joints},
+    {"globals", diff_globals},
+    {"geometry", diff_geometry, false},
+    {"rng", diff_rng},
+    {"bodies", diff_bodies},
+    {"contacts", diff_contact_cache},
+    {"joints", diff_joints},
     {"particles", diff_particles},
+    {"game", diff_game},
 };
 
 /// The hashes of a state's sections from its bytes (a state that may not restore here), and its

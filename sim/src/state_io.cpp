@@ -289,30 +289,47 @@ constexpr std::size_t kSectionCount = std::size(kSections);
 // The container: "DSIM", the version, the section count, then each section's record.
 constexpr std::size_t kMaxSectionName = max_section_name;
 
+/// The game's own state (World::set_game_state): a section after the World's, present only when
+/// the game set one, so that a world without it saves what it always did. Its payload is the
+/// game's bytes as they are.
+constexpr const char* kGameSection = "game";
+constexpr std::uint32_t kGameSectionVersion = 1;
+
 /// Where the sections of an encoded state start and end, for the hashes.
 struct Encoded {
   ByteWriter w;
-  std::array<std::size_t, kSectionCount + 1> starts{};  // the last entry: the end of the state
+  std::size_t count = 0;  ///< sections written: kSectionCount, + 1 with a game section
+  std::array<std::size_t, kSectionCount + 2> starts{};  // then the end of the state
 };
 
+void begin_section(Encoded& e, std::size_t i, std::string_view name, std::uint32_t version) {
+  e.starts[i] = e.w.size();
+  e.w.var(name.size());
+  e.w.raw({reinterpret_cast<const std::uint8_t*>(name.data()), name.size()});
+  e.w.var(version);
+}
+
 void encode(const WorldState& s, Encoded& e) {
-  e.w.reserve(256 + s.bodies.size() * 96 + s.contacts.size() * 72 + s.joints.size() * 96);
+  e.w.reserve(256 + s.bodies.size() * 96 + s.contacts.size() * 72 + s.joints.size() * 96 +
+              s.game.size());
+  e.count = kSectionCount + (s.game.empty() ? 0 : 1);
   e.w.u32(kMagic);
   e.w.u32(kVersion);
-  e.w.var(kSectionCount);
+  e.w.var(e.count);
   for (std::size_t i = 0; i < kSectionCount; ++i) {
     const WorldSection& section = kSections[i];
-    e.starts[i] = e.w.size();
-    const std::string_view name = section.name;
-    e.w.var(name.size());
-    e.w.raw({reinterpret_cast<const std::uint8_t*>(name.data()), name.size()});
-    e.w.var(section.version);
+    begin_section(e, i, section.name, section.version);
     const std::size_t length_at = e.w.size();
     e.w.u32(0);
     section.write(s, e.w);
     e.w.patch_u32(length_at, static_cast<std::uint32_t>(e.w.size() - length_at - 4));
   }
-  e.starts[kSectionCount] = e.w.size();
+  if (!s.game.empty()) {
+    begin_section(e, kSectionCount, kGameSection, kGameSectionVersion);
+    e.w.u32(static_cast<std::uint32_t>(s.game.size()));
+    e.w.raw(s.game);
+  }
+  e.starts[e.count] = e.w.size();
 }
 
 // Reads and validates a whole state; on failure returns false with `error` set.
@@ -330,8 +347,21 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
   std::string names;
   for (const WorldSection& ws : kSections)
     names += std::string(names.empty() ? "" : ", ") + ws.name;
+  names += std::string(", and a game's own state: \"") + kGameSection + "\"";
   for (std::size_t i = 0; i < sections->size(); ++i) {
     const StateSection& found = (*sections)[i];
+    if (i == kSectionCount && found.name == kGameSection) {
+      if (found.version != kGameSectionVersion)
+        return failed_at(found.offset, std::string("section \"") + kGameSection + "\" version " +
+                                           std::to_string(found.version) + ", this build reads " +
+                                           std::to_string(kGameSectionVersion));
+      if (found.payload.empty() || found.payload.size() > max_game_state_size)
+        return failed_at(found.payload_offset, std::string("section \"") + kGameSection +
+                                                   "\": " + std::to_string(found.payload.size()) +
+                                                   " bytes, expected 1 .. " +
+                                                   std::to_string(max_game_state_size));
+      continue;
+    }
     if (i >= kSectionCount || found.name != kSections[i].name)
       return failed_at(found.offset,
                        "section \"" + std::string(found.name) + "\" where " +
@@ -364,6 +394,11 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
     if (!r.at_end())
       return failed_at(r.offset(), where + std::to_string(r.remaining()) +
                                        " unexpected bytes after the section's fields");
+  }
+  s.game.clear();
+  if (sections->size() > kSectionCount) {
+    const std::span<const std::uint8_t> game = (*sections)[kSectionCount].payload;
+    s.game.assign(game.begin(), game.end());
   }
   return true;
 }
@@ -463,6 +498,7 @@ Status World::restore(std::span<const std::uint8_t> bytes) {
   // Whatever the state does not name is set aside again, not forgotten.
   scratch->geometries = s_->geometries;
   scratch->geometries.insert(scratch->geometries.end(), s_->retained.begin(), s_->retained.end());
+  scratch->game_fields = s_->game_fields;  // a description, like the geometry: not the state's
   const sim_detail::GeometryTable known = scratch->geometries;
   std::string error;
   if (!sim_detail::read_state(bytes, *scratch, error)) return Status::error(error);
@@ -485,11 +521,12 @@ StateHashes World::save(std::vector<std::uint8_t>& out) const {
   sim_detail::encode(*s_, e);
   const std::uint8_t* bytes = e.w.bytes().data();
   StateHashes h;
-  h.sections.reserve(sim_detail::kSectionCount);
-  for (std::size_t i = 0; i < sim_detail::kSectionCount; ++i) {
+  h.sections.reserve(e.count);
+  for (std::size_t i = 0; i < e.count; ++i) {
     const std::size_t from = e.starts[i];
-    h.sections.push_back(
-        {sim_detail::kSections[i].name, hash_bytes({bytes + from, e.starts[i + 1] - from})});
+    const char* name =
+        i < sim_detail::kSectionCount ? sim_detail::kSections[i].name : sim_detail::kGameSection;
+    h.sections.push_back({name, hash_bytes({bytes + from, e.starts[i + 1] - from})});
   }
   h.total = hash_bytes({bytes, e.w.size()});
   out = e.w.take();

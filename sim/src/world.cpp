@@ -406,6 +406,49 @@ Status World::set_user_data(BodyId id, std::uint64_t user_data) {
   });
 }
 
+Status World::set_game_state(std::span<const std::uint8_t> bytes) {
+  if (bytes.empty())
+    return Status::error("game state: expected 1 .. " + std::to_string(max_game_state_size) +
+                         " bytes, got none");
+  if (bytes.size() > max_game_state_size)
+    return Status::error("game state: " + std::to_string(bytes.size()) + " bytes, at most " +
+                         std::to_string(max_game_state_size));
+  s_->game.assign(bytes.begin(), bytes.end());
+  return Status::success();
+}
+
+std::span<const std::uint8_t> World::game_state() const noexcept {
+  return s_->game;
+}
+
+Status World::describe_game_state(std::span<const GameField> fields) {
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const GameField& f = fields[i];
+    const std::string which = "game state field " + std::to_string(i) + " \"" + f.name + "\": ";
+    const bool good_name = !f.name.empty() && f.name.size() <= 64 &&
+                           std::all_of(f.name.begin(), f.name.end(), [](char c) {
+                             return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
+                                    (c >= '0' && c <= '9') || c == '_' || c == '.' || c == '[' ||
+                                    c == ']';
+                           });
+    if (!good_name)
+      return Status::error(which + "a name is 1..64 characters of A-Z a-z 0-9 _ . [ ]");
+    if (f.type > GameFieldType::fixed)
+      return Status::error(which + "unknown type " + std::to_string(static_cast<unsigned>(f.type)));
+    if (std::uint64_t{f.offset} + game_field_size(f.type) > max_game_state_size)
+      return Status::error(which + "ends past the largest game state (" +
+                           std::to_string(max_game_state_size) + " bytes)");
+    for (std::size_t k = 0; k < i; ++k)
+      if (fields[k].name == f.name) return Status::error(which + "named twice");
+  }
+  s_->game_fields.assign(fields.begin(), fields.end());
+  return Status::success();
+}
+
+std::span<const GameField> World::game_state_fields() const noexcept {
+  return s_->game_fields;
+}
+
 Status World::apply_force(BodyId id, Vec3 force) {
   return with_body(*s_, id, true, [&](BodyState& b) {
     Vec3 f;

@@ -113,6 +113,10 @@ struct WorldState {
   std::uint32_t next_joint_id = 1;
   std::vector<ParticleGroup> particle_groups;  ///< ascending ID
   std::uint32_t next_particle_group_id = 1;
+  /// The game's own state (World::set_game_state): the "game" section when not empty.
+  std::vector<std::uint8_t> game;
+  /// Its fields' names for diff (World::describe_game_state): a description, not saved.
+  std::vector<GameField> game_fields;
   std::vector<Derived> derived;  ///< rebuilt each step
   /// Step scratch, not saved: where each joint's body_a and body_b are in `bodies` (parallel to
   /// `joints`), set by prepare_bodies for the stages after it so that they need not search for

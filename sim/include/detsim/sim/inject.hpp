@@ -30,6 +30,9 @@
 //                         field; DELTA: a decimal, added
 //   particle_group[G].awake
 //                         BODY 0; DELTA: 1 toggles the flag
+//   game.NAME             BODY 0; a field of the game state (World::describe_game_state names
+//                         it): DELTA an integer added at the field's width, a decimal for Fixed
+//   game.byte[N]          BODY 0; byte N of the game state; DELTA: an integer, added mod 256
 // Results that restore() would refuse (an orientation no longer a unit quaternion, a negative
 // sleep time, a static body awake, an all-zero RNG state, a joint's axis no longer a unit vector,
 // a particle beyond +-2^30 m or m/s) are refused, and the world is unchanged.

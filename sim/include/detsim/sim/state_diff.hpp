@@ -17,7 +17,7 @@ namespace detsim {
 /// One difference between state A and state B.
 struct FieldDiff {
   /// The state section the field is in (a World's: "globals", "geometry", "rng", "bodies",
-  /// "contacts", "joints").
+  /// "contacts", "joints", "particles", and "game" for a game's own state).
   std::string subsystem;
   /// The body the field belongs to, in any section ("bodies": the body; "contacts": the pair's
   /// lower ID); 0 for a field of no body (a joint's). A section's own "hash" line has 0.
@@ -30,7 +30,9 @@ struct FieldDiff {
   /// sub-shape 0 of body 23), the syntax --inject takes (inject.hpp); for joint 7:
   /// "joint[7].linear_impulse.x", "joint[7].broken", "joint[7].present"; for the geometry that
   /// the state names (registered geometry 3): "geometry[3]", with the values as the type and
-  /// content hash ("convex hull, content hash 0x..." or "absent").
+  /// content hash ("convex hull, content hash 0x..." or "absent"); in the game's own state
+  /// (body 0): a described field by its name ("score.player1"), "size", and runs of bytes no
+  /// field describes as "bytes[12..15]" with their hex digits.
   std::string field;
   std::string a;  ///< the value in A: decimal, then the raw bits ("0.5 (0x0000000080000000)")
   std::string b;  ///< the value in B, alike; "absent" for a body missing on that side

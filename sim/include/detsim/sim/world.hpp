@@ -18,6 +18,7 @@
 #include <detsim/core/status.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
+#include <detsim/sim/game_state.hpp>
 #include <detsim/sim/geometry.hpp>
 #include <detsim/sim/joint.hpp>
 #include <detsim/sim/mass.hpp>
@@ -379,6 +380,27 @@ class World {
   /// create_body would refuse overlaps nothing: the result is empty.
   [[nodiscard]] std::vector<BodyId> overlap(const Shape& shape, Vec3 position, Quat orientation,
                                             const QueryFilter& filter = {}) const;
+
+  // ---- The game's own state (<detsim/sim/game_state.hpp>) ----
+
+  /// Stores the game's own state beside the bodies: 1 .. max_game_state_size bytes in the game's
+  /// canonical encoding (fixed byte order, no padding, no pointers, no floating point). It is the
+  /// state's "game" section: saved, restored, hashed (its own part hash), compared by diff and
+  /// bisect, carried by keyframes and desync reports, so every tool sees it. Set it before the
+  /// first step and keep it for the run (a replay lists the sections of frame 0). A world that
+  /// never sets it has no such section: its states and hashes are what they were. Refused
+  /// (nothing changes): empty, or more than max_game_state_size bytes.
+  Status set_game_state(std::span<const std::uint8_t> bytes);
+  /// The game state (empty if never set).
+  [[nodiscard]] std::span<const std::uint8_t> game_state() const noexcept;
+  /// Names fields of the game state for diff and bisect ("score.player1" instead of a byte
+  /// range). A description, not state: not saved or hashed, kept by restore() and by copies of
+  /// the world (the world a diff restores states into must carry it: the game's own world at
+  /// frame 0). Replaces any earlier description. Refused (nothing changes), naming the field: a
+  /// bad or repeated name, or a field that ends past max_game_state_size.
+  Status describe_game_state(std::span<const GameField> fields);
+  /// The description (empty if none).
+  [[nodiscard]] std::span<const GameField> game_state_fields() const noexcept;
 
   // ---- State ----
 
