@@ -209,7 +209,7 @@ TEST(ScenarioReplay, FingerprintsThisBuildCannotReproduceAreRefused) {
   };
   Fingerprint f = good;
   f.scenario = "nope";
-  EXPECT_NE(error_for(f).find("scenario \"nope\" is not one of this build's scenarios"),
+  EXPECT_NE(error_for(f).find("scenario \"nope\" is not one of this program's scenarios"),
             std::string::npos);
   f = good;
   f.fixed_fraction_bits = 16;

@@ -144,7 +144,9 @@ Expected<Scenario> scenario_of(const Fingerprint& f, const std::string& name) {
         std::to_string(state_encoding_version) + "; detsim " + f.detsim_version + " recorded it");
   if (find_scenario(f.scenario) == nullptr)
     return Status::error(where + "scenario \"" + f.scenario +
-                         "\" is not one of this build's scenarios (detsim scenarios lists them)");
+                         "\" is not one of this program's scenarios (`scenarios` lists them; a "
+                         "game's own scenario is known to the program that registers it: its tool "
+                         "built on detsim::cli::run_cli)");
   if (f.input_size != PlayerInput::encoded_size)
     return Status::error(where + "inputs of " + std::to_string(f.input_size) +
                          " bytes, this build's scenarios take " +

@@ -1,7 +1,11 @@
 // The scenario registry, the Scenario driver, player inputs, and the scenes without game logic.
 #include <algorithm>
 #include <array>
+#include <deque>
+#include <functional>
+#include <mutex>
 #include <string>
+#include <vector>
 
 #include <detsim/fixed/math.hpp>
 #include <detsim/fixed/quat.hpp>
@@ -28,7 +32,9 @@ void build_pile_spheres(World& w, const ScenarioParams& p) {
   scenes_detail::build_pile(w, p, true);
 }
 
-// Sorted by name: scenario_list() is documented to be.
+namespace scenes {
+
+// The built-in scenarios, sorted by name.
 constexpr std::array entries{
     Entry{{"arena",
            "2-8 player-controlled spheres pushing crates in a walled arena; RNG-driven crate "
@@ -165,25 +171,78 @@ constexpr std::array entries{
           nullptr},
 };
 
-constexpr std::array<ScenarioInfo, entries.size()> infos = [] {
-  std::array<ScenarioInfo, entries.size()> out{};
-  for (std::size_t i = 0; i < entries.size(); ++i)
-    out[i] = entries[i].info;
-  return out;
-}();
+}  // namespace scenes
 
-const Entry* find_entry(std::string_view name) {
-  for (const Entry& e : entries) {
-    if (e.info.name == name) return &e;
+bool valid_scenario_name(std::string_view name) {
+  return !name.empty() && name.size() <= 32 && std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+  });
+}
+
+}  // namespace
+
+namespace scenes_detail {
+
+/// A scenario the registry can create: a built-in (its strings are literals) or a game's own
+/// (register_scenario: its strings are owned here and `info` views them).
+struct ScenarioEntry {
+  ScenarioInfo info;
+  std::string name;
+  std::string summary;
+  std::string count_unit;
+  WorldDef world;
+  std::function<void(World&, const ScenarioParams&)> build;
+  std::function<void(World&, std::span<const PlayerInput>, const ScenarioParams&)> control;
+};
+
+}  // namespace scenes_detail
+
+namespace {
+
+using scenes_detail::ScenarioEntry;
+
+/// Every scenario: the built-ins, then the games registered in this process. Entries are only
+/// appended (a deque keeps their addresses), so the info pointers and the entries Scenario objects
+/// point to stay valid.
+struct Registry {
+  std::mutex mutex;
+  std::deque<ScenarioEntry> entries;
+
+  Registry() {
+    for (const Entry& e : scenes::entries) {
+      ScenarioEntry& added = entries.emplace_back();
+      added.info = e.info;
+      added.build = e.build;
+      if (e.control != nullptr) added.control = e.control;
+    }
   }
-  return nullptr;
+  const ScenarioEntry* find(std::string_view name) {
+    const std::lock_guard lock(mutex);
+    for (const ScenarioEntry& e : entries)
+      if (e.info.name == name) return &e;
+    return nullptr;
+  }
+  std::vector<ScenarioInfo> infos() {
+    const std::lock_guard lock(mutex);
+    std::vector<ScenarioInfo> out;
+    for (const ScenarioEntry& e : entries)
+      out.push_back(e.info);
+    std::sort(out.begin(), out.end(),
+              [](const ScenarioInfo& a, const ScenarioInfo& b) { return a.name < b.name; });
+    return out;
+  }
+};
+
+Registry& registry() {
+  static Registry r;
+  return r;
 }
 
 std::string known_names() {
   std::string s;
-  for (const Entry& e : entries) {
+  for (const ScenarioInfo& info : registry().infos()) {
     if (!s.empty()) s += ", ";
-    s += e.info.name;
+    s += info.name;
   }
   return s;
 }
@@ -197,23 +256,61 @@ constexpr std::uint64_t mix(std::uint64_t z) noexcept {
 
 }  // namespace
 
-std::span<const ScenarioInfo> scenario_list() noexcept {
-  return infos;
+std::vector<ScenarioInfo> scenario_list() {
+  return registry().infos();
 }
 
 const ScenarioInfo* find_scenario(std::string_view name) noexcept {
-  for (const ScenarioInfo& info : infos) {
-    if (info.name == name) return &info;
-  }
-  return nullptr;
+  const ScenarioEntry* e = registry().find(name);
+  return e == nullptr ? nullptr : &e->info;
+}
+
+Status register_scenario(const ScenarioDefinition& d) {
+  const std::string which = "register_scenario \"" + d.name + "\": ";
+  if (!valid_scenario_name(d.name))
+    return Status::error(which + "a name is 1..32 characters of a-z, 0-9 and _");
+  if (!d.build) return Status::error(which + "build is empty: it makes the scene at frame 0");
+  if (d.default_frames == 0) return Status::error(which + "default_frames must be >= 1");
+  if (d.max_players > max_scenario_players)
+    return Status::error(which + "at most " + std::to_string(max_scenario_players) +
+                         " players, got max_players " + std::to_string(d.max_players));
+  if (d.min_players > d.max_players || d.default_players < d.min_players ||
+      d.default_players > d.max_players)
+    return Status::error(which +
+                         "players must satisfy min_players <= default_players <= "
+                         "max_players, got " +
+                         std::to_string(d.min_players) + ", " + std::to_string(d.default_players) +
+                         ", " + std::to_string(d.max_players));
+  if (d.default_count > d.max_count)
+    return Status::error(which + "default_count " + std::to_string(d.default_count) +
+                         " exceeds max_count " + std::to_string(d.max_count));
+  if (d.max_players > 0 && !d.control)
+    return Status::error(which + "a scenario with players needs control: their inputs go there");
+  if (Status s = World::create(d.world).status(); !s)
+    return Status::error(which + "world: " + s.message());
+  Registry& r = registry();
+  if (r.find(d.name) != nullptr)
+    return Status::error(which + "a scenario of that name exists (known: " + known_names() + ")");
+  const std::lock_guard lock(r.mutex);
+  ScenarioEntry& e = r.entries.emplace_back();
+  e.name = d.name;
+  e.summary = d.summary;
+  e.count_unit = d.count_unit;
+  e.info = ScenarioInfo{e.name,        e.summary,         d.default_frames, d.min_players,
+                        d.max_players, d.default_players, d.default_count,  d.max_count,
+                        d.uses_seed,   e.count_unit};
+  e.world = d.world;
+  e.build = d.build;
+  e.control = d.control;
+  return Status::success();
 }
 
 Expected<Scenario> Scenario::create(std::string_view name, const ScenarioParams& params) {
-  const Entry* e = find_entry(name);
+  const ScenarioEntry* e = registry().find(name);
   if (e == nullptr)
     return Status::error("unknown scenario '" + std::string(name) + "' (known: " + known_names() +
                          ")");
-  const ScenarioInfo& info = *find_scenario(name);
+  const ScenarioInfo& info = e->info;
   ScenarioParams p = params;
   if (p.players == 0) p.players = info.default_players;
   if (p.players < info.min_players || p.players > info.max_players) {
@@ -233,20 +330,24 @@ Expected<Scenario> Scenario::create(std::string_view name, const ScenarioParams&
                          std::to_string(info.max_count) + " " + std::string(info.count_unit) +
                          ", got " + std::to_string(p.count));
   }
-  WorldDef def;
+  WorldDef def = e->world;
   def.seed = p.seed;
   auto world = World::create(def);
   if (!world) return world.status();
   e->build(world.value(), p);
-  return Scenario(info, p, std::move(world.value()), e->control);
+  return Scenario(*e, p, std::move(world.value()));
+}
+
+const ScenarioInfo& Scenario::info() const noexcept {
+  return entry_->info;
 }
 
 void Scenario::step(std::span<const PlayerInput> inputs) {
-  if (control_ != nullptr) {
-    std::array<PlayerInput, 8> frame{};  // missing inputs are neutral
+  if (entry_->control) {
+    std::array<PlayerInput, max_scenario_players> frame{};  // missing inputs are neutral
     const std::size_t n = std::min<std::size_t>({inputs.size(), params_.players, frame.size()});
     std::copy_n(inputs.begin(), n, frame.begin());
-    control_(world_, std::span<const PlayerInput>(frame.data(), params_.players), params_);
+    entry_->control(world_, std::span<const PlayerInput>(frame.data(), params_.players), params_);
   }
   world_.step();
 }

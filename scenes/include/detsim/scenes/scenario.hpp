@@ -8,9 +8,12 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include <detsim/core/status.hpp>
 #include <detsim/sim/world.hpp>
@@ -55,10 +58,49 @@ struct ScenarioParams {
   friend constexpr bool operator==(const ScenarioParams&, const ScenarioParams&) noexcept = default;
 };
 
-/// Every scenario, in a fixed order (by name).
-[[nodiscard]] std::span<const ScenarioInfo> scenario_list() noexcept;
+/// The most players a scenario takes (and a session plays).
+inline constexpr std::uint32_t max_scenario_players = 8;
+
+/// A game's own scenario, for register_scenario(): how to build its scene and run its frames.
+/// Like the built-ins, its logic reads only the World (bodies, RNG, and the game's own state kept
+/// in it with World::set_game_state) and the frame's inputs, so the World's saved state is the
+/// game's whole state, and every tool that works on scenarios works on it.
+struct ScenarioDefinition {
+  std::string name;     ///< 1..32 characters of a-z, 0-9 and _; a replay records it
+  std::string summary;  ///< one line, for `detsim scenarios`
+  std::uint32_t default_frames = 600;
+  std::uint32_t min_players = 0;  ///< 0 .. max_players; 0 .. 0: takes no players
+  std::uint32_t max_players = 0;  ///< at most max_scenario_players
+  std::uint32_t default_players = 0;
+  std::uint32_t default_count = 0;  ///< 0: no `count` parameter; else its default
+  std::uint32_t max_count = 0;
+  bool uses_seed = false;
+  std::string count_unit = "bodies";
+  /// The world's settings (step, solver, gravity); its seed is replaced by the parameters'.
+  WorldDef world;
+  /// Builds the scene at frame 0 into the new, empty world: bodies, joints, the game state.
+  std::function<void(World&, const ScenarioParams&)> build;
+  /// A frame's game logic, before the world steps: one input per player (players() of them).
+  /// Required when the scenario takes players.
+  std::function<void(World&, std::span<const PlayerInput>, const ScenarioParams&)> control;
+};
+
+/// Adds a game's own scenario to this process's registry, so that Scenario::create, replays
+/// (record, verify, seek), desync reports, bisect's re-simulation, the sync test, the session
+/// adapters and the `detsim` commands run through detsim::cli::run_cli know it by name. Register
+/// before anything creates scenarios (at the start of main). An error, registering nothing, names
+/// the problem: a bad or taken name, an empty build, inconsistent player or count ranges, a world
+/// definition World::create refuses.
+Status register_scenario(const ScenarioDefinition& definition);
+
+/// Every scenario known to this process (the built-ins and the registered), sorted by name.
+[[nodiscard]] std::vector<ScenarioInfo> scenario_list();
 /// The scenario called `name`, or nullptr.
 [[nodiscard]] const ScenarioInfo* find_scenario(std::string_view name) noexcept;
+
+namespace scenes_detail {
+struct ScenarioEntry;
+}  // namespace scenes_detail
 
 class Scenario {
  public:
@@ -66,7 +108,7 @@ class Scenario {
   /// parameters are errors naming what is wrong and what is allowed.
   static Expected<Scenario> create(std::string_view name, const ScenarioParams& params = {});
 
-  [[nodiscard]] const ScenarioInfo& info() const noexcept { return *info_; }
+  [[nodiscard]] const ScenarioInfo& info() const noexcept;
   /// The parameters with the defaults filled in.
   [[nodiscard]] const ScenarioParams& params() const noexcept { return params_; }
   [[nodiscard]] World& world() noexcept { return world_; }
@@ -80,14 +122,12 @@ class Scenario {
   [[nodiscard]] BodyId player_body(std::uint32_t player) const;
 
  private:
-  using Control = void (*)(World&, std::span<const PlayerInput>, const ScenarioParams&);
-  Scenario(const ScenarioInfo& info, const ScenarioParams& params, World world, Control control)
-      : info_(&info), params_(params), world_(std::move(world)), control_(control) {}
+  Scenario(const scenes_detail::ScenarioEntry& entry, const ScenarioParams& params, World world)
+      : entry_(&entry), params_(params), world_(std::move(world)) {}
 
-  const ScenarioInfo* info_;
+  const scenes_detail::ScenarioEntry* entry_;  ///< in the registry, which never removes one
   ScenarioParams params_;
   World world_;
-  Control control_;
 };
 
 /// A deterministic stand-in for a human player, for headless runs, tests and golden files: the

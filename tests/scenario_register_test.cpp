@@ -1,0 +1,195 @@
+// A game's own scenario (register_scenario): created by name like the built-ins, listed, refused
+// with the problem named, and recorded, verified and seeked through replay/ with its game state.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <detsim/detsim.hpp>
+
+#include "support/replay_files.hpp"
+
+namespace detsim {
+namespace {
+
+using namespace detsim::literals;
+
+/// "tally": a ball on a plane, and per player the number of frames its jump button was down,
+/// kept in the World's game state (u32 each, little-endian) and pushed into the ball as a kick.
+void build_tally(World& w, const ScenarioParams& p) {
+  BodyDef ground;
+  ground.type = BodyType::static_body;
+  ground.shape = Shape::plane();
+  (void)w.create_body(ground);
+  BodyDef ball;
+  ball.shape = Shape::sphere(0.5_fx);
+  ball.position = {0_fx, 0.5_fx, 0_fx};
+  (void)w.create_body(ball);
+  (void)w.set_game_state(std::vector<std::uint8_t>(4 * p.players, 0));
+  std::vector<GameField> fields;
+  for (std::uint32_t i = 0; i < p.players; ++i)
+    fields.push_back({"presses.player" + std::to_string(i + 1), 4 * i, GameFieldType::u32});
+  (void)w.describe_game_state(fields);
+}
+
+void control_tally(World& w, std::span<const PlayerInput> inputs, const ScenarioParams&) {
+  std::vector<std::uint8_t> state(w.game_state().begin(), w.game_state().end());
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    if ((inputs[i].buttons & PlayerInput::jump) == 0) continue;
+    std::uint32_t count = 0;
+    for (int k = 0; k < 4; ++k)
+      count |= std::uint32_t{state[4 * i + static_cast<std::size_t>(k)]} << (8 * k);
+    ++count;
+    for (int k = 0; k < 4; ++k)
+      state[4 * i + static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(count >> (8 * k));
+    (void)w.apply_linear_impulse(BodyId{2},
+                                 {Fixed::from_int(inputs[i].move_x) / 64_fx, 0_fx, 0_fx});
+  }
+  (void)w.set_game_state(state);
+}
+
+ScenarioDefinition tally() {
+  ScenarioDefinition d;
+  d.name = "tally";
+  d.summary = "a ball kicked by players, who score a point per frame of jump";
+  d.default_frames = 300;
+  d.min_players = 1;
+  d.max_players = 4;
+  d.default_players = 2;
+  d.uses_seed = true;
+  d.build = build_tally;
+  d.control = control_tally;
+  return d;
+}
+
+/// Registered once per process (the registry never forgets).
+void ensure_tally() {
+  static const bool registered = [] {
+    const Status s = register_scenario(tally());
+    EXPECT_TRUE(s.ok()) << s.message();
+    return true;
+  }();
+  (void)registered;
+}
+
+std::uint32_t presses(const World& w, std::uint32_t player) {
+  std::uint32_t n = 0;
+  for (int k = 0; k < 4; ++k)
+    n |= std::uint32_t{w.game_state()[4 * player + static_cast<std::size_t>(k)]} << (8 * k);
+  return n;
+}
+
+TEST(ScenarioRegister, ARegisteredGameIsCreatedListedAndStepsLikeABuiltIn) {
+  ensure_tally();
+  const ScenarioInfo* info = find_scenario("tally");
+  ASSERT_NE(info, nullptr);
+  EXPECT_EQ(info->summary, tally().summary);
+  EXPECT_EQ(info->default_players, 2U);
+  const std::vector<ScenarioInfo> all = scenario_list();
+  for (std::size_t i = 1; i < all.size(); ++i)
+    EXPECT_LT(all[i - 1].name, all[i].name) << "sorted by name";
+  EXPECT_TRUE(
+      std::any_of(all.begin(), all.end(), [](const ScenarioInfo& s) { return s.name == "tally"; }));
+
+  auto made = Scenario::create("tally", {.seed = 9});
+  ASSERT_TRUE(made.ok()) << made.message();
+  Scenario& s = made.value();
+  EXPECT_EQ(s.params().players, 2U);
+  EXPECT_EQ(s.info().name, "tally");
+  std::vector<PlayerInput> inputs(2);
+  inputs[1].buttons = PlayerInput::jump;
+  inputs[1].move_x = 64;
+  for (int f = 0; f < 10; ++f)
+    s.step(inputs);
+  EXPECT_EQ(presses(s.world(), 0), 0U);
+  EXPECT_EQ(presses(s.world(), 1), 10U);
+  EXPECT_GT(s.world().body(BodyId{2})->linear_velocity.x, 0_fx) << "the kicks moved the ball";
+  EXPECT_EQ(s.world().hashes().sections.back().name, "game");
+
+  auto other = Scenario::create("tally", {.players = 5});
+  EXPECT_FALSE(other.ok());
+  EXPECT_NE(other.message().find("takes 1 to 4 players, got 5"), std::string::npos)
+      << other.message();
+}
+
+TEST(ScenarioRegister, ARegisteredGameRecordsVerifiesAndSeeks) {
+  ensure_tally();
+  test::TempFile file("tally.dsr");
+  auto scenario = Scenario::create("tally", {.seed = 3});
+  ASSERT_TRUE(scenario.ok());
+  replay::RecordOptions options;
+  options.frames = 200;
+  options.keyframe_interval = 50;
+  auto recorded = replay::record(scenario.value(), file.path(), options);
+  ASSERT_TRUE(recorded.ok()) << recorded.message();
+  auto reader = replay::ReplayReader::open(file.path());
+  ASSERT_TRUE(reader.ok()) << reader.message();
+  EXPECT_EQ(reader->fingerprint().scenario, "tally");
+  EXPECT_EQ(reader->fingerprint().state_sections.back(), "game");
+  auto verified = replay::verify(reader.value());
+  ASSERT_TRUE(verified.ok()) << verified.message();
+  EXPECT_TRUE(verified->ok);
+  EXPECT_EQ(verified->frames, 200U);
+  EXPECT_EQ(verified->final_hash, recorded->final_hash);
+  auto at = replay::seek(reader.value(), 137);
+  ASSERT_TRUE(at.ok()) << at.message();
+  auto straight = Scenario::create("tally", {.seed = 3});
+  ASSERT_TRUE(straight.ok());
+  std::vector<PlayerInput> inputs(2);
+  for (std::uint64_t f = 1; f <= 137; ++f) {  // record's frame f is stepped with its inputs
+    for (std::uint32_t p = 0; p < 2; ++p)
+      inputs[p] = scripted_input(3, f, p);
+    straight->step(inputs);
+  }
+  EXPECT_EQ(at->world().save(), straight->world().save());
+}
+
+TEST(ScenarioRegister, BadDefinitionsAreRefusedNamingTheProblem) {
+  ensure_tally();
+  const auto refused = [](ScenarioDefinition d, const std::string& expected) {
+    const Status s = register_scenario(d);
+    EXPECT_FALSE(s.ok()) << d.name;
+    EXPECT_NE(s.message().find(expected), std::string::npos) << s.message();
+  };
+  ScenarioDefinition d = tally();
+  d.name = "Tally";
+  refused(d, "a name is 1..32 characters of a-z, 0-9 and _");
+  d.name = "";
+  refused(d, "a name is 1..32 characters");
+  d = tally();
+  refused(d, "a scenario of that name exists");
+  d.name = "arena";
+  refused(d, "a scenario of that name exists");
+  d = tally();
+  d.name = "tally2";
+  d.build = nullptr;
+  refused(d, "build is empty");
+  d = tally();
+  d.name = "tally2";
+  d.max_players = 9;
+  refused(d, "at most 8 players");
+  d = tally();
+  d.name = "tally2";
+  d.default_players = 5;
+  refused(d, "min_players <= default_players <= max_players, got 1, 5, 4");
+  d = tally();
+  d.name = "tally2";
+  d.control = nullptr;
+  refused(d, "needs control");
+  d = tally();
+  d.name = "tally2";
+  d.default_count = 3;
+  refused(d, "default_count 3 exceeds max_count 0");
+  d = tally();
+  d.name = "tally2";
+  d.world.dt = 0_fx;
+  refused(d, "world: ");
+  d = tally();
+  d.name = "tally2";
+  d.default_frames = 0;
+  refused(d, "default_frames must be >= 1");
+  EXPECT_EQ(find_scenario("tally2"), nullptr) << "nothing was registered";
+}
+
+}  // namespace
+}  // namespace detsim
