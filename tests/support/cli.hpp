@@ -29,18 +29,23 @@ inline std::string read_text(const std::string& path) {
   return {bytes.begin(), bytes.end()};
 }
 
-/// Runs `detsim <args>` with stdin from /dev/null, capturing stdout and stderr.
-inline CliResult detsim_cli(const std::string& args) {
+/// Runs `<binary> <args>` with stdin from /dev/null, capturing stdout and stderr.
+inline CliResult run_program(const std::string& binary, const std::string& args) {
   TempFile out("out.txt");
   TempFile err("err.txt");
   const std::string command =
-      detsim_binary() + " " + args + " </dev/null >" + out.path() + " 2>" + err.path();
+      binary + " " + args + " </dev/null >" + out.path() + " 2>" + err.path();
   const int status = std::system(command.c_str());
   CliResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   r.out = read_text(out.path());
   r.err = read_text(err.path());
   return r;
+}
+
+/// Runs `detsim <args>` with stdin from /dev/null, capturing stdout and stderr.
+inline CliResult detsim_cli(const std::string& args) {
+  return run_program(detsim_binary(), args);
 }
 
 inline bool has(const std::string& text, const std::string& part) {

@@ -27,9 +27,24 @@ bool write_file(const std::string& path, const std::vector<std::uint8_t>& bytes)
   return std::fclose(f) == 0 && ok;
 }
 
+namespace {
+std::string& program() {
+  static std::string name = "detsim";
+  return name;
+}
+}  // namespace
+
+void set_program_name(std::string_view name) {
+  program() = std::string(name);
+}
+
+const std::string& program_name() {
+  return program();
+}
+
 int usage_error(std::string_view command, const std::string& message) {
-  std::fprintf(stderr, "detsim %.*s: %s\n", static_cast<int>(command.size()), command.data(),
-               message.c_str());
+  std::fprintf(stderr, "%s %.*s: %s\n", program().c_str(), static_cast<int>(command.size()),
+               command.data(), message.c_str());
   return exit_usage;
 }
 

@@ -23,7 +23,11 @@ std::string hex(std::uint64_t v);
 /// Writes `bytes` to the file `path` (replacing it); false when it cannot.
 bool write_file(const std::string& path, const std::vector<std::uint8_t>& bytes);
 
-/// Prints "detsim <command>: <message>" on stderr and returns exit_usage.
+/// The tool's name in messages: "detsim", or what a game's tool passed to run_cli.
+void set_program_name(std::string_view name);
+[[nodiscard]] const std::string& program_name();
+
+/// Prints "<program> <command>: <message>" on stderr and returns exit_usage.
 int usage_error(std::string_view command, const std::string& message);
 
 /// A JSON object built field by field, printed once.
