@@ -20,7 +20,6 @@
 namespace {
 
 const std::string version_text = "detsim " + std::string(detsim::version);
-constexpr int exit_usage = detsim::cli::exit_usage;
 
 // ---- Scenario, replay and golden commands -------------------------------------------------------
 
