@@ -114,6 +114,34 @@ TEST(NetSession, TwoPlayersOnAPerfectNetworkAgreeWithoutRollingBack) {
   EXPECT_TRUE(m.record(0).has(EventType::synchronized));
 }
 
+TEST(NetSession, DeliveredFrameCountsWhatTheListenerGotAndReachesTheEndByPollingAlone) {
+  // Delivered frames trail the confirmed ones while the peers' holds travel back; after the last
+  // advance, polling alone delivers the rest of the match.
+  MatchOptions o;
+  o.frames = 400;
+  o.link = net::internet_link();
+  std::vector<std::size_t> delivered(2, 0);
+  std::uint64_t trailing = 0;
+  bool consistent = true;
+  Match* match = nullptr;
+  o.on_tick = [&](std::uint32_t p, std::uint64_t, net::Session& s) {
+    if (match == nullptr) return;
+    consistent = consistent && match->record(p).hashes.size() == s.delivered_frame() &&
+                 s.delivered_frame() <= s.confirmed_frame();
+    if (s.delivered_frame() < s.confirmed_frame()) ++trailing;
+  };
+  Match m(o);
+  match = &m;
+  ASSERT_TRUE(m.run()) << m.compare();
+  EXPECT_TRUE(consistent) << "the listener got exactly the frames before delivered_frame()";
+  EXPECT_GT(trailing, 0U) << "on a 100 ms link the holds take a while";
+  for (std::uint32_t p = 0; p < 2; ++p) {
+    EXPECT_GE(m.session(p).delivered_frame(), o.frames);
+    EXPECT_EQ(m.record(p).hashes.size(), m.session(p).delivered_frame());
+  }
+  EXPECT_EQ(m.compare(), "");
+}
+
 TEST(NetSession, LatencyCausesRollbacksThatEndIdentical) {
   MatchOptions o;
   o.frames = 1200;

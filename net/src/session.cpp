@@ -473,6 +473,9 @@ std::uint64_t Session::current_frame() const noexcept {
 std::uint64_t Session::confirmed_frame() const noexcept {
   return impl_->confirmed_frame();
 }
+std::uint64_t Session::delivered_frame() const noexcept {
+  return impl_->next_emit;
+}
 const SessionStats& Session::stats() const noexcept {
   return impl_->stats;
 }

@@ -241,6 +241,13 @@ class Session {
   /// Every frame before this one has all inputs confirmed (disconnected players count as
   /// confirmed).
   [[nodiscard]] std::uint64_t confirmed_frame() const noexcept;
+  /// Every frame before this one has been handed to the confirmed listener: confirmed here, final
+  /// (no correction pending) and held by every connected peer, so no disconnect can be agreed
+  /// before it. It trails confirmed_frame() by the round trip in which the peers say they hold it.
+  /// At the end of a match of N frames, keep calling poll() (without advancing) until it reaches
+  /// N — the peers' last acknowledgements arrive — then linger a few polls so that they get yours;
+  /// a peer that left or stays silent is disconnected by the timeouts, which also ends the wait.
+  [[nodiscard]] std::uint64_t delivered_frame() const noexcept;
   /// Frames the game should skip (not advance) to let slower peers catch up: 0 when in time.
   /// A policy that works: while it is above 0, skip advance_frame() on one tick in three (a
   /// skipped tick still polls), so the correction is spread out and never visible as a stall.
