@@ -44,7 +44,8 @@ using test::TempFile;
 /// A detsim process started in the background, its stdout and stderr going to files.
 class Process {
  public:
-  Process(const std::vector<std::string>& args, const std::string& name)
+  Process(const std::vector<std::string>& args, const std::string& name,
+          const std::string& binary = test::detsim_binary())
       : out_(name + ".out"), err_(name + ".err") {
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
@@ -53,7 +54,6 @@ class Process {
                                      0644);
     posix_spawn_file_actions_addopen(&actions, 2, err_.path().c_str(), O_WRONLY | O_CREAT | O_TRUNC,
                                      0644);
-    const std::string binary = test::detsim_binary();
     std::vector<std::string> all = {binary};
     all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
@@ -121,14 +121,16 @@ struct Group {
 
 using Commands = std::function<std::vector<std::vector<std::string>>(std::uint16_t base)>;
 
-Group run_group(const Commands& commands, std::chrono::seconds limit) {
+Group run_group(const Commands& commands, std::chrono::seconds limit,
+                const std::string& binary = test::detsim_binary()) {
   Group group;
   for (int attempt = 0; attempt < 6; ++attempt) {
     const std::vector<std::vector<std::string>> args = commands(port_for(attempt));
     group.processes.clear();
     group.timed_out = false;
     for (std::size_t i = 0; i < args.size(); ++i)
-      group.processes.push_back(std::make_unique<Process>(args[i], "netplay_" + std::to_string(i)));
+      group.processes.push_back(
+          std::make_unique<Process>(args[i], "netplay_" + std::to_string(i), binary));
     const auto deadline = std::chrono::steady_clock::now() + limit;
     bool retry = false;
     for (;;) {
@@ -160,7 +162,7 @@ struct Pair {
 };
 
 Pair run_pair(const std::vector<std::string>& extra_a, const std::vector<std::string>& extra_b,
-              std::chrono::seconds limit) {
+              std::chrono::seconds limit, const std::string& binary = test::detsim_binary()) {
   const auto commands = [&](std::uint16_t port_a) {
     const auto port_b = static_cast<std::uint16_t>(port_a + 1);
     std::vector<std::string> args_a = {"netplay",        "--players", "2",
@@ -173,7 +175,7 @@ Pair run_pair(const std::vector<std::string>& extra_a, const std::vector<std::st
     args_b.insert(args_b.end(), extra_b.begin(), extra_b.end());
     return std::vector<std::vector<std::string>>{args_a, args_b};
   };
-  Group group = run_group(commands, limit);
+  Group group = run_group(commands, limit, binary);
   return Pair{std::move(group.processes[0]), std::move(group.processes[1]), group.timed_out};
 }
 
@@ -545,6 +547,42 @@ TEST(CliNetplay, ASpectatorReachesThePlayersHashAndRecordsTheSameReplay) {
   EXPECT_EQ(json_value(out_a, "desync_report"), "null");
   EXPECT_FALSE(std::filesystem::exists(report_a.path()));
   EXPECT_FALSE(std::filesystem::exists(report_b.path()));
+}
+
+TEST(CliNetplay, AGamesOwnScenarioIsPlayedByItsToolAndRecordedAlike) {
+  // pushball (examples/pushball) through pushball-tool: the same final hash and replay on both
+  // peers, and the replay verifies with the same tool.
+  const std::string tool = std::string(DETSIM_BINARY_DIR) + "/examples/pushball/pushball-tool";
+  TempFile replay_a("pushball_a.dsr");
+  TempFile replay_b("pushball_b.dsr");
+  const std::vector<std::string> common = {"--scenario", "pushball", "--frames", "600",
+                                           "--fps",      "1000",     "--json"};
+  std::vector<std::string> a = {"--bot", "21", "--record", replay_a.path()};
+  std::vector<std::string> b = {"--bot", "22", "--record", replay_b.path()};
+  a.insert(a.end(), common.begin(), common.end());
+  b.insert(b.end(), common.begin(), common.end());
+  const Pair pair = run_pair(a, b, std::chrono::seconds(60), tool);
+  ASSERT_FALSE(pair.timed_out) << pair.a->err() << pair.b->err();
+  for (const Process* p : {pair.a.get(), pair.b.get()}) {
+    EXPECT_EQ(p->exit_code(), 0) << p->out() << p->err();
+    EXPECT_EQ(json_value(p->out(), "scenario"), "pushball") << p->out();
+    EXPECT_EQ(json_value(p->out(), "frames"), "600") << p->out();
+  }
+  EXPECT_EQ(json_value(pair.a->out(), "final_hash"), json_value(pair.b->out(), "final_hash"));
+  EXPECT_EQ(read_bytes(replay_a.path()), read_bytes(replay_b.path()));
+  const test::CliResult verify = test::run_program(tool, "verify " + replay_a.path() + " --json");
+  EXPECT_EQ(verify.exit_code, 0) << verify.err;
+  EXPECT_EQ(json_value(verify.out, "final_hash"), json_value(pair.a->out(), "final_hash"));
+
+  // Scenarios that cannot be played over a network are refused by name.
+  const test::CliResult none =
+      test::detsim_cli("netplay --bind 127.0.0.1:0 --peer 1=127.0.0.1:9 --scenario stack");
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_TRUE(has(none.err, "--scenario stack takes no players")) << none.err;
+  const test::CliResult unknown =
+      test::detsim_cli("netplay --bind 127.0.0.1:0 --peer 1=127.0.0.1:9 --scenario pushball");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_TRUE(has(unknown.err, "unknown scenario \"pushball\"")) << unknown.err;
 }
 
 TEST(CliNetplay, ASpectatorOfAnotherMatchIsRefused) {

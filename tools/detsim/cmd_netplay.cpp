@@ -1,6 +1,7 @@
-// detsim netplay: this machine plays one player of an `arena` match against peers over UDP, with a
-// net::Session in rollback or lockstep mode, optionally recording the confirmed frames as a replay
-// that every peer writes byte for byte alike, and serving spectators (--spectator). With
+// detsim netplay: this machine plays one player of a match (the `arena`, or --scenario) against
+// peers over UDP, with a net::Session in rollback or lockstep mode, optionally recording the
+// confirmed frames as a replay that every peer writes byte for byte alike, and serving spectators
+// (--spectator). With
 // --spectate it watches instead (cmd_spectate.cpp); netplay_plan.cpp checks the command line.
 //
 // The loop: every iteration polls the session (network in and out, timers); every 1/fps seconds
@@ -125,7 +126,7 @@ Status Netplay::start() {
   ScenarioParams params;
   params.seed = args_.seed;
   params.players = args_.players;
-  auto scenario = Scenario::create("arena", params);
+  auto scenario = Scenario::create(args_.scenario, params);
   if (!scenario) return scenario.status();
   scenario_.emplace(std::move(scenario.value()));
   game_.emplace(*scenario_);
@@ -347,8 +348,8 @@ std::string Netplay::spectators_behind() const {
 
 int Netplay::run() {
   if (Status s = start(); !s) return usage_error(netplay_name, s.message());
-  say("arena (seed " + std::to_string(args_.seed) + ", " + std::to_string(args_.players) +
-      " players): player " + std::to_string(args_.me) + " on " +
+  say(args_.scenario + " (seed " + std::to_string(args_.seed) + ", " +
+      std::to_string(args_.players) + " players): player " + std::to_string(args_.me) + " on " +
       transport_->local_endpoint().to_string() + ", " + args_.mode + ", input delay " +
       std::to_string(args_.input_delay) + ", " + std::to_string(args_.frames) + " frames");
   say(protection_line(plan_));
@@ -478,7 +479,7 @@ int Netplay::report(double handshake_seconds, double match_seconds) {
                             .hash("remote_hash", e.remote_hash)
                             .text());
     Json j;
-    j.str("scenario", "arena")
+    j.str("scenario", args_.scenario)
         .num("seed", args_.seed)
         .num("players", args_.players)
         .num("player", args_.me)

@@ -1,7 +1,7 @@
-// detsim netplay --spectate: this machine watches an `arena` match, receiving every confirmed
-// frame from one player (the host, which lists this machine with --spectator) through a
-// net::SpectatorSession. It simulates exactly the confirmed inputs, so it reaches the players'
-// final hash and, with --record, writes the same replay bytes as they do.
+// detsim netplay --spectate: this machine watches a match (the `arena`, or --scenario), receiving
+// every confirmed frame from one player (the host, which lists this machine with --spectator)
+// through a net::SpectatorSession. It simulates exactly the confirmed inputs, so it reaches the
+// players' final hash and, with --record, writes the same replay bytes as they do.
 //
 // The loop: every iteration polls the session; every 1/fps seconds it advances, which simulates
 // one received frame, or several when frames have piled up (the session catches up by itself);
@@ -73,7 +73,7 @@ Status Spectate::start() {
   ScenarioParams params;
   params.seed = args_.seed;
   params.players = args_.players;
-  auto scenario = Scenario::create("arena", params);
+  auto scenario = Scenario::create(args_.scenario, params);
   if (!scenario) return scenario.status();
   scenario_.emplace(std::move(scenario.value()));
   game_.emplace(*scenario_);
@@ -149,9 +149,10 @@ std::string Spectate::handshake_failure() const {
 
 int Spectate::run() {
   if (Status s = start(); !s) return usage_error(netplay_name, s.message());
-  say("arena (seed " + std::to_string(args_.seed) + ", " + std::to_string(args_.players) +
-      " players): spectator on " + transport_->local_endpoint().to_string() + ", " + args_.mode +
-      ", " + std::to_string(args_.frames) + " frames");
+  say(args_.scenario + " (seed " + std::to_string(args_.seed) + ", " +
+      std::to_string(args_.players) + " players): spectator on " +
+      transport_->local_endpoint().to_string() + ", " + args_.mode + ", " +
+      std::to_string(args_.frames) + " frames");
   say(protection_line(plan_));
   say("waiting for " + host_name());
 
@@ -213,7 +214,7 @@ int Spectate::report(double handshake_seconds, double match_seconds) const {
                                  .num("packets_dropped", st.dropped)
                                  .text();
     Json j;
-    j.str("scenario", "arena")
+    j.str("scenario", args_.scenario)
         .num("seed", args_.seed)
         .num("players", args_.players)
         .null("player")

@@ -95,6 +95,7 @@ int demo_command(const DemoArgs& args);
 /// One player of an arena match over UDP against the listed peers, or (spectate) a spectator of
 /// one of them.
 struct NetplayArgs {
+  std::string scenario = "arena";  ///< any scenario with players (2 or more)
   std::uint32_t players = 2;
   std::uint32_t me = 0;
   bool me_given = false;           ///< --me was on the command line (refused with spectate)

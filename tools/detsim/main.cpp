@@ -110,9 +110,13 @@ void add_netplay(CLI::App& app, int& exit_code) {
 #else
 void add_netplay(CLI::App& app, int& exit_code) {
   static detsim::cli::NetplayArgs netplay;
-  auto* c =
-      app.add_subcommand("netplay", "Play one player of an arena match against peers over UDP");
-  c->add_option("--players", netplay.players, "Players in the match, 2 .. 8 (default 2)")
+  auto* c = app.add_subcommand(
+      "netplay", "Play one player of a match (the arena, or --scenario) against peers over UDP");
+  c->add_option("--scenario", netplay.scenario,
+                "The scenario to play, one that takes players (default arena; same on all peers)")
+      ->type_name("NAME");
+  c->add_option("--players", netplay.players,
+                "Players in the match, 2 .. the scenario's most (arena: 8; default 2)")
       ->type_name("N");
   auto* me = c->add_option("--me", netplay.me,
                            "This machine's player index, 0 .. N-1 (default 0; not with --spectate)")
@@ -135,7 +139,7 @@ void add_netplay(CLI::App& app, int& exit_code) {
               "Watch the match instead of playing: no --me, one --peer naming the player that "
               "lists this machine with --spectator, and the players' --players, --seed, --mode "
               "and --frames");
-  c->add_option("--seed", netplay.seed, "Seed of the arena scenario (default 1; same on all peers)")
+  c->add_option("--seed", netplay.seed, "Seed of the scenario (default 1; same on all peers)")
       ->type_name("S");
   c->add_option("--mode", netplay.mode,
                 "rollback (predict remote inputs, correct by re-simulating) or lockstep (wait "

@@ -160,9 +160,15 @@ Expected<net::MatchKey> parse_match_key(std::string_view text) {
 }
 
 Expected<NetplayPlan> netplay_plan(const NetplayArgs& a) {
-  if (a.players < 2 || a.players > 8)
-    return Status::error("--players must be 2 .. 8 (the arena scenario's range), got " +
-                         std::to_string(a.players));
+  const ScenarioInfo* info = find_scenario(a.scenario);
+  if (info == nullptr) return Status::error("--scenario: unknown scenario \"" + a.scenario + "\"");
+  const std::uint32_t lowest = std::max(2U, info->min_players);
+  if (info->max_players < 2)
+    return Status::error("--scenario " + a.scenario + " takes no players to play over a network");
+  if (a.players < lowest || a.players > info->max_players)
+    return Status::error("--players must be " + std::to_string(lowest) + " .. " +
+                         std::to_string(info->max_players) + " (the " + a.scenario +
+                         " scenario's range), got " + std::to_string(a.players));
   if (Status s = check_role(a); !s) return s;
   NetplayPlan plan;
   if (a.mode == "rollback") {
