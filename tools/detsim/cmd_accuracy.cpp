@@ -27,7 +27,7 @@
 
 namespace {
 
-constexpr int exit_usage = detsim::cli::exit_usage;
+[[maybe_unused]] constexpr int exit_usage = detsim::cli::exit_usage;  // without MPFR
 
 // ---- detsim accuracy ---------------------------------------------------------------------------
 
