@@ -56,6 +56,10 @@ int main(int argc, char** argv) {
   (void)w.apply_force(box.value(), {detsim::Fixed::one(), {}, {}});
   (void)w.apply_torque(box.value(), {{}, detsim::Fixed::one(), {}});
   write(dir + "/flags", w.save());
+  // The same with a game's own state (the optional "game" section).
+  const std::vector<std::uint8_t> scores = {3, 0, 0, 0, 1, 0, 0, 0, 0x5A};
+  if (!w.set_game_state(scores)) return 1;
+  write(dir + "/game", w.save());
   // The geometry the target world holds, with a body on each kind, at rest and after a fall.
   detsim::World g = fuzz_support::geometry_world(true);
   if (g.geometry_count() == 0) return 1;

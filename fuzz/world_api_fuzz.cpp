@@ -4,7 +4,8 @@
 // create_joint with any type, bodies, anchor, axis, limits, motor, lengths, spring and break
 // thresholds, destroy_joint, set_joint_motor, the geometry registrations, and the particle groups:
 // create_rope, create_cloth, create_soft_body with any values, apply_particle_force,
-// destroy_particle_group, raycast_particles).
+// destroy_particle_group, raycast_particles; and the game's own state: set_game_state of any size,
+// describe_game_state with good and bad fields, set_user_data).
 //
 // Properties checked beyond the sanitizers' (no crash, no undefined behaviour, no leak):
 // - a refused call changes nothing: the world's saved bytes are those from before the call;
@@ -49,7 +50,7 @@ constexpr std::size_t kMaxJoints = 64;
 constexpr int kMaxSteps = 16;
 constexpr int kMaxCalls = 256;
 constexpr std::size_t kMaxGeometries = 16;
-constexpr int kOps = 28;                    // the calls' opcodes, op % kOps
+constexpr int kOps = 31;                    // the calls' opcodes, op % kOps
 constexpr std::size_t kMaxParticles = 600;  // what the groups of one input may hold in all
 // Sub-steps x iterations x (bodies + joints + 1), summed over the steps: what the steps of one
 // input may cost in total.
@@ -652,6 +653,33 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 27: {
         const Vec3 origin = in.vec3();
         (void)world.raycast_particles(origin, in.vec3());
+        break;
+      }
+      case 28: {  // the game's own state: mostly small, sometimes empty or over the limit
+        const std::uint8_t pick = in.byte();
+        const std::size_t size = pick == 0xFF   ? detsim::max_game_state_size + 1
+                                 : pick == 0xFE ? 0
+                                                : pick % 48U;
+        std::vector<std::uint8_t> bytes(size);
+        for (std::size_t i = 0; i < size && i < 48; ++i)
+          bytes[i] = in.byte();
+        status = world.set_game_state(bytes);
+        break;
+      }
+      case 29: {  // its description: names, offsets and types good and bad
+        std::vector<detsim::GameField> fields(in.byte() % 5U);
+        for (detsim::GameField& f : fields) {
+          static constexpr const char* names[] = {"score", "score", "a.b[1]", "", "bad name"};
+          f.name = names[in.byte() % 5U];
+          f.offset = (in.byte() & 0x80U) != 0 ? in.u32() : in.byte() % 40U;
+          f.type = static_cast<detsim::GameFieldType>(in.byte() % 10U);  // 9: no type
+        }
+        status = world.describe_game_state(fields);
+        break;
+      }
+      case 30: {
+        const BodyId id = body_id(in, world);
+        status = world.set_user_data(id, in.u32());
         break;
       }
       default: {
