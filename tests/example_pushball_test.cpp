@@ -144,6 +144,18 @@ TEST(ExamplePushball, ItsToolRecordsVerifiesAndSyncTestsItsRuns) {
     straight.step(inputs);
   }
   EXPECT_EQ(at->world().save(), straight.world().save());
+  // The same through the tool: the state at 450, as recorded, written for diff.
+  TempFile state("seek450.state");
+  const test::CliResult seek =
+      tool("seek " + replay.path() + " 450 --json --save-state " + state.path());
+  EXPECT_EQ(seek.exit_code, 0) << seek.err;
+  EXPECT_EQ(json_value(seek.out, "ok"), "true") << seek.out;
+  EXPECT_EQ(test::read_bytes(state.path()), straight.world().save());
+  const test::CliResult past = tool("seek " + replay.path() + " 901");
+  EXPECT_EQ(past.exit_code, 2);
+  EXPECT_TRUE(
+      has(past.err, "pushball-tool seek: " + replay.path() + " has frames 0 .. 900, not 901"))
+      << past.err;
 
   // The stock detsim does not know the game, and says where it is known.
   const test::CliResult stock = test::detsim_cli("verify " + replay.path());

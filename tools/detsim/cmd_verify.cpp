@@ -142,6 +142,52 @@ int verify_command(const VerifyArgs& args) {
   return v.ok ? exit_ok : exit_check_failed;
 }
 
+int seek_command(const SeekArgs& args) {
+  auto reader = replay::ReplayReader::open(args.file);
+  if (!reader) return usage_error("seek", reader.message());
+  const replay::ReplayReader& r = reader.value();
+  if (args.frame > r.frame_count())
+    return usage_error("seek", args.file + " has frames 0 .. " + std::to_string(r.frame_count()) +
+                                   ", not " + std::to_string(args.frame));
+  std::uint64_t resimulated = 0;
+  auto scenario = replay::seek(r, args.frame, &resimulated);
+  if (!scenario) return usage_error("seek", scenario.message());
+  std::vector<std::uint8_t> state;
+  const std::uint64_t hash = scenario.value().world().save(state).total;
+  // Frame 0 has no record: its hash is the fingerprint's initial hash.
+  std::uint64_t recorded = r.fingerprint().initial_hash;
+  if (args.frame > 0) {
+    auto record = r.frame(args.frame);
+    if (!record) return usage_error("seek", record.message());
+    recorded = record.value().hashes.total;
+  }
+  if (!args.save_state.empty() && !write_file(args.save_state, state))
+    return usage_error("seek", "cannot write " + args.save_state);
+  const bool ok = hash == recorded;
+  if (args.json) {
+    Json j;
+    j.boolean("ok", ok)
+        .str("file", args.file)
+        .num("frame", args.frame)
+        .hash("hash", hash)
+        .hash("recorded_hash", recorded)
+        .num("resimulated_frames", resimulated);
+    if (args.save_state.empty()) {
+      j.null("state");
+    } else {
+      j.str("state", args.save_state);
+    }
+    j.print();
+  } else {
+    std::printf("frame %llu of %s: hash %s, %s (re-simulated %llu frames from a keyframe)\n",
+                static_cast<unsigned long long>(args.frame), args.file.c_str(), hex(hash).c_str(),
+                ok ? "as recorded" : ("RECORDED " + hex(recorded)).c_str(),
+                static_cast<unsigned long long>(resimulated));
+    if (!args.save_state.empty()) std::printf("state written to %s\n", args.save_state.c_str());
+  }
+  return ok ? exit_ok : exit_check_failed;
+}
+
 int info_command(const InfoArgs& args) {
   auto reader = replay::ReplayReader::open(args.file);
   if (!reader) return usage_error("info", reader.message());

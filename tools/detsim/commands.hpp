@@ -67,6 +67,14 @@ struct InfoArgs {
 };
 int info_command(const InfoArgs& args);
 
+struct SeekArgs {
+  std::string file;
+  std::uint64_t frame = 0;
+  std::string save_state;  ///< the state at the frame (World::save bytes) to write, or empty
+  bool json = false;
+};
+int seek_command(const SeekArgs& args);
+
 struct SynctestArgs {
   ScenarioArgs scene;
   std::uint32_t check_distance = 8;

@@ -260,6 +260,23 @@ without its end marker (a recording that stopped early) verifies up to its last 
             exit_footer);
   c->callback([&exit_code] { exit_code = cli::verify_command(verify); });
 
+  static cli::SeekArgs seek;
+  c = app.add_subcommand("seek",
+                         "A replay's state at one frame: from the nearest keyframe, re-simulated");
+  c->add_option("FILE", seek.file, "Replay file")->required();
+  c->add_option("FRAME", seek.frame, "The frame, 0 .. the replay's last")->required();
+  c->add_option("--save-state", seek.save_state,
+                "Write the state at FRAME (World::save bytes) to FILE, for detsim diff")
+      ->type_name("FILE");
+  c->add_flag("--json", seek.json,
+              "Print one JSON object: ok, frame, hash, recorded_hash, resimulated_frames, state");
+  c->footer(std::string(R"(
+Restores the keyframe at or before FRAME and re-simulates the recorded inputs up to it (at most one
+keyframe interval), then compares the state's hash with the one recorded for FRAME: exit 1 when
+they differ (this machine does not reproduce the recording there).
+)") + exit_footer);
+  c->callback([&exit_code] { exit_code = cli::seek_command(seek); });
+
   c = app.add_subcommand("info", "Describe a replay: fingerprint, frames, keyframes");
   c->add_option("FILE", info.file, "Replay file")->required();
   c->add_flag("--json", info.json, "Print one JSON object");
