@@ -379,6 +379,11 @@ TEST(NetAttack, AHeldFrameOfZeroCannotStallTheMatch) {
   MatchOptions o;
   o.match_key.reset();  // the plain framing: what a peer with the key could send sealed
   o.frames = 2400;
+  // The victim plays on alone after the disconnect (a two-player match's default is to end:
+  // SessionConfig::partition), which is what this test watches.
+  o.configure = [](std::uint32_t, net::SessionConfig& c) {
+    c.partition = net::PartitionPolicy::play_on;
+  };
   o.max_ticks = 6000;
   o.link.latency_us = 20'000;
   o.wrap = tamper(1, [](net::PeerId, Packet& p, std::uint64_t) {
@@ -404,6 +409,11 @@ TEST(NetAttack, APeerThatTalksButNeverAdvancesIsDisconnectedForNoProgress) {
   auto watch = std::make_shared<DisconnectWatch>();
   MatchOptions o;
   o.frames = 1800;
+  // The victim plays on alone after the disconnect (a two-player match's default is to end:
+  // SessionConfig::partition), which is what this test watches.
+  o.configure = [](std::uint32_t, net::SessionConfig& c) {
+    c.partition = net::PartitionPolicy::play_on;
+  };
   o.max_ticks = 6000;
   o.link.latency_us = 20'000;
   o.active = [](std::uint32_t p, std::uint64_t tick) { return p != 1 || tick < 300; };

@@ -396,6 +396,11 @@ TEST(NetProtection, ARelayThatRewritesInputsAndDropsTheChecksCannotSplitTheMatch
   REQUIRE_SODIUM();
   MatchOptions o;
   o.frames = 900;
+  // The victim plays on alone after the disconnect (a two-player match's default is to end:
+  // SessionConfig::partition), which is what this test watches.
+  o.configure = [](std::uint32_t, net::SessionConfig& c) {
+    c.partition = net::PartitionPolicy::play_on;
+  };
   o.max_ticks = 3000;
   o.link.latency_us = 20'000;
   o.wrap = [](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
@@ -412,7 +417,7 @@ TEST(NetProtection, ARelayThatRewritesInputsAndDropsTheChecksCannotSplitTheMatch
   m.run();
   // No split: what both peers confirmed is the same, frame by frame, up to the first frame either
   // took the other as gone (the progress guard's "no progress", a detected end: from there each
-  // plays on alone, as a two-player match does after a disconnect).
+  // plays on alone, as a two-player match with PartitionPolicy::play_on does).
   const test::PeerRecord& a = m.record(0);
   const test::PeerRecord& b = m.record(1);
   std::size_t common = std::min(a.hashes.size(), b.hashes.size());

@@ -69,6 +69,10 @@ TEST(NetSession, RejectsInvalidConfigsNamingTheField) {
               c.disconnect_timeout_us = c.disconnect_warning_us;
             }).find("disconnect_timeout_us"),
             std::string::npos);
+  EXPECT_NE(error_of([](net::SessionConfig& c) {
+              c.partition = static_cast<net::PartitionPolicy>(7);
+            }).find("partition must be end_match or play_on, got 7"),
+            std::string::npos);
 }
 
 TEST(NetSession, WrongLocalInputSizeIsAnErrorAndChangesNothing) {
@@ -367,6 +371,67 @@ TEST(NetSession, ASilentPeerIsDisconnectedAndTheOthersGoOnTogether) {
   EXPECT_TRUE(m.record(0).has(EventType::disconnected));
   EXPECT_TRUE(m.record(1).has(EventType::disconnected));
   EXPECT_EQ(m.record(0).status.back(), net::InputStatus::disconnected);  // player 2, last frame
+  // Two of three are a majority and go on; the one cut off alone ends its match.
+  EXPECT_FALSE(m.record(0).has(EventType::match_ended));
+  EXPECT_FALSE(m.record(1).has(EventType::match_ended));
+  EXPECT_TRUE(m.record(2).has(EventType::match_ended));
+}
+
+TEST(NetSession, ATwoPlayerPartitionEndsTheMatchOnBothSidesWithTheSameFrames) {
+  // The 8-second outage between two players: before, each marked the other gone and
+  // played on alone, ending with different hashes and no event. Now both end where they stood.
+  MatchOptions o;
+  o.frames = 1200;
+  o.link.latency_us = 20'000;
+  o.max_ticks = 1800;
+  o.setup = [](net::SimNetwork& n) { ASSERT_TRUE(n.add_outage(1, 4'000'000, 12'000'000).ok()); };
+  Match m(o);
+  EXPECT_FALSE(m.run()) << "the first advance after the end fails, and so does the match";
+  m.idle(600);  // past the outage: nothing more is delivered, the end stands
+  const std::vector<std::uint8_t> input(4, 0);
+  for (std::uint32_t p = 0; p < 2; ++p) {
+    SCOPED_TRACE("peer " + std::to_string(p));
+    EXPECT_TRUE(m.record(p).has(EventType::disconnected));
+    const net::Event* end = nullptr;
+    for (const net::Event& e : m.record(p).events)
+      if (e.type == EventType::match_ended) end = &e;
+    ASSERT_NE(end, nullptr);
+    EXPECT_EQ(end->reason, "no majority");
+    EXPECT_EQ(end->frame, m.record(p).hashes.size()) << "nothing delivered after the end";
+    auto refused = m.session(p).advance_frame(input);
+    ASSERT_FALSE(refused.ok());
+    EXPECT_NE(refused.message().find("the match ended: this machine is left with 1 of 2 players"),
+              std::string::npos)
+        << refused.message();
+    EXPECT_GT(m.record(p).hashes.size(), 200U) << "the 4 s before the outage were delivered";
+    EXPECT_LT(m.record(p).hashes.size(), 300U);
+  }
+  // Every frame either side delivered, both delivered alike, and as an offline replay of their
+  // inputs gives it: two records of one match that stopped, not two matches.
+  const std::size_t common = std::min(m.record(0).hashes.size(), m.record(1).hashes.size());
+  for (std::size_t f = 0; f < common; ++f)
+    ASSERT_EQ(m.record(0).hashes[f], m.record(1).hashes[f]) << "frame " << f;
+  for (std::uint32_t p = 0; p < 2; ++p)
+    EXPECT_EQ(m.offline_hashes(p), m.record(p).hashes) << "peer " << p;
+}
+
+TEST(NetSession, PlayOnKeepsBothSidesOfAPartitionPlayingAlone) {
+  // The old behaviour, chosen: each side zeroes the other's inputs and goes on to the end.
+  MatchOptions o;
+  o.frames = 1200;
+  o.link.latency_us = 20'000;
+  o.max_ticks = 4000;
+  o.setup = [](net::SimNetwork& n) { ASSERT_TRUE(n.add_outage(1, 4'000'000, 12'000'000).ok()); };
+  o.configure = [](std::uint32_t, net::SessionConfig& c) {
+    c.partition = net::PartitionPolicy::play_on;
+  };
+  Match m(o);
+  EXPECT_TRUE(m.run());
+  for (std::uint32_t p = 0; p < 2; ++p) {
+    EXPECT_TRUE(m.record(p).has(EventType::disconnected));
+    EXPECT_FALSE(m.record(p).has(EventType::match_ended));
+    EXPECT_GE(m.record(p).hashes.size(), 1200U);
+  }
 }
 
 /// The frame from which `record` shows player `player` as disconnected, or the record's length.

@@ -25,6 +25,9 @@ Status validate(const SessionConfig& c) {
   const auto bad = [](const std::string& what) { return Status::error("session config: " + what); };
   if (c.players < 1 || c.players > max_players)
     return bad("players must be 1 .. 8, got " + std::to_string(c.players));
+  if (c.partition != PartitionPolicy::end_match && c.partition != PartitionPolicy::play_on)
+    return bad("partition must be end_match or play_on, got " +
+               std::to_string(static_cast<unsigned>(c.partition)));
   if (c.local_player >= c.players)
     return bad("local_player must be below players (" + std::to_string(c.players) + "), got " +
                std::to_string(c.local_player));
@@ -215,6 +218,9 @@ void Session::Impl::emit_confirmed() {
   // A frame is final once its inputs are all confirmed, it was simulated, no pending correction
   // reaches back to it (states after first_incorrect are re-simulated first), and every peer holds
   // every input of it (so a disconnect can never be agreed before it).
+  // A match that ended for want of a majority delivers nothing more: past this point, frames
+  // are no longer held by every peer, and the sides of a partition would tell them differently.
+  if (ended) return;
   const std::uint64_t limit = emit_limit();
   const std::size_t size = config.input_size;
   for (; next_emit < limit; ++next_emit) {
@@ -365,6 +371,20 @@ bool Session::Impl::holds_back(const detail::Peer& peer) const noexcept {
   return false;
 }
 
+void Session::Impl::end_without_majority() {
+  if (config.partition != PartitionPolicy::end_match || !broken.empty()) return;
+  std::uint32_t staying = 0;
+  for (std::uint32_t p = 0; p < config.players; ++p)
+    if (disconnect_frame[p] == never) ++staying;
+  if (2 * staying > config.players) return;
+  ended = true;
+  broken = "the match ended: this machine is left with " + std::to_string(staying) + " of " +
+           std::to_string(config.players) +
+           " players, no majority (a partition and players leaving look alike from here; "
+           "SessionConfig::partition)";
+  raise(Event{EventType::match_ended, config.local_player, next_emit, 0, 0, "no majority"});
+}
+
 void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame,
                                 std::string_view reason) {
   // Frames already emitted are final: no peer can report an earlier frame unless the network is
@@ -381,6 +401,7 @@ void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame,
     }
     raise(Event{EventType::disconnected, player, frame, 0, 0, reason});
     retire_checks();
+    end_without_majority();
   } else if (frame < disconnect_frame[player]) {
     disconnect_frame[player] = frame;
   } else {

@@ -109,6 +109,9 @@ struct Session::Impl {
   /// `broken` set) when that state is no longer held.
   Status rollback();
   void emit_confirmed();
+  /// Ends the match (Event::match_ended, `broken`) when the players still in it are no strict
+  /// majority and the config says to (SessionConfig::partition).
+  void end_without_majority();
   void add_local_check(std::uint64_t frame, std::uint64_t hash, const detail::State* state);
   void compare_checks(detail::Peer& peer);
   void retire_checks();
@@ -193,6 +196,8 @@ struct Session::Impl {
   std::vector<detail::State> states;  ///< ring of saved states
   /// Set when the session cannot go on (a broken invariant): advance_frame returns it from then on.
   std::string broken;
+  /// The match ended without a majority (end_without_majority): nothing more is delivered.
+  bool ended = false;
   std::uint64_t current = 0;
   std::optional<std::uint64_t> first_incorrect;
   std::uint64_t next_emit = 0;  ///< the next frame to hand to the confirmed listener

@@ -109,7 +109,12 @@ bool Match::run() {
                   (bot.buttons + i * static_cast<std::uint8_t>(bot.move_x)) & 0xFFU);
           }
           auto result = s.advance_frame(input);
-          if (!result.ok()) return false;
+          if (!result.ok()) {  // the session stopped (a match that ended): keep what it said
+            for (std::uint32_t q = 0; q < options_.players; ++q)
+              for (const net::Event& e : sessions_[q]->take_events())
+                records_[q].events.push_back(e);
+            return false;
+          }
         }
       }
       for (const net::Event& e : s.take_events())

@@ -247,6 +247,10 @@ bool Netplay::handle_events() {
         failure_ = who + " disconnected at frame " + std::to_string(e.frame) + " (" +
                    disconnect_reason(e.reason) + ")";
         return false;
+      case net::EventType::match_ended:  // after a disconnect, which ended netplay's match above
+        if (failure_.empty())
+          failure_ = "the match ended at frame " + std::to_string(e.frame) + ": no majority left";
+        return false;
     }
   }
   return true;

@@ -43,6 +43,19 @@ namespace detsim::net {
 
 enum class SessionMode : std::uint8_t { rollback, lockstep };
 
+/// What a session does when a disconnect leaves it with no strict majority of the match's players
+/// (itself included) — in a two-player match, whenever the other player is gone: from its side
+/// a partition of the network looks exactly like the other player leaving, and both sides would
+/// play on alone, each sure it is right.
+enum class PartitionPolicy : std::uint8_t {
+  /// Raise Event::match_ended and stop: advance_frame() fails from then on. Every side of a
+  /// partition ends, and their delivered frames (delivered_frame(): held by every peer) agree.
+  end_match,
+  /// Play on with the gone players' inputs zeroed (for games where a player may drop and the rest
+  /// go on against bots); a partition then splits the match into two that never compare.
+  play_on,
+};
+
 /// A remote player and the transport peer that plays it.
 struct RemotePlayer {
   std::uint32_t player = 0;
@@ -80,6 +93,8 @@ struct SessionConfig {
   /// the path can read, forge and rewrite — for LAN tests and the simulated network only. A
   /// build without libsodium refuses a key (create() fails) rather than play unprotected.
   std::optional<MatchKey> match_key;
+  /// When a disconnect leaves this machine with no strict majority of the players.
+  PartitionPolicy partition = PartitionPolicy::end_match;
   std::vector<RemotePlayer> remotes;  ///< every other player, each exactly once
   /// Spectators this machine serves (at most 16; ids distinct from the remotes'): each receives
   /// every confirmed frame's inputs from here (SpectatorSession). Events about spectator k use
@@ -111,6 +126,11 @@ enum class EventType : std::uint8_t {
   /// one, is unverified with that peer. Raised once per peer. A relay that strips checks, or a
   /// peer that does not send them, ends here instead of passing unchecked.
   check_missing,
+  /// The match ended on this machine (`reason`: "no majority"): a disconnect left it with no
+  /// strict majority of the match's players, so it cannot tell a partition from players leaving
+  /// (SessionConfig::partition). `frame`: delivered_frame() then — the frames every side agrees
+  /// on. advance_frame() fails from then on; poll() still answers the peers.
+  match_ended,
 };
 
 struct Event {
