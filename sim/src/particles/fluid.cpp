@@ -49,38 +49,21 @@ KernelValue kernel(Vec3 r, Fixed d2, Fixed inv_h, bool a_first) {
   return {u2 * u, r * -(slope * inverse), slope};
 }
 
-// The kernel pass: per pair, W and its gradient at pair_a (into weight / gradient); per particle,
-// 1 + the sum of W, the sum of the gradients at it and the sum of their squares.
-void kernel_pass(std::span<const Vec3> x, Fixed radius, FluidScratch& sc) {
-  const std::size_t n = x.size();
-  const std::size_t pairs = sc.pair_a.size();
+// Each particle's density in kernel units: 1 + the sum of W over the pairs within reach (what the
+// statistics report; the solver keeps its own sums per neighbour entry).
+void density_pass(std::span<const Vec3> x, Fixed radius, FluidScratch& sc) {
   const Fixed radius2 = radius * radius;
   const Fixed inv_h = Fixed::one() / radius;
-  sc.density.assign(n, Fixed::one());
-  sc.gradient_sum.assign(n, Vec3{});
-  sc.gradient_square.assign(n, Fixed::zero());
-  sc.weight.resize(pairs);
-  sc.gradient.resize(pairs);
-  for (std::size_t k = 0; k < pairs; ++k) {
+  sc.density.assign(x.size(), Fixed::one());
+  for (std::size_t k = 0; k < sc.pair_a.size(); ++k) {
     const std::uint32_t a = sc.pair_a[k];
     const std::uint32_t b = sc.pair_b[k];
     const Vec3 r = x[a] - x[b];
     const Fixed d2 = length_squared(r);
-    if (d2 >= radius2) {
-      sc.weight[k] = Fixed::zero();
-      sc.gradient[k] = {};
-      continue;
-    }
-    const KernelValue kv = kernel(r, d2, inv_h, true);
-    sc.weight[k] = kv.weight;
-    sc.gradient[k] = kv.gradient;
-    sc.density[a] += kv.weight;
-    sc.density[b] += kv.weight;
-    sc.gradient_sum[a] += kv.gradient;
-    sc.gradient_sum[b] -= kv.gradient;
-    const Fixed g2 = kv.slope * kv.slope;
-    sc.gradient_square[a] += g2;
-    sc.gradient_square[b] += g2;
+    if (d2 >= radius2) continue;
+    const Fixed w = kernel(r, d2, inv_h, true).weight;
+    sc.density[a] += w;
+    sc.density[b] += w;
   }
 }
 
@@ -336,7 +319,7 @@ void apply_fluid_viscosity(ParticleGroup& g, FluidScratch& sc, Fixed viscosity) 
 std::vector<Fixed> fluid_densities(const ParticleGroup& g) {
   FluidScratch sc;
   find_fluid_pairs(g.positions, g.kernel_radius, sc);
-  kernel_pass(g.positions, g.kernel_radius, sc);
+  density_pass(g.positions, g.kernel_radius, sc);
   std::vector<Fixed> out(g.size());
   for (std::size_t i = 0; i < g.size(); ++i)
     out[i] = sc.density[i] / g.kernel_rest_sum;

@@ -58,16 +58,13 @@ struct FluidScratch {
   std::vector<std::uint32_t> bucket_of;     ///< per particle
   std::vector<std::uint32_t> bucket_start;  ///< per bucket, and one past the last
   std::vector<std::uint32_t> by_bucket;     ///< particle indices, bucket by bucket, ascending
-  // The pairs within reach, and per pair, from the last density pass, the kernel and its gradient
-  // at the first particle.
+  // The pairs within reach.
   std::vector<std::uint32_t> pair_a;
   std::vector<std::uint32_t> pair_b;
-  std::vector<Fixed> weight;
+  /// The density pass's scratch: the gradient at one particle of each of its neighbour entries.
   std::vector<Vec3> gradient;
   // Per particle.
-  std::vector<Fixed> density;  ///< 1 + the sum of W over the neighbours
-  std::vector<Vec3> gradient_sum;
-  std::vector<Fixed> gradient_square;
+  std::vector<Fixed> density;  ///< 1 + the sum of W over the neighbours (the statistics only)
   std::vector<Vec3> delta;
   // Each particle's neighbours (both ways), particle by particle.
   std::vector<std::uint32_t> neighbour_start;
