@@ -144,6 +144,36 @@ TEST(ScenarioRegister, ARegisteredGameRecordsVerifiesAndSeeks) {
   EXPECT_EQ(at->world().save(), straight->world().save());
 }
 
+TEST(ScenarioRegister, AGameStateSetAfterFrameZeroIsARecordingErrorThatSaysWhy) {
+  // A replay lists the sections of frame 0; a game section that appears later cannot be recorded.
+  static const bool registered = [] {
+    ScenarioDefinition late = tally();
+    late.name = "tally_late";
+    late.build = [](World& w, const ScenarioParams&) {
+      BodyDef ground;
+      ground.type = BodyType::static_body;
+      ground.shape = Shape::plane();
+      (void)w.create_body(ground);
+    };
+    late.control = [](World& w, std::span<const PlayerInput>, const ScenarioParams&) {
+      (void)w.set_game_state(std::vector<std::uint8_t>{1});
+    };
+    return register_scenario(late).ok();
+  }();
+  ASSERT_TRUE(registered);
+  test::TempFile file("late.dsr");
+  auto scenario = Scenario::create("tally_late");
+  ASSERT_TRUE(scenario.ok());
+  replay::RecordOptions options;
+  options.frames = 10;
+  auto recorded = replay::record(scenario.value(), file.path(), options);
+  ASSERT_FALSE(recorded.ok());
+  EXPECT_NE(recorded.message().find("frame 1: the state's sections"), std::string::npos)
+      << recorded.message();
+  EXPECT_NE(recorded.message().find("must be set before the first frame"), std::string::npos)
+      << recorded.message();
+}
+
 TEST(ScenarioRegister, BadDefinitionsAreRefusedNamingTheProblem) {
   ensure_tally();
   const auto refused = [](ScenarioDefinition d, const std::string& expected) {

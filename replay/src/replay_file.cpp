@@ -308,8 +308,13 @@ Status ReplayWriter::frame(std::span<const std::uint8_t> inputs, const StateHash
     std::string got;
     for (const SectionHash& h : hashes.sections)
       got += (got.empty() ? "" : ", ") + h.name;
+    const bool game = got.find("game") != std::string::npos ||
+                      std::find(sections.begin(), sections.end(), "game") != sections.end();
     return m.fail("frame " + std::to_string(m.frames + 1) + ": the state's sections (" + got +
-                  ") are not the fingerprint's");
+                  ") are not the fingerprint's" +
+                  (game ? std::string(" (a game's own state must be set before the first frame, "
+                                      "in its scenario's build, and kept for the run)")
+                        : std::string()));
   }
   m.pending.raw(inputs);
   encode_hashes(hashes, m.pending);

@@ -218,6 +218,9 @@ struct Registry {
   }
   const ScenarioEntry* find(std::string_view name) {
     const std::lock_guard lock(mutex);
+    return find_locked(name);
+  }
+  const ScenarioEntry* find_locked(std::string_view name) const {
     for (const ScenarioEntry& e : entries)
       if (e.info.name == name) return &e;
     return nullptr;
@@ -289,9 +292,11 @@ Status register_scenario(const ScenarioDefinition& d) {
   if (Status s = World::create(d.world).status(); !s)
     return Status::error(which + "world: " + s.message());
   Registry& r = registry();
-  if (r.find(d.name) != nullptr)
-    return Status::error(which + "a scenario of that name exists (known: " + known_names() + ")");
+  const std::string known = known_names();
+  // One lock for the check and the insertion: two threads registering one name cannot both win.
   const std::lock_guard lock(r.mutex);
+  if (r.find_locked(d.name) != nullptr)
+    return Status::error(which + "a scenario of that name exists (known: " + known + ")");
   ScenarioEntry& e = r.entries.emplace_back();
   e.name = d.name;
   e.summary = d.summary;
