@@ -9,6 +9,7 @@ packages=(
   libgtest-dev                                                 # tests
   libxxhash-dev libcli11-dev                                   # state hashing, the CLI
   libsodium-dev pkg-config                                     # net/: session ids, challenges
+  libzstd-dev                                                  # net/: rejoin snapshots
   libmpfr-dev libgmp-dev                                       # reference for the accuracy tests
   libbenchmark-dev libfixmath-dev libbullet-dev               # benchmarks and their peers
   python3                                                      # docs/ table generation

@@ -36,6 +36,9 @@ struct Sample {
   std::size_t input_size;
 };
 
+/// The highest packet type: every one above is unknown.
+constexpr std::uint8_t last_type = static_cast<std::uint8_t>(PacketType::state_chunk);
+
 std::vector<Sample> samples() {
   std::vector<Sample> out;
   Packet hello = make(PacketType::hello, 0xDEADBEEF, 77);
@@ -49,6 +52,15 @@ std::vector<Sample> samples() {
     ping.ping.time_us = 123456789012345ULL;
     out.push_back({type == PacketType::ping ? "ping" : "pong", ping, 64});
   }
+  Packet request = make(PacketType::state_request, 11, 12);
+  request.state_request.offset = 70'000;
+  out.push_back({"state_request", request, 4});
+  Packet chunk = make(PacketType::state_chunk, 13, 14);
+  chunk.state_chunk.total = 5000;
+  chunk.state_chunk.offset = 1024;
+  for (std::size_t i = 0; i < 40; ++i)
+    chunk.state_chunk.data.push_back(byte(i * 29 + 3));
+  out.push_back({"state_chunk", chunk, 4});
   out.push_back({"input empty", input_packet(0, {}), 4});
   Bytes mixed(20);
   for (std::size_t i = 0; i < mixed.size(); ++i)
@@ -105,7 +117,7 @@ TEST(NetProtocolDecode, EverySingleBitFlipIsRefused) {
         DecodeError expected = DecodeError::bad_checksum;
         if (i < 2) expected = DecodeError::bad_magic;
         if (i == 2) expected = DecodeError::bad_version;
-        if (i == 3 && (flipped[3] < 1 || flipped[3] > 5)) expected = DecodeError::bad_type;
+        if (i == 3 && (flipped[3] < 1 || flipped[3] > last_type)) expected = DecodeError::bad_type;
         const DecodeError got = decode_bytes(flipped, s.input_size);
         ASSERT_NE(got, DecodeError::none) << s.name << ", byte " << i << " bit " << bit;
         EXPECT_EQ(got, expected) << s.name << ", byte " << i << " bit " << bit;
@@ -120,7 +132,7 @@ TEST(NetProtocolDecode, LengthLimits) {
   EXPECT_EQ(decode_bytes(small, 4), DecodeError::too_short);
   EXPECT_EQ(decode_bytes({}, 4), DecodeError::too_short);
   // A sealed header with no body: long enough to check, too short for any body.
-  for (std::uint8_t type = 1; type <= 5; ++type)
+  for (std::uint8_t type = 1; type <= last_type; ++type)
     EXPECT_EQ(decode_bytes(Writer().header(type, 1, 2).sealed(), 4), DecodeError::bad_length)
         << "type " << int{type};
   // A ping with trailing bytes up to exactly max_datagram is checked to the end (bad_length); one
@@ -155,7 +167,8 @@ TEST(NetProtocolDecode, WrongMagicVersionAndType) {
     w.u8('D').u8('N').u8(v).u8(4).u32(1).u16(2).u64(3);
     EXPECT_EQ(decode_bytes(w.sealed(), 4), DecodeError::bad_version) << "version " << int{v};
   }
-  for (const std::uint8_t type : {std::uint8_t{0}, std::uint8_t{6}, std::uint8_t{255}}) {
+  for (const std::uint8_t type :
+       {std::uint8_t{0}, std::uint8_t{last_type + 1}, std::uint8_t{255}}) {
     Writer w;
     w.header(type, 1, 2).u64(3);
     EXPECT_EQ(decode_bytes(w.sealed(), 4), DecodeError::bad_type) << "type " << int{type};

@@ -57,6 +57,48 @@ TEST(NetProtocolRoundTrip, HelloReplyPingPongAtExtremes) {
   }
 }
 
+TEST(NetProtocolRoundTrip, StateRequestAndChunkAtTheirBounds) {
+  for (const std::uint32_t offset :
+       {0U, 1U, 127U, 128U, static_cast<std::uint32_t>(max_state_transfer)}) {
+    Packet request = make(PacketType::state_request, 3, 4);
+    request.state_request.offset = offset;
+    expect_round_trip(request, 4, plain_bytes(request));
+  }
+  for (const std::size_t length : {std::size_t{1}, max_state_chunk}) {
+    Packet chunk = make(PacketType::state_chunk, max_u64, 0xFFFF);
+    chunk.state_chunk.total = static_cast<std::uint32_t>(max_state_transfer);
+    chunk.state_chunk.offset = static_cast<std::uint32_t>(max_state_transfer - length);
+    chunk.state_chunk.data.resize(length);
+    for (std::size_t i = 0; i < length; ++i)
+      chunk.state_chunk.data[i] = static_cast<std::uint8_t>(i * 131 + 7);
+    const Bytes expected = plain_bytes(chunk);
+    EXPECT_LE(expected.size(), max_datagram);
+    expect_round_trip(chunk, 4, expected);
+  }
+}
+
+TEST(NetProtocolRoundTrip, StateFieldsOutOfBoundsAreBadFieldsAndNeverEncode) {
+  const auto chunk = [](std::uint32_t total, std::uint32_t offset, std::size_t length) {
+    Packet p = make(PacketType::state_chunk, 1, 2);
+    p.state_chunk.total = total;
+    p.state_chunk.offset = offset;
+    p.state_chunk.data.assign(length, 0xAB);
+    return p;
+  };
+  const auto too_big = static_cast<std::uint32_t>(max_state_transfer + 1);
+  for (const Packet& bad : {chunk(0, 0, 1), chunk(10, 0, 0), chunk(10, 5, 6), chunk(too_big, 0, 1),
+                            chunk(5000, 0, max_state_chunk + 1)}) {
+    Bytes out;
+    EXPECT_FALSE(encode(bad, 4, out));
+    EXPECT_EQ(decode_bytes(plain_bytes(bad), 4), DecodeError::bad_field);
+  }
+  Packet request = make(PacketType::state_request, 1, 2);
+  request.state_request.offset = too_big;
+  Bytes out;
+  EXPECT_FALSE(encode(request, 4, out));
+  EXPECT_EQ(decode_bytes(plain_bytes(request), 4), DecodeError::bad_field);
+}
+
 TEST(NetProtocolRoundTrip, HeaderFieldsAreLittleEndian) {
   Packet p = make(PacketType::ping, 0x1122334455667788ULL, 0xE5F6);
   p.ping.time_us = 0x0102030405060708ULL;
@@ -534,7 +576,8 @@ TEST(NetProtocolEncode, RefusesInconsistentPackets) {
     expect_refused(q, 0, "input_size 0");
     expect_refused(q, max_unit_size + 1, "input_size max_unit_size + 1");
   }
-  for (const std::uint8_t type : {std::uint8_t{0}, std::uint8_t{6}, std::uint8_t{255}}) {
+  constexpr auto unknown = static_cast<std::uint8_t>(PacketType::state_chunk) + 1;
+  for (const std::uint8_t type : {std::uint8_t{0}, std::uint8_t{unknown}, std::uint8_t{255}}) {
     hello.header.type = static_cast<PacketType>(type);
     expect_refused(hello, 4, "type " + std::to_string(type));
   }

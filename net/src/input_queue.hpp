@@ -43,6 +43,14 @@ class InputQueue {
     return reference(next_confirmed_);
   }
 
+  /// Empties the queue so that the next confirmed input is `frame`'s (a rejoining session, which
+  /// starts from a snapshot instead of frame 0).
+  void restart_at(std::uint64_t frame) noexcept {
+    std::fill(confirmed_.begin(), confirmed_.end(), std::uint8_t{0});
+    std::fill(used_.begin(), used_.end(), std::uint8_t{0});
+    next_confirmed_ = frame;
+  }
+
   /// Appends the confirmed input of frame next_confirmed().
   void confirm(std::span<const std::uint8_t> input) noexcept {
     std::copy(input.begin(), input.end(),

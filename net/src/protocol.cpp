@@ -150,6 +150,13 @@ bool run_length_decode(Reader& in, std::size_t length, std::vector<std::uint8_t>
 }
 
 bool body_ok(const Packet& p, std::size_t input_size) {
+  if (p.header.type == PacketType::state_chunk) {
+    const StateChunk& c = p.state_chunk;
+    return c.total > 0 && c.total <= max_state_transfer && !c.data.empty() &&
+           c.data.size() <= max_state_chunk && std::size_t{c.offset} + c.data.size() <= c.total;
+  }
+  if (p.header.type == PacketType::state_request)
+    return p.state_request.offset <= max_state_transfer;
   if (p.header.type != PacketType::input) return true;
   const InputBody& b = p.input;
   return b.deltas.size() == std::size_t{b.count} * input_size &&
@@ -225,12 +232,21 @@ void put_body(const Packet& packet, std::vector<std::uint8_t>& out) {
     case PacketType::pong:
       put(out, packet.ping.time_us, 8);
       break;
+    case PacketType::state_request:
+      put_varint(out, packet.state_request.offset);
+      break;
+    case PacketType::state_chunk:
+      put_varint(out, packet.state_chunk.total);
+      put_varint(out, packet.state_chunk.offset);
+      put_varint(out, packet.state_chunk.data.size());
+      out.insert(out.end(), packet.state_chunk.data.begin(), packet.state_chunk.data.end());
+      break;
   }
 }
 
 bool known_type(std::uint8_t type) noexcept {
   return type >= static_cast<std::uint8_t>(PacketType::hello) &&
-         type <= static_cast<std::uint8_t>(PacketType::pong);
+         type <= static_cast<std::uint8_t>(PacketType::state_chunk);
 }
 
 bool handshake(PacketType type) noexcept {
@@ -292,6 +308,32 @@ DecodeError get_body(Reader& in, PacketType type, std::size_t input_size, Packet
     case PacketType::pong:
       out.ping.time_us = in.u64();
       break;
+    case PacketType::state_request: {
+      bool bad = false;
+      const std::uint64_t offset = in.varint(bad);
+      if (!in.ok()) return DecodeError::bad_length;
+      if (bad || offset > max_state_transfer) return DecodeError::bad_field;
+      out.state_request.offset = static_cast<std::uint32_t>(offset);
+      break;
+    }
+    case PacketType::state_chunk: {
+      StateChunk& c = out.state_chunk;
+      bool bad = false;
+      const std::uint64_t total = in.varint(bad);
+      const std::uint64_t offset = in.varint(bad);
+      const std::uint64_t length = in.varint(bad);
+      if (!in.ok()) return DecodeError::bad_length;
+      // Every bound before the copy: at most max_state_chunk bytes, inside the snapshot.
+      if (bad || total == 0 || total > max_state_transfer || length == 0 ||
+          length > max_state_chunk || offset + length > total)
+        return DecodeError::bad_field;
+      c.total = static_cast<std::uint32_t>(total);
+      c.offset = static_cast<std::uint32_t>(offset);
+      c.data.resize(static_cast<std::size_t>(length));
+      for (std::uint8_t& b : c.data)
+        b = in.u8();
+      break;
+    }
   }
   if (!in.ok() || !in.at_end()) return DecodeError::bad_length;
   return DecodeError::none;

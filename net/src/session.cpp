@@ -25,9 +25,15 @@ Status validate(const SessionConfig& c) {
   const auto bad = [](const std::string& what) { return Status::error("session config: " + what); };
   if (c.players < 1 || c.players > max_players)
     return bad("players must be 1 .. 8, got " + std::to_string(c.players));
-  if (c.partition != PartitionPolicy::end_match && c.partition != PartitionPolicy::play_on)
-    return bad("partition must be end_match or play_on, got " +
+  if (c.partition != PartitionPolicy::end_match && c.partition != PartitionPolicy::play_on &&
+      c.partition != PartitionPolicy::pause)
+    return bad("partition must be end_match, play_on or pause, got " +
                std::to_string(static_cast<unsigned>(c.partition)));
+  if (c.rejoin && c.players != 2)
+    return bad("rejoin is for two-player matches only (this one has " + std::to_string(c.players) +
+               " players)");
+  if (c.rejoin && !c.spectators.empty())
+    return bad("a rejoining session serves no spectators (they followed the earlier one)");
   if (c.local_player >= c.players)
     return bad("local_player must be below players (" + std::to_string(c.players) + "), got " +
                std::to_string(c.local_player));
@@ -112,6 +118,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
   zero.frame = 0;
   zero.hash = game->save(zero.bytes);
   agreed_state = zero.bytes;  // every peer starts from the same state (the fingerprint says so)
+  awaiting_state = c.rejoin;  // the match's state comes from a peer instead
 }
 
 bool Session::Impl::gone_final(std::uint32_t player) const noexcept {
@@ -345,6 +352,21 @@ void Session::Impl::receive_input(detail::Peer& peer, std::uint64_t frame,
   q.confirm(input);
 }
 
+bool Session::Impl::majority_without(std::uint32_t player) const noexcept {
+  std::uint32_t staying = 0;
+  for (std::uint32_t p = 0; p < config.players; ++p)
+    if (p != player && disconnect_frame[p] == never) ++staying;
+  return 2 * staying > config.players;
+}
+
+void Session::Impl::restart_clocks() {
+  window_start_us = now_us;
+  window_advanced = 0;
+  window_held = 0;
+  for (detail::LocalCheck& c : local_checks)
+    c.confirmed_us = std::max(c.confirmed_us, now_us);
+}
+
 void Session::Impl::disconnect(detail::Peer& peer, std::string_view reason) {
   player_gone(peer.player, queues[peer.player].next_confirmed(), reason);
 }
@@ -390,6 +412,15 @@ void Session::Impl::player_gone(std::uint32_t player, std::uint64_t frame,
   // Frames already emitted are final: no peer can report an earlier frame unless the network is
   // partitioned, and then the hash checks will tell.
   frame = std::max(frame, next_emit);
+  if (disconnect_frame[player] == never && config.partition == PartitionPolicy::pause &&
+      !majority_without(player)) {
+    // The match waits for the player instead (it may come back, or rejoin).
+    if (!paused) {
+      paused = true;
+      raise(Event{EventType::paused, player, next_emit, 0, 0, "no majority"});
+    }
+    return;
+  }
   if (disconnect_frame[player] == never) {
     // From now on this machine takes no input of the player: its holdings are frozen.
     frame = std::min(frame, queues[player].next_confirmed());

@@ -78,6 +78,14 @@ struct Peer {
   std::optional<std::uint64_t> ping_out;
   bool interrupted = false;
   bool disconnected = false;
+  // Rejoin (docs/NET.md, "Rejoining"), on the side that stayed. A hello naming another session of
+  // the peer's player is answered, and met with a challenge of our own (one per hello interval);
+  // only a reply to it, which comes from the peer's address, rebinds the peer to a new session,
+  // which is then served `snapshot` until its first input datagram.
+  std::optional<std::uint64_t> rechallenge;
+  std::optional<std::uint64_t> last_rechallenge_us;
+  std::vector<std::uint8_t> snapshot;
+  bool rejoining = false;
   bool needs_ack = false;  ///< received data since the last packet we sent
   std::uint16_t send_sequence = 0;
   std::optional<std::uint16_t> last_sequence;
@@ -149,6 +157,11 @@ struct Session::Impl {
     return states[static_cast<std::size_t>(frame % states.size())];
   }
   void raise(Event e) { events.push_back(e); }
+  /// Whether the players other than `player` that are still in the match are a strict majority.
+  [[nodiscard]] bool majority_without(std::uint32_t player) const noexcept;
+  /// The match goes on after a pause (PartitionPolicy::pause) or an outage: the progress guard
+  /// and the hash-check deadlines count from now, not from before the silence.
+  void restart_clocks();
 
   // session_wire.cpp: the network.
   void receive_all();
@@ -170,10 +183,21 @@ struct Session::Impl {
   void send_due();
   void send_inputs(detail::Peer& peer);
   void send_frames(detail::Peer& spectator);
-  void send_hello(detail::Peer& peer);
+  void send_hello(detail::Peer& peer, std::uint64_t challenge);
   void send(detail::Peer& peer, protocol::Packet& packet);
   void check_timeouts();
   [[nodiscard]] detail::Peer* peer_by_id(PeerId id) noexcept;
+  // session_rejoin.cpp: a restarted player's way back (docs/NET.md, "Rejoining").
+  /// A hello that names a new session of a synchronized peer's player: answered, and met with
+  /// a challenge of our own (at most one per hello interval).
+  void handle_rejoin_hello(detail::Peer& peer, const protocol::Packet& packet);
+  /// The peer answered our rechallenge from `session`: a new session takes its seat.
+  void rebind(detail::Peer& peer, std::uint64_t session);
+  void serve_state(detail::Peer& peer, std::uint32_t offset);
+  void receive_state(detail::Peer& peer, const protocol::StateChunk& chunk);
+  /// Loads the whole snapshot received from `from`; an error (and `broken`) when it is invalid.
+  Status load_snapshot(detail::Peer& from);
+  void request_state();
 
   SessionConfig config;
   Game* game;
@@ -215,6 +239,13 @@ struct Session::Impl {
 
   std::deque<detail::LocalCheck> local_checks;
   std::optional<DesyncEvidence> evidence;
+  // Rejoin, on the rejoining side: the snapshot as it arrives, until it is whole and loaded.
+  bool awaiting_state = false;
+  std::vector<std::uint8_t> incoming;
+  std::uint32_t incoming_total = 0;
+  std::optional<std::uint64_t> last_request_us;
+  /// PartitionPolicy::pause: Event::paused was raised and no silent player came back yet.
+  bool paused = false;
   std::uint64_t agreed_frame = 0;
   std::vector<std::uint8_t> agreed_state;
 

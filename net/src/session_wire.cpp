@@ -115,6 +115,13 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
     // be spoofed), so it is not a sign of life either.
     handle_hello(peer, p);
     return;
+  } else if (p.header.type == PacketType::hello_reply && peer.rechallenge &&
+             p.hello_reply.challenge == *peer.rechallenge) {
+    // The answer to a rechallenge (session_rejoin.cpp): from the session we know, nothing
+    // changes; from a new one, a restarted process of the peer's player takes the seat.
+    peer.rechallenge.reset();
+    if (p.header.session == peer.remote_session) return;
+    rebind(peer, p.header.session);
   } else if (p.header.type == PacketType::hello_reply) {
     // The peer's session id is taken from the reply to our own challenge only — 64 random bits
     // sent to its address alone, which a third party off the path never sees — and once.
@@ -156,6 +163,14 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
           rtt * 16 > peer.rtt_x16 ? rtt * 16 - peer.rtt_x16 : peer.rtt_x16 - rtt * 16;
       peer.rtt_x16 = smooth(peer.rtt_x16, rtt, first);
       peer.jitter_x16 = smooth(peer.jitter_x16, deviation / 16, first);
+    } else if (p.header.type == PacketType::state_request) {
+      if (!peer.rejoining) {  // only a peer that rejoined is served a snapshot
+        ++stats.dropped_implausible;
+        return;
+      }
+      serve_state(peer, p.state_request.offset);
+    } else if (p.header.type == PacketType::state_chunk) {
+      receive_state(peer, p.state_chunk);
     } else if (!handle_input(peer, p.input, fresh)) {
       ++stats.dropped_implausible;
       return;
@@ -178,13 +193,21 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
   if (peer.interrupted) {
     peer.interrupted = false;
     raise(Event{EventType::resumed, peer.player, current, 0, 0, {}});
+    // A pause ends when every player is heard again; the clocks start anew from here.
+    if (paused && std::none_of(peers.begin(), peers.end(),
+                               [](const detail::Peer& x) { return x.interrupted; })) {
+      paused = false;
+      restart_clocks();
+    }
   }
   if (!peer.synchronized && peer.answered) {
     peer.synchronized = true;
     peer.stats.synchronized = true;
     raise(Event{EventType::synchronized, peer.player, current, 0, 0, {}});
-    if (!peer.spectator && std::all_of(peers.begin(), peers.end(),
-                                       [](const detail::Peer& x) { return x.synchronized; })) {
+    // A rejoining session runs once the snapshot is loaded (load_snapshot), not before.
+    if (!peer.spectator && !awaiting_state &&
+        std::all_of(peers.begin(), peers.end(),
+                    [](const detail::Peer& x) { return x.synchronized; })) {
       running = true;
       window_start_us = now_us;  // the progress guard counts from here
       raise(Event{EventType::running, 0, current, 0, 0, {}});
@@ -208,8 +231,11 @@ void Session::Impl::handle_hello(detail::Peer& peer, const protocol::Packet& p) 
     reject(peer, reason);
     return;
   }
-  if (peer.knows_us) {  // the genuine peer has our id already: this one is stale or forged
+  if (peer.knows_us) {
+    // The genuine peer has our id already: this hello is stale, forged, or from a restarted
+    // process of the peer's player (session_rejoin.cpp). It is not believed, only answered.
     ++stats.dropped_wrong_session;
+    handle_rejoin_hello(peer, p);
     return;
   }
   // Every matching hello is answered (to the peer's address, whoever sent it): a flood of forged
@@ -262,6 +288,10 @@ bool Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& 
     peer.advantage_x16 = smooth_signed(peer.advantage_x16, ahead);
   }
 
+  if (peer.rejoining) {  // the rejoined session has the snapshot: it plays from here
+    peer.rejoining = false;
+    peer.snapshot = {};
+  }
   detail::InputQueue& q = queues[peer.player];
   if (b.count > 0 && disconnect_frame[peer.player] == detail::never) {
     const std::uint64_t start = b.start_frame;
@@ -372,15 +402,13 @@ void Session::Impl::send_inputs(detail::Peer& peer) {
   send(peer, p);
 }
 
-void Session::Impl::send_hello(detail::Peer& peer) {
+void Session::Impl::send_hello(detail::Peer& peer, std::uint64_t challenge) {
   protocol::Packet hello;
   hello.header.type = protocol::PacketType::hello;
   hello.hello = protocol::Hello{config.fingerprint, static_cast<std::uint8_t>(config.players),
                                 static_cast<std::uint8_t>(config.local_player),
-                                static_cast<std::uint8_t>(config.input_size), peer.challenge};
+                                static_cast<std::uint8_t>(config.input_size), challenge};
   send(peer, hello);
-  peer.hello_sent = true;
-  peer.last_hello_us = now_us;
 }
 
 void Session::Impl::send_frames(detail::Peer& spectator) {
@@ -410,14 +438,18 @@ void Session::Impl::send_frames(detail::Peer& spectator) {
 }
 
 void Session::Impl::send_due() {
+  if (awaiting_state) request_state();
   const detail::InputQueue& mine = queues[config.local_player];
   const std::uint64_t logged = unit_size ? frame_log.size() / unit_size : 0;
   for (std::vector<detail::Peer>* group : {&peers, &spectators}) {
     for (detail::Peer& peer : *group) {
       if (peer.disconnected) continue;
       if (!peer.answered &&
-          (!peer.hello_sent || now_us - peer.last_hello_us >= config.hello_interval_us))
-        send_hello(peer);
+          (!peer.hello_sent || now_us - peer.last_hello_us >= config.hello_interval_us)) {
+        send_hello(peer, peer.challenge);
+        peer.hello_sent = true;
+        peer.last_hello_us = now_us;
+      }
       if (!peer.synchronized) continue;
       if (now_us - peer.last_ping_us >= config.ping_interval_us) {
         protocol::Packet ping;
@@ -434,6 +466,9 @@ void Session::Impl::send_due() {
           send_frames(peer);
         continue;
       }
+      // A rejoining session has no inputs yet, and a peer rejoining here none of ours: until its
+      // first input datagram it is sent the snapshot it asks for instead (session_rejoin.cpp).
+      if (awaiting_state || peer.rejoining) continue;
       // advance_frame() sends each new local input at once; here only what it did not cover: a
       // stall (waiting at the limit adds no input), acknowledgements, resends and keepalives.
       // Waiting a frame and a half first keeps the normal flow at one datagram per frame.

@@ -108,6 +108,10 @@ struct SpectatorSession::Impl {
       }
       case PacketType::pong:
         return;
+      case PacketType::state_request:  // between players only
+      case PacketType::state_chunk:
+        ++stats.dropped;
+        return;
       case PacketType::input:
         if (!running || p.header.session != host_session) {
           ++stats.dropped;

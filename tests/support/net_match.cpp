@@ -11,38 +11,61 @@ Match::Match(const MatchOptions& options) : options_(options) {
   network_.emplace(std::move(network.value()));  // the test's own settings: always valid
   if (options.setup) options.setup(*network_);
   records_.resize(options.players);
+  sessions_.resize(options.players);
   for (std::uint32_t p = 0; p < options.players; ++p) {
     games_.push_back(make_game(p));
-    net::SessionConfig config;
-    config.mode = options.mode;
-    config.players = options.players;
-    config.local_player = p;
-    config.input_size = options.arena ? net::ScenarioGame::input_size : 4;
-    config.input_delay = options.input_delay;
-    config.max_prediction = options.max_prediction;
-    config.check_interval = options.check_interval;
-    config.fingerprint = 0xD5'1A'77ULL + options.players;
-    config.match_key = options.match_key;
-    for (std::uint32_t q = 0; q < options.players; ++q)
-      if (q != p) config.remotes.push_back(net::RemotePlayer{q, q});
-    if (p == 0)
-      for (std::uint32_t k = 0; k < options.spectators; ++k)
-        config.spectators.push_back(options.players + k);
-    if (options.configure) options.configure(p, config);
     net::Transport* transport = &network_->endpoint(p);
     if (options.wrap) {
       wrappers_.push_back(options.wrap(p, *transport));
       if (wrappers_.back()) transport = wrappers_.back().get();
     }
-    auto session = net::Session::create(config, *games_[p], *transport);
-    sessions_.emplace_back(std::move(session.value()));
-    PeerRecord& record = records_[p];
-    sessions_[p]->set_confirmed_listener([&record](const net::ConfirmedFrame& f) {
-      record.hashes.push_back(f.hash);
-      record.inputs.insert(record.inputs.end(), f.inputs.begin(), f.inputs.end());
-      record.status.insert(record.status.end(), f.status.begin(), f.status.end());
-    });
+    transports_.push_back(transport);
+    start_session(p, false);
   }
+}
+
+void Match::start_session(std::uint32_t p, bool rejoin) {
+  net::SessionConfig config;
+  config.mode = options_.mode;
+  config.players = options_.players;
+  config.local_player = p;
+  config.input_size = options_.arena ? net::ScenarioGame::input_size : 4;
+  config.input_delay = options_.input_delay;
+  config.max_prediction = options_.max_prediction;
+  config.check_interval = options_.check_interval;
+  config.fingerprint = 0xD5'1A'77ULL + options_.players;
+  config.match_key = options_.match_key;
+  config.rejoin = rejoin;
+  for (std::uint32_t q = 0; q < options_.players; ++q)
+    if (q != p) config.remotes.push_back(net::RemotePlayer{q, q});
+  if (p == 0 && !rejoin)
+    for (std::uint32_t k = 0; k < options_.spectators; ++k)
+      config.spectators.push_back(options_.players + k);
+  if (options_.configure) options_.configure(p, config);
+  auto session = net::Session::create(config, *games_[p], *transports_[p]);
+  sessions_[p].emplace(std::move(session.value()));
+  PeerRecord& record = records_[p];
+  sessions_[p]->set_confirmed_listener([&record](const net::ConfirmedFrame& f) {
+    if (record.hashes.empty()) record.first_frame = f.frame;
+    record.hashes.push_back(f.hash);
+    record.inputs.insert(record.inputs.end(), f.inputs.begin(), f.inputs.end());
+    record.status.insert(record.status.end(), f.status.begin(), f.status.end());
+  });
+}
+
+bool Match::restarted_peer_up(std::uint32_t p) {
+  if (options_.restart_peer != p) return true;
+  if (tick_ == options_.restart_tick && sessions_[p]) {  // the process dies: all of it is lost
+    sessions_[p].reset();
+    games_[p].reset();
+    earlier_record_ = std::move(records_[p]);
+    records_[p] = PeerRecord{};
+  }
+  if (tick_ == options_.rejoin_tick && !sessions_[p]) {
+    games_[p] = make_game(p);
+    start_session(p, true);
+  }
+  return sessions_[p].has_value();
 }
 
 std::unique_ptr<net::Game> Match::make_game(std::uint32_t p) {
@@ -93,6 +116,10 @@ bool Match::run() {
     network_->advance_to(now);
     bool done = true;
     for (std::uint32_t p = 0; p < options_.players; ++p) {
+      if (!restarted_peer_up(p)) {
+        done = false;
+        continue;
+      }
       net::Session& s = *sessions_[p];
       s.poll(now);
       if (options_.on_tick) options_.on_tick(p, tick_, s);
@@ -111,8 +138,9 @@ bool Match::run() {
           auto result = s.advance_frame(input);
           if (!result.ok()) {  // the session stopped (a match that ended): keep what it said
             for (std::uint32_t q = 0; q < options_.players; ++q)
-              for (const net::Event& e : sessions_[q]->take_events())
-                records_[q].events.push_back(e);
+              if (sessions_[q])
+                for (const net::Event& e : sessions_[q]->take_events())
+                  records_[q].events.push_back(e);
             return false;
           }
         }
@@ -120,7 +148,8 @@ bool Match::run() {
       for (const net::Event& e : s.take_events())
         records_[p].events.push_back(e);
       const bool gone = !active;
-      if (!gone && records_[p].hashes.size() < options_.frames) done = false;
+      if (!gone && records_[p].first_frame + records_[p].hashes.size() < options_.frames)
+        done = false;
     }
     for (std::uint32_t k = 0; k < options_.spectators; ++k) {
       if (tick_ < options_.spectator_join_tick) {
@@ -144,6 +173,7 @@ void Match::idle(std::uint64_t ticks) {
     const std::uint64_t now = tick_ * 16'667;
     network_->advance_to(now);
     for (std::uint32_t p = 0; p < options_.players; ++p) {
+      if (!sessions_[p]) continue;
       sessions_[p]->poll(now);
       for (const net::Event& e : sessions_[p]->take_events())
         records_[p].events.push_back(e);

@@ -68,6 +68,7 @@ class CounterGame final : public net::Game {
 
 /// What one peer confirmed.
 struct PeerRecord {
+  std::uint64_t first_frame = 0;         ///< the frame of hashes[0] (a rejoined session's is late)
   std::vector<std::uint64_t> hashes;     ///< per confirmed frame
   std::vector<std::uint8_t> inputs;      ///< every confirmed frame's inputs, concatenated
   std::vector<net::InputStatus> status;  ///< per confirmed frame and player
@@ -130,6 +131,12 @@ struct MatchOptions {
   std::uint32_t spectators = 0;
   std::uint64_t spectator_join_tick = 0;
   std::function<void(std::uint32_t spectator, net::SpectatorConfig&)> configure_spectator;
+  /// A restart of one player's process: at restart_tick its session and game are destroyed and
+  /// it falls silent; at rejoin_tick a new game (at frame 0) and a session with
+  /// SessionConfig::rejoin take the seat, with a new record (earlier_record() keeps the old one).
+  std::optional<std::uint32_t> restart_peer;
+  std::uint64_t restart_tick = 0;
+  std::uint64_t rejoin_tick = 0;
 };
 
 /// N peers, each with its own game and session, over one SimNetwork.
@@ -147,6 +154,8 @@ class Match {
   net::Session& session(std::uint32_t p) { return *sessions_[p]; }
   net::SimNetwork& network() { return *network_; }
   const PeerRecord& record(std::uint32_t p) const { return records_[p]; }
+  /// The record of restart_peer's session before the restart.
+  const PeerRecord& earlier_record() const { return earlier_record_; }
   const PeerRecord& spectator_record(std::uint32_t k) const { return spectator_records_[k]; }
   net::SpectatorSession& spectator(std::uint32_t k) { return *spectator_sessions_[k]; }
   std::uint64_t ticks() const { return tick_; }
@@ -163,6 +172,12 @@ class Match {
 
  private:
   std::unique_ptr<net::Game> make_game(std::uint32_t p);
+  /// Creates peer p's session (config.rejoin as given) and points its listener at records_[p].
+  void start_session(std::uint32_t p, bool rejoin);
+  /// Takes restart_peer down or back up at this tick; false while it is down.
+  bool restarted_peer_up(std::uint32_t p);
+  PeerRecord earlier_record_;
+  std::vector<net::Transport*> transports_;
   void add_spectators();
 
   MatchOptions options_;

@@ -163,7 +163,7 @@ inline Bytes input_bytes(const Packet& p, std::span<const std::uint8_t> tokens) 
   return w.sealed();
 }
 
-/// The bytes of a hello, hello_reply, ping or pong packet.
+/// The bytes of a hello, hello_reply, ping, pong, state_request or state_chunk packet.
 inline Bytes plain_bytes(const Packet& p) {
   Writer w;
   w.header(static_cast<std::uint8_t>(p.header.type), p.header.session, p.header.sequence);
@@ -181,6 +181,15 @@ inline Bytes plain_bytes(const Packet& p) {
     case PacketType::ping:
     case PacketType::pong:
       w.u64(p.ping.time_us);
+      break;
+    case PacketType::state_request:
+      w.varint(p.state_request.offset);
+      break;
+    case PacketType::state_chunk:
+      w.varint(p.state_chunk.total)
+          .varint(p.state_chunk.offset)
+          .varint(p.state_chunk.data.size())
+          .raw(p.state_chunk.data);
       break;
     case PacketType::input:
       ADD_FAILURE() << "plain_bytes of an input packet";
@@ -323,6 +332,15 @@ inline testing::AssertionResult same_packet(const Packet& a, const Packet& b) {
     case PacketType::pong:
       if (a.ping.time_us != b.ping.time_us)
         return testing::AssertionFailure() << "ping body differs";
+      break;
+    case PacketType::state_request:
+      if (a.state_request.offset != b.state_request.offset)
+        return testing::AssertionFailure() << "state_request body differs";
+      break;
+    case PacketType::state_chunk:
+      if (a.state_chunk.total != b.state_chunk.total ||
+          a.state_chunk.offset != b.state_chunk.offset || a.state_chunk.data != b.state_chunk.data)
+        return testing::AssertionFailure() << "state_chunk body differs";
       break;
   }
   return testing::AssertionSuccess();

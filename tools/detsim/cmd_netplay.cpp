@@ -72,6 +72,8 @@ class Netplay {
   /// every one has): a frame whose check never arrives is unverified, never a pass.
   [[nodiscard]] std::string checks_behind() const;
   [[nodiscard]] std::string unconfirmed_players() const;
+  /// Why the session stopped (it was broken: a rejoin that failed).
+  std::string session_failure();
   /// Spectator `player` (players + k) acknowledged every frame of the match.
   [[nodiscard]] bool has_every_frame(std::uint32_t player) const {
     const auto stats = session_->peer_stats(player);
@@ -102,7 +104,6 @@ class Netplay {
   /// Hash checks that never arrived (Event::check_missing, or still missing at the end).
   std::vector<std::string> unverified_;
   std::string failure_;
-  std::uint64_t confirmed_ = 0;
   std::optional<std::uint64_t> final_hash_;
   std::uint64_t ticks_ = 0;
   std::uint64_t skipped_ = 0;  ///< advances skipped to let slower peers catch up
@@ -164,6 +165,8 @@ Status Netplay::start() {
   config.input_delay = args_.input_delay;
   config.fingerprint = session_fingerprint(*scenario_, plan_.mode, args_.frames);
   config.match_key = plan_.match_key;
+  config.partition = plan_.partition;
+  config.rejoin = args_.rejoin;
   config.frame_us =
       args_.fps == 0 ? 1000 : std::clamp<std::uint32_t>(1'000'000 / args_.fps, 1000, 1'000'000);
   for (const net::UdpPeer& p : plan_.peers)
@@ -174,7 +177,6 @@ Status Netplay::start() {
   if (!session) return session.status();
   session_.emplace(std::move(session.value()));
   const auto on_confirmed = [this](const net::ConfirmedFrame& f) {
-    ++confirmed_;
     if (f.frame + 1 == args_.frames) final_hash_ = f.hash;
   };
   if (recorder_) {
@@ -237,6 +239,22 @@ bool Netplay::handle_events() {
         std::fprintf(stderr, "detsim netplay: UNVERIFIED: %s\n", line.c_str());
         break;
       }
+      case net::EventType::paused:
+        std::fprintf(stderr,
+                     "detsim netplay: paused at frame %llu: %s is silent, and without it no "
+                     "majority is left (--partition pause); waiting for it to come back or "
+                     "rejoin\n",
+                     static_cast<unsigned long long>(e.frame), who.c_str());
+        break;
+      case net::EventType::rejoined:
+        if (e.player == args_.me) {
+          say("rejoined the match at frame " + std::to_string(e.frame) + " (" +
+              std::to_string(session_->current_frame()) + " now)");
+        } else {
+          std::fprintf(stderr, "detsim netplay: %s rejoined at frame %llu\n", who.c_str(),
+                       static_cast<unsigned long long>(e.frame));
+        }
+        break;
       case net::EventType::disconnected:
         if (left) break;
         if (spectator) {  // the match goes on without it
@@ -249,7 +267,10 @@ bool Netplay::handle_events() {
         return false;
       case net::EventType::match_ended:  // after a disconnect, which ended netplay's match above
         if (failure_.empty())
-          failure_ = "the match ended at frame " + std::to_string(e.frame) + ": no majority left";
+          failure_ =
+              e.reason == "rejoin failed"
+                  ? "rejoining failed: " + session_failure()
+                  : "the match ended at frame " + std::to_string(e.frame) + ": no majority left";
         return false;
     }
   }
@@ -322,6 +343,13 @@ std::string Netplay::checks_behind() const {
            " .. " + std::to_string(last) + ")";
   }
   return out;
+}
+
+std::string Netplay::session_failure() {
+  // A broken session returns its reason from advance_frame, and changes nothing.
+  const std::array<std::uint8_t, PlayerInput::encoded_size> none{};
+  const auto result = session_->advance_frame(none);
+  return result.ok() ? "(no reason given)" : result.status().message();
 }
 
 std::string Netplay::unconfirmed_players() const {
@@ -406,7 +434,7 @@ int Netplay::run() {
       continue;
     }
     if (!ended_at) ended_at = now;
-    if (!match_complete_ && confirmed_ >= args_.frames && peers_at_end()) {
+    if (!match_complete_ && session_->delivered_frame() >= args_.frames && peers_at_end()) {
       if (checks_behind().empty()) {
         match_complete_ = true;
       } else if (now - *ended_at >= timeout_us) {  // every frame is here, some checks never came
@@ -425,8 +453,8 @@ int Netplay::run() {
         break;
       }
       const std::string behind = unconfirmed_players();
-      failure_ = "timed out after the last frame: " + std::to_string(confirmed_) + " of " +
-                 std::to_string(args_.frames) + " frames confirmed; waiting for " +
+      failure_ = "timed out after the last frame: " + std::to_string(session_->delivered_frame()) +
+                 " of " + std::to_string(args_.frames) + " frames confirmed; waiting for " +
                  (behind.empty() ? "the peers' last inputs" : behind);
       break;
     }
@@ -491,7 +519,7 @@ int Netplay::report(double handshake_seconds, double match_seconds) {
         .boolean("protected", plan_.match_key.has_value())
         .str("mode", args_.mode)
         .num("input_delay", args_.input_delay)
-        .num("frames", confirmed_);
+        .num("frames", session_->delivered_frame());
     if (final_hash_) {
       j.hash("final_hash", *final_hash_);
     } else {
@@ -527,7 +555,8 @@ int Netplay::report(double handshake_seconds, double match_seconds) {
 
 void Netplay::print_text_report(double handshake_seconds, double match_seconds) const {
   const net::SessionStats& st = session_->stats();
-  std::printf("frames       %llu, final hash %s\n", static_cast<unsigned long long>(confirmed_),
+  std::printf("frames       %llu, final hash %s\n",
+              static_cast<unsigned long long>(session_->delivered_frame()),
               final_hash_ ? hex(*final_hash_).c_str() : "-");
   std::printf("rollbacks    %llu, %llu frames re-simulated\n",
               static_cast<unsigned long long>(st.rollbacks),

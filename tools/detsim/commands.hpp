@@ -125,6 +125,8 @@ struct NetplayArgs {
   bool json = false;
   std::string key;       ///< --key: the match key, 64 hex digits; or empty
   std::string key_file;  ///< --key-file: a file holding it (64 hex digits, or 32 raw bytes)
+  std::string partition = "end";  ///< --partition: end, pause or play-on
+  bool rejoin = false;            ///< --rejoin: take this player's seat again (a restart)
 };
 int netplay_command(const NetplayArgs& args);
 

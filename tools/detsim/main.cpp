@@ -91,6 +91,10 @@ replay as the players. Player 0 above could serve one at 127.0.0.1:7002 with
 A player waits for its connected spectators to have every frame before it exits (up to
 --timeout; a spectator that lags is only warned about).
 
+If a player's process stops, it can be started again with the same arguments plus --rejoin: the
+other player sends the match's state (compressed) and the inputs since, and the match goes on; the
+frames the restart missed take no input from the rejoining player. Both end with the same hash.
+
 Exit status: 0 the match completed; 1 a desync (the frame, both hashes and the player are
 printed; --desync-report writes this machine's side for bisection) or an unverified frame (a
 peer's hash check that never arrived: "UNVERIFIED" on stderr, "unverified" in --json); 2 bad
@@ -179,6 +183,17 @@ void add_netplay(CLI::App& app, int& exit_code) {
                 "exactly 32 raw bytes")
       ->type_name("FILE")
       ->excludes(key);
+  c->add_option("--partition", netplay.partition,
+                "When this player is left without a majority (two players: the other one is "
+                "gone): end (the match ends on every side at the frames all of them hold; "
+                "exit 2), pause (wait for the player to come back or --rejoin, however long) "
+                "or play-on (go on alone: the match splits); default end")
+      ->type_name("POLICY");
+  c->add_flag("--rejoin", netplay.rejoin,
+              "Take this player's seat again in a match under way, after this machine's "
+              "process stopped: the other player sends the match's state and this one "
+              "re-simulates to the present (two players; the other must still hold the seat: "
+              "within 5 s of the stop, or --partition pause)");
   add_inject_option(c, netplay.injections);
   c->add_option("--desync-report", netplay.desync_report,
                 "On a desync, write this machine's side to FILE: the inputs up to the divergent "

@@ -41,6 +41,16 @@ Status check_role(const NetplayArgs& a) {
       return Status::error("--me " + std::to_string(a.me) + " must be below --players " +
                            std::to_string(a.players) + " (players are numbered 0 .. " +
                            std::to_string(a.players - 1) + ")");
+    if (a.rejoin && a.players != 2)
+      return Status::error("--rejoin works in two-player matches only (--players " +
+                           std::to_string(a.players) + ")");
+    if (a.rejoin && !a.record.empty())
+      return Status::error(
+          "--rejoin cannot be combined with --record: a rejoining player sees the match only "
+          "from its return on (record on the other player)");
+    if (a.rejoin && !a.spectators.empty())
+      return Status::error(
+          "--rejoin cannot be combined with --spectator: spectators follow the earlier process");
     if (a.spectators.size() > max_spectators)
       return Status::error("at most " + std::to_string(max_spectators) +
                            " --spectator addresses, got " + std::to_string(a.spectators.size()));
@@ -48,6 +58,8 @@ Status check_role(const NetplayArgs& a) {
   }
   if (a.me_given)
     return Status::error("--me cannot be combined with --spectate: a spectator plays no player");
+  if (a.rejoin)
+    return Status::error("--rejoin cannot be combined with --spectate: a spectator holds no seat");
   if (!a.spectators.empty())
     return Status::error(
         "--spectator cannot be combined with --spectate: only players serve spectators");
@@ -177,6 +189,15 @@ Expected<NetplayPlan> netplay_plan(const NetplayArgs& a) {
     plan.mode = net::SessionMode::lockstep;
   } else {
     return Status::error("--mode must be rollback or lockstep, got \"" + a.mode + "\"");
+  }
+  if (a.partition == "end") {
+    plan.partition = net::PartitionPolicy::end_match;
+  } else if (a.partition == "pause") {
+    plan.partition = net::PartitionPolicy::pause;
+  } else if (a.partition == "play-on") {
+    plan.partition = net::PartitionPolicy::play_on;
+  } else {
+    return Status::error("--partition must be end, pause or play-on, got \"" + a.partition + "\"");
   }
   auto bind = net::parse_endpoint(a.bind);
   if (!bind) return Status::error("--bind: " + bind.message());

@@ -40,6 +40,8 @@ struct NetplayPlan {
   /// --key or --key-file: every datagram sealed (docs/NET.md, "Packet protection"); absent: the
   /// plain framing, unauthenticated (a trusted network only).
   std::optional<net::MatchKey> match_key;
+  /// --partition: what a player left without a majority does.
+  net::PartitionPolicy partition = net::PartitionPolicy::end_match;
 };
 
 /// A match key from 64 hex digits (either case; surrounding whitespace ignored); errors say why.

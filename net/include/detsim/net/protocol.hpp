@@ -34,6 +34,8 @@
 //                  deltas: run-length coded bytes (below) | checks u8 | checks x (frame z, hash
 //                  u64)
 //     ping, pong   time u64 (microseconds of the pinging side's clock)
+//     state_request  offset v (the snapshot bytes the rejoining sender holds)
+//     state_chunk    total v | offset v | length v | length bytes (a slice of the snapshot)
 //
 // Frame numbers are u32 values. `v` is an unsigned LEB128 varint (7 bits per byte, low first, at
 // most 5 bytes, no redundant trailing zero byte); `z` is the frame minus ack_frame, zigzag-coded
@@ -58,8 +60,9 @@
 namespace detsim::net::protocol {
 
 /// Changes whenever the layout above changes; peers of different versions drop each other's
-/// datagrams (counted as bad_version) and never synchronise. Version 5 added the sealed framing.
-inline constexpr std::uint8_t version = 5;
+/// datagrams (counted as bad_version) and never synchronise. Version 5 added the sealed framing,
+/// version 6 the state transfer that lets a restarted player rejoin (state_request, state_chunk).
+inline constexpr std::uint8_t version = 6;
 inline constexpr std::uint8_t magic0 = 'D';
 inline constexpr std::uint8_t magic1 = 'N';
 inline constexpr std::size_t header_size = 14;
@@ -80,7 +83,20 @@ inline constexpr std::size_t max_checks_per_packet = 8;
 /// The player byte of a spectator's hello.
 inline constexpr std::uint8_t spectator_player = 0xFF;
 
-enum class PacketType : std::uint8_t { hello = 1, hello_reply = 2, input = 3, ping = 4, pong = 5 };
+enum class PacketType : std::uint8_t {
+  hello = 1,
+  hello_reply = 2,
+  input = 3,
+  ping = 4,
+  pong = 5,
+  state_request = 6,
+  state_chunk = 7,
+};
+
+/// The most snapshot bytes one state_chunk carries, and the largest snapshot a transfer allows
+/// (compressed): a bound on what a rejoining session allocates, whatever a peer says.
+inline constexpr std::size_t max_state_chunk = 1024;
+inline constexpr std::size_t max_state_transfer = std::size_t{64} << 20;
 
 struct Header {
   PacketType type = PacketType::hello;
@@ -141,6 +157,19 @@ struct PingBody {
   std::uint64_t time_us = 0;
 };
 
+/// "Send me the match's snapshot from this byte on" (a rejoining session; docs/NET.md,
+/// "Rejoining"): resent until the snapshot is whole, and its own acknowledgement.
+struct StateRequest {
+  std::uint32_t offset = 0;
+};
+
+/// A slice of the snapshot a rejoining peer asked for.
+struct StateChunk {
+  std::uint32_t total = 0;  ///< the whole snapshot's size: 1 .. max_state_transfer
+  std::uint32_t offset = 0;
+  std::vector<std::uint8_t> data;  ///< 1 .. max_state_chunk bytes, offset + size <= total
+};
+
 /// One decoded datagram. Only the body of `header.type` is meaningful.
 struct Packet {
   Header header;
@@ -148,6 +177,8 @@ struct Packet {
   HelloReply hello_reply;
   InputBody input;
   PingBody ping;  ///< ping and pong
+  StateRequest state_request;
+  StateChunk state_chunk;
 };
 
 /// Why a datagram was dropped.

@@ -54,6 +54,12 @@ enum class PartitionPolicy : std::uint8_t {
   /// Play on with the gone players' inputs zeroed (for games where a player may drop and the rest
   /// go on against bots); a partition then splits the match into two that never compare.
   play_on,
+  /// Wait: a silent player whose loss would leave no majority is never disconnected. The match
+  /// stands still (advance_frame() holds at the prediction limit, or waits in lockstep) with
+  /// Event::paused, and goes on when the player is heard again — after an outage of any length —
+  /// or rejoins from a restarted process (SessionConfig::rejoin). Ending a match that stays
+  /// paused is the game's call.
+  pause,
 };
 
 /// A remote player and the transport peer that plays it.
@@ -95,6 +101,15 @@ struct SessionConfig {
   std::optional<MatchKey> match_key;
   /// When a disconnect leaves this machine with no strict majority of the players.
   PartitionPolicy partition = PartitionPolicy::end_match;
+  /// This session takes the place of an earlier one of the same player in a match that is under
+  /// way (the process was restarted; docs/NET.md, "Rejoining"). It does not start from the game's
+  /// state: after the handshake the peer sends a snapshot (the state of the last frame every
+  /// peer holds as final, the confirmed frames before it and every input since, compressed),
+  /// which the session loads, re-simulating to the peer's present; advance_frame() reports
+  /// Advance::synchronizing until then, and Event::rejoined says it is done. The peer must still
+  /// hold the seat (within disconnect_timeout_us of the old session's last word, or paused).
+  /// Two-player matches only, for now.
+  bool rejoin = false;
   std::vector<RemotePlayer> remotes;  ///< every other player, each exactly once
   /// Spectators this machine serves (at most 16; ids distinct from the remotes'): each receives
   /// every confirmed frame's inputs from here (SpectatorSession). Events about spectator k use
@@ -131,6 +146,14 @@ enum class EventType : std::uint8_t {
   /// (SessionConfig::partition). `frame`: delivered_frame() then — the frames every side agrees
   /// on. advance_frame() fails from then on; poll() still answers the peers.
   match_ended,
+  /// The match waits (PartitionPolicy::pause): `player` is silent, and this machine without it
+  /// would have no majority (`reason`: "no majority"). Event::resumed or Event::rejoined for that
+  /// player says it goes on. `frame`: delivered_frame() then.
+  paused,
+  /// A restarted process took `player`'s seat again (SessionConfig::rejoin) from a snapshot of
+  /// state frame `frame`: on the rejoining machine `player` is its own, on the others the one
+  /// that came back.
+  rejoined,
 };
 
 struct Event {
@@ -212,6 +235,9 @@ struct SessionStats {
   /// duplicate, or older than the 64 before the newest), before decryption.
   std::uint64_t dropped_unauthenticated = 0;
   std::uint64_t dropped_replayed = 0;
+  /// Rejoining peers this machine sent a snapshot to, and the snapshot bytes sent (resends too).
+  std::uint64_t snapshots_served = 0;
+  std::uint64_t snapshot_bytes_sent = 0;
 };
 
 /// Predicts a remote player's input for a frame not received yet: writes the prediction to `out`

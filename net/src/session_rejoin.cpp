@@ -1,0 +1,217 @@
+// A restarted player's way back into a match (docs/NET.md, "Rejoining").
+//
+// The side that stayed keeps the seat (within the disconnect timeout, or indefinitely under
+// PartitionPolicy::pause). The restarted process's session (SessionConfig::rejoin) says hello with
+// a new session id. The hello is answered like any other, and met with a challenge of our own:
+// only the reply to it — sent to the peer's address, which a third party off the path never sees,
+// and under a match key sealed with a key only a player has — moves the seat to the new session.
+// The stayer then snapshots the match (snapshot.hpp): the state of delivered_frame(), which every
+// peer holds as final, the confirmed frames before it, and every input it holds since. The
+// rejoining side asks for it in slices (state_request, resent until the snapshot is whole: its
+// own acknowledgement), loads it, fills its own inputs from where the stayer's copy of them ends
+// to the stayer's present with zeros (the restart lost them), re-simulates to the present and
+// plays on. The stayer re-simulates those frames when the zeros arrive, as after any
+// misprediction: both sides end on the same frames, the hash checks compare them again.
+#include <algorithm>
+#include <string>
+
+#include "secure_random.hpp"
+#include "session_impl.hpp"
+#include "snapshot.hpp"
+
+namespace detsim::net {
+namespace {
+
+/// Slices sent per request: 16 KB, a round trip's worth on any link a match is played over.
+constexpr std::size_t chunks_per_request = 16;
+
+}  // namespace
+
+void Session::Impl::handle_rejoin_hello(detail::Peer& peer, const protocol::Packet& p) {
+  if (peer.spectator) return;
+  // Answered (the sender may be a new session of the peer that waits for our id; a reply goes
+  // to the peer's address only), so the genuine peer is never starved of it by forged hellos.
+  protocol::Packet reply;
+  reply.header.type = protocol::PacketType::hello_reply;
+  reply.hello_reply.challenge = p.hello.challenge;
+  send(peer, reply);
+  // A hello from the session we know asks nothing more; nor does any hello once the match cannot
+  // take a player back (over, broken, or the seat given up).
+  if (p.header.session == peer.remote_session || config.players != 2 || !broken.empty() ||
+      peer.disconnected || awaiting_state)
+    return;
+  // One challenge outstanding, the same until answered (a flood of forged hellos cannot replace
+  // the one the genuine peer is answering), resent at most once per hello interval.
+  if (!peer.rechallenge) peer.rechallenge = detail::secure_random_u64();
+  if (peer.last_rechallenge_us && now_us - *peer.last_rechallenge_us < config.hello_interval_us)
+    return;
+  peer.last_rechallenge_us = now_us;
+  send_hello(peer, *peer.rechallenge);
+}
+
+void Session::Impl::rebind(detail::Peer& peer, std::uint64_t session) {
+  // The snapshot: the state of the oldest frame not yet delivered (final everywhere: every peer
+  // holds its inputs, no correction reaches back to it), from the input just before it on.
+  const std::uint64_t frame = next_emit;
+  const std::uint64_t first = frame == 0 ? 0 : frame - 1;
+  const detail::State& state = state_slot(frame);
+  detail::Snapshot snapshot;
+  snapshot.frame = frame;
+  snapshot.present = current;
+  snapshot.input_size = config.input_size;
+  for (std::uint32_t p = 0; p < config.players; ++p) {
+    const detail::InputQueue& q = queues[p];
+    detail::SnapshotPlayer& player = snapshot.players.emplace_back();
+    player.disconnect = disconnect_frame[p];
+    player.first = first;
+    for (std::uint64_t f = first; f < q.next_confirmed(); ++f) {
+      if (!q.holds(f)) return;  // cannot happen (the queues span the window); keep the seat
+      const std::span<const std::uint8_t> input = q.confirmed(f);
+      player.inputs.insert(player.inputs.end(), input.begin(), input.end());
+    }
+  }
+  if (state.frame != frame) return;  // likewise: the ring holds every frame not yet delivered
+  snapshot.log = frame_log;
+  snapshot.state = state.bytes;
+
+  peer.remote_session = session;
+  if (protection) {  // new keys both ways, and a fresh window for the new session's sequence
+    protection->bind(peer.channel, session);
+    peer.channel.window = {};
+  }
+  peer.snapshot = detail::encode_snapshot(snapshot);
+  peer.rejoining = true;
+  ++stats.snapshots_served;
+  peer.knows_us = false;  // until the new session sends beyond the handshake
+  peer.last_sequence.reset();
+  peer.ping_out.reset();
+  peer.needs_ack = false;
+  peer.acked_inputs = 0;  // its first input datagram says what it holds of ours
+  peer.reported_held = std::min(peer.reported_held, frame);
+  // Hash checks start over after the snapshot's frame on both sides (load_snapshot does the
+  // same): the new session compares nothing before it, and took this machine's state there.
+  const std::uint64_t interval = config.check_interval;
+  const std::uint64_t through = interval == 0 ? 0 : frame / interval * interval;
+  peer.checks_through = through;
+  peer.acked_checks = through;
+  peer.pending_checks.clear();
+  raise(Event{EventType::rejoined, peer.player, frame, 0, 0, {}});
+  retire_checks();
+}
+
+void Session::Impl::serve_state(detail::Peer& peer, std::uint32_t offset) {
+  const std::vector<std::uint8_t>& bytes = peer.snapshot;
+  if (offset >= bytes.size()) return;  // it has everything (its inputs are on their way)
+  protocol::Packet p;
+  p.header.type = protocol::PacketType::state_chunk;
+  p.state_chunk.total = static_cast<std::uint32_t>(bytes.size());
+  std::size_t at = offset;
+  for (std::size_t k = 0; k < chunks_per_request && at < bytes.size(); ++k) {
+    const std::size_t n = std::min(protocol::max_state_chunk, bytes.size() - at);
+    p.state_chunk.offset = static_cast<std::uint32_t>(at);
+    p.state_chunk.data.assign(bytes.begin() + static_cast<std::ptrdiff_t>(at),
+                              bytes.begin() + static_cast<std::ptrdiff_t>(at + n));
+    send(peer, p);
+    stats.snapshot_bytes_sent += n;
+    at += n;
+  }
+}
+
+void Session::Impl::request_state() {
+  detail::Peer& server = peers.front();  // two-player matches: the other player
+  if (!server.synchronized || !broken.empty()) return;
+  // Asked again when what was asked for arrived (receive_state), or after two round trips (or
+  // two frames) without it: lost slices are asked for anew from the first missing byte.
+  const std::uint64_t wait = std::max<std::uint64_t>(2 * config.frame_us, server.rtt_x16 / 8);
+  if (last_request_us && now_us - *last_request_us < wait) return;
+  protocol::Packet p;
+  p.header.type = protocol::PacketType::state_request;
+  p.state_request.offset = static_cast<std::uint32_t>(incoming.size());
+  send(server, p);
+  last_request_us = now_us;
+}
+
+void Session::Impl::receive_state(detail::Peer& peer, const protocol::StateChunk& chunk) {
+  if (!awaiting_state || &peer != &peers.front()) {
+    ++stats.dropped_implausible;  // nobody asked this machine's session for a snapshot
+    return;
+  }
+  if (incoming_total == 0) incoming_total = chunk.total;
+  if (chunk.total != incoming_total) {
+    ++stats.dropped_implausible;
+    return;
+  }
+  if (chunk.offset != incoming.size()) return;  // a resend, or out of order: asked for again
+  incoming.insert(incoming.end(), chunk.data.begin(), chunk.data.end());
+  if (incoming.size() < incoming_total) {
+    if (incoming.size() % (chunks_per_request * protocol::max_state_chunk) == 0) {
+      last_request_us.reset();  // the whole window arrived: ask for the next one now
+      request_state();
+    }
+    return;
+  }
+  if (Status s = load_snapshot(peer); !s) {
+    broken = s.message();
+    raise(Event{EventType::match_ended, config.local_player, 0, 0, 0, "rejoin failed"});
+  }
+}
+
+Status Session::Impl::load_snapshot(detail::Peer& from) {
+  Expected<detail::Snapshot> decoded =
+      detail::decode_snapshot(incoming, config.players, config.input_size, detail::input_capacity);
+  incoming = {};
+  if (!decoded)
+    return Status::error("rejoin: the snapshot player " + std::to_string(from.player) +
+                         " sent is invalid (" + decoded.status().message() +
+                         "); start this player again to retry");
+  const detail::Snapshot& s = *decoded;
+
+  game->load(s.state);
+  current = s.frame;
+  next_emit = s.frame;
+  detail::State& saved = state_slot(s.frame);
+  saved.frame = s.frame;
+  saved.hash = game->save(saved.bytes);
+  agreed_frame = s.frame;
+  agreed_state = saved.bytes;
+  frame_log = s.log;
+  const std::size_t size = config.input_size;
+  for (std::uint32_t p = 0; p < config.players; ++p) {
+    detail::InputQueue& q = queues[p];
+    const detail::SnapshotPlayer& player = s.players[p];
+    q.restart_at(player.first);
+    for (std::size_t at = 0; at < player.inputs.size(); at += size)
+      q.confirm(std::span<const std::uint8_t>(player.inputs).subspan(at, size));
+    disconnect_frame[p] = player.disconnect;
+  }
+  // The peer holds our inputs up to here; the restart lost the rest, which are zeros up to the
+  // peer's present (the first input of this session goes after them).
+  detail::InputQueue& mine = queues[config.local_player];
+  from.acked_inputs = mine.next_confirmed();
+  std::fill(scratch_input.begin(), scratch_input.end(), std::uint8_t{0});
+  while (mine.next_confirmed() < s.present)
+    mine.confirm(scratch_input);
+  const std::uint64_t interval = config.check_interval;
+  const std::uint64_t through = interval == 0 ? 0 : s.frame / interval * interval;
+  from.checks_through = through;
+  from.acked_checks = through;
+  from.pending_checks.clear();
+  from.reported_held = s.frame;
+
+  awaiting_state = false;
+  running = true;
+  window_start_us = now_us;
+  raise(Event{EventType::rejoined, config.local_player, s.frame, 0, 0, {}});
+  raise(Event{EventType::running, 0, current, 0, 0, {}});
+  // Re-simulate to the peer's present, as far as the window allows (advance_frame goes on).
+  while (current < s.present && current + 2 - next_emit <= states.size() &&
+         current < confirmed_frame() + max_prediction) {
+    simulate(current, false);
+    ++stats.frames;
+  }
+  for (detail::Peer& peer : peers)
+    send_inputs(peer);
+  return Status::success();
+}
+
+}  // namespace detsim::net
