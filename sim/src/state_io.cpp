@@ -265,69 +265,93 @@ bool read_contacts(std::span<const std::uint8_t>, ByteReader& r, WorldState& s,
   return r.ok();
 }
 
+void write_game(const WorldState& s, ByteWriter& w) {
+  w.raw(s.game);
+}
+
+bool read_game(std::span<const std::uint8_t>, ByteReader& r, WorldState& s, std::string& error) {
+  // The payload is the game's bytes as they are: the section's whole length.
+  const std::size_t at = r.offset();
+  const std::size_t size = r.remaining();
+  if (size == 0 || size > max_game_state_size) {
+    error = "byte " + std::to_string(at) + ": " + std::to_string(size) + " bytes, expected 1 .. " +
+            std::to_string(max_game_state_size);
+    return false;
+  }
+  const std::span<const std::uint8_t> game = r.raw(size, "game state");
+  s.game.assign(game.begin(), game.end());
+  return r.ok();
+}
+
+bool has_game(const WorldState& s) {
+  return !s.game.empty();
+}
+
+void clear_game(WorldState& s) {
+  s.game.clear();
+}
+
 /// A section of a World's state: its name and version, and its writer and reader side by side.
 /// A reader validates what it reads into the scratch state (sections before it already read) and
-/// returns false with `error` set, or leaves the failure in the reader.
+/// returns false with `error` set, or leaves the failure in the reader. An optional section is
+/// written only when `present` says so; a state without it reads as `absent` leaves the scratch
+/// state, so a world that never uses it saves what it always did.
 struct WorldSection {
   const char* name;
   std::uint32_t version;
   void (*write)(const WorldState& s, ByteWriter& w);
   bool (*read)(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState& s,
                std::string& error);
+  bool (*present)(const WorldState& s) = nullptr;  ///< nullptr: always written
+  void (*absent)(WorldState& s) = nullptr;         ///< an optional section not in the state
 };
 
 /// The World's sections, in the order a state lists them: a new kind of state (joints, particle
-/// groups, controllers) is a row here, after the bodies it refers to.
+/// groups, controllers) is a row here, after the bodies it refers to. The game's own state
+/// (World::set_game_state) comes last, present only when the game set one.
 constexpr WorldSection kSections[] = {
-    {"globals", 1, write_globals, read_globals},       {"rng", 1, write_rng_section, read_rng},
-    {"geometry", 1, write_geometry, read_geometry},    {"bodies", 2, write_bodies, read_bodies},
-    {"contacts", 2, write_contacts, read_contacts},    {"joints", 1, write_joints, read_joints},
+    {"globals", 1, write_globals, read_globals},
+    {"rng", 1, write_rng_section, read_rng},
+    {"geometry", 1, write_geometry, read_geometry},
+    {"bodies", 2, write_bodies, read_bodies},
+    {"contacts", 2, write_contacts, read_contacts},
+    {"joints", 1, write_joints, read_joints},
     {"particles", 1, write_particles, read_particles},
+    {"game", 1, write_game, read_game, has_game, clear_game},
 };
 constexpr std::size_t kSectionCount = std::size(kSections);
 
 // The container: "DSIM", the version, the section count, then each section's record.
 constexpr std::size_t kMaxSectionName = max_section_name;
 
-/// The game's own state (World::set_game_state): a section after the World's, present only when
-/// the game set one, so that a world without it saves what it always did. Its payload is the
-/// game's bytes as they are.
-constexpr const char* kGameSection = "game";
-constexpr std::uint32_t kGameSectionVersion = 1;
-
 /// Where the sections of an encoded state start and end, for the hashes.
 struct Encoded {
   ByteWriter w;
-  std::size_t count = 0;  ///< sections written: kSectionCount, + 1 with a game section
-  std::array<std::size_t, kSectionCount + 2> starts{};  // then the end of the state
+  std::size_t count = 0;                                ///< sections written
+  std::array<std::size_t, kSectionCount> written{};     ///< each one's index in kSections
+  std::array<std::size_t, kSectionCount + 1> starts{};  // then the end of the state
 };
-
-void begin_section(Encoded& e, std::size_t i, std::string_view name, std::uint32_t version) {
-  e.starts[i] = e.w.size();
-  e.w.var(name.size());
-  e.w.raw({reinterpret_cast<const std::uint8_t*>(name.data()), name.size()});
-  e.w.var(version);
-}
 
 void encode(const WorldState& s, Encoded& e) {
   e.w.reserve(256 + s.bodies.size() * 96 + s.contacts.size() * 72 + s.joints.size() * 96 +
               s.game.size());
-  e.count = kSectionCount + (s.game.empty() ? 0 : 1);
+  e.count = 0;
+  for (std::size_t i = 0; i < kSectionCount; ++i)
+    if (kSections[i].present == nullptr || kSections[i].present(s)) e.written[e.count++] = i;
   e.w.u32(kMagic);
   e.w.u32(kVersion);
   e.w.var(e.count);
-  for (std::size_t i = 0; i < kSectionCount; ++i) {
-    const WorldSection& section = kSections[i];
-    begin_section(e, i, section.name, section.version);
+  for (std::size_t k = 0; k < e.count; ++k) {
+    const WorldSection& section = kSections[e.written[k]];
+    const std::string_view name = section.name;
+    e.starts[k] = e.w.size();
+    e.w.var(name.size());
+    e.w.raw({reinterpret_cast<const std::uint8_t*>(name.data()), name.size()});
+    e.w.var(section.version);
     const std::size_t length_at = e.w.size();
     e.w.u32(0);
     section.write(s, e.w);
     e.w.patch_u32(length_at, static_cast<std::uint32_t>(e.w.size() - length_at - 4));
-  }
-  if (!s.game.empty()) {
-    begin_section(e, kSectionCount, kGameSection, kGameSectionVersion);
-    e.w.u32(static_cast<std::uint32_t>(s.game.size()));
-    e.w.raw(s.game);
   }
   e.starts[e.count] = e.w.size();
 }
@@ -343,45 +367,36 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
     error = "invalid state: byte " + std::to_string(at) + ": " + message;
     return false;
   };
-  // The World's sections, each once, in their order, at the version this build reads.
+  // The World's sections, each once, in their order, at the version this build reads; an
+  // optional one may be left out.
   std::string names;
   for (const WorldSection& ws : kSections)
-    names += std::string(names.empty() ? "" : ", ") + ws.name;
-  names += std::string(", and a game's own state: \"") + kGameSection + "\"";
-  for (std::size_t i = 0; i < sections->size(); ++i) {
-    const StateSection& found = (*sections)[i];
-    if (i == kSectionCount && found.name == kGameSection) {
-      if (found.version != kGameSectionVersion)
-        return failed_at(found.offset, std::string("section \"") + kGameSection + "\" version " +
-                                           std::to_string(found.version) + ", this build reads " +
-                                           std::to_string(kGameSectionVersion));
-      if (found.payload.empty() || found.payload.size() > max_game_state_size)
-        return failed_at(found.payload_offset, std::string("section \"") + kGameSection +
-                                                   "\": " + std::to_string(found.payload.size()) +
-                                                   " bytes, expected 1 .. " +
-                                                   std::to_string(max_game_state_size));
-      continue;
+    names += std::string(names.empty() ? "" : ", ") + (ws.present ? "optionally " : "") + ws.name;
+  std::size_t next = 0;  // the next of the state's sections
+  for (const WorldSection& section : kSections) {
+    const bool here = next < sections->size() && (*sections)[next].name == section.name;
+    if (!here) {
+      if (section.absent != nullptr) {
+        section.absent(s);
+        continue;
+      }
+      if (next < sections->size())
+        return failed_at((*sections)[next].offset,
+                         "section \"" + std::string((*sections)[next].name) +
+                             "\" where section \"" + section.name +
+                             "\" was expected (a World's state is " + names + ")");
+      return failed_at(bytes.size(), "section \"" + std::string(section.name) +
+                                         "\" is missing (a World's state is " + names + ")");
     }
-    if (i >= kSectionCount || found.name != kSections[i].name)
-      return failed_at(found.offset,
-                       "section \"" + std::string(found.name) + "\" where " +
-                           (i < kSectionCount ? "section \"" + std::string(kSections[i].name) + "\""
-                                              : std::string("the state's end")) +
-                           " was expected (a World's state is " + names + ")");
-    if (found.version != kSections[i].version)
+    const StateSection& found = (*sections)[next++];
+    if (found.version != section.version)
       return failed_at(found.offset, "section \"" + std::string(found.name) + "\" version " +
                                          std::to_string(found.version) + ", this build reads " +
-                                         std::to_string(kSections[i].version));
-  }
-  if (sections->size() < kSectionCount)
-    return failed_at(bytes.size(), "section \"" + std::string(kSections[sections->size()].name) +
-                                       "\" is missing (a World's state is " + names + ")");
-  for (std::size_t i = 0; i < kSectionCount; ++i) {
-    const StateSection& found = (*sections)[i];
+                                         std::to_string(section.version));
     const std::size_t end = found.payload_offset + found.payload.size();
     ByteReader r(bytes.first(end), found.payload_offset);
     std::string section_error;
-    const bool read = kSections[i].read(bytes, r, s, section_error);
+    const bool read = section.read(bytes, r, s, section_error);
     const std::string where = "section \"" + std::string(found.name) + "\": ";
     if (!section_error.empty()) {
       error = "invalid state: " + where + section_error;
@@ -395,11 +410,11 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
       return failed_at(r.offset(), where + std::to_string(r.remaining()) +
                                        " unexpected bytes after the section's fields");
   }
-  s.game.clear();
-  if (sections->size() > kSectionCount) {
-    const std::span<const std::uint8_t> game = (*sections)[kSectionCount].payload;
-    s.game.assign(game.begin(), game.end());
-  }
+  if (next < sections->size())
+    return failed_at((*sections)[next].offset,
+                     "section \"" + std::string((*sections)[next].name) +
+                         "\" where the state's end was expected (a World's state is " + names +
+                         ")");
   return true;
 }
 
@@ -522,11 +537,10 @@ StateHashes World::save(std::vector<std::uint8_t>& out) const {
   const std::uint8_t* bytes = e.w.bytes().data();
   StateHashes h;
   h.sections.reserve(e.count);
-  for (std::size_t i = 0; i < e.count; ++i) {
-    const std::size_t from = e.starts[i];
-    const char* name =
-        i < sim_detail::kSectionCount ? sim_detail::kSections[i].name : sim_detail::kGameSection;
-    h.sections.push_back({name, hash_bytes({bytes + from, e.starts[i + 1] - from})});
+  for (std::size_t k = 0; k < e.count; ++k) {
+    const std::size_t from = e.starts[k];
+    h.sections.push_back({sim_detail::kSections[e.written[k]].name,
+                          hash_bytes({bytes + from, e.starts[k + 1] - from})});
   }
   h.total = hash_bytes({bytes, e.w.size()});
   out = e.w.take();
