@@ -48,10 +48,10 @@ TEST(ExamplePushball, ABallOverTheGoalLineScoresOnceThenPlayRestartsFromTheStart
   const BodyId ball = pushball::find(w, pushball::ball_tag);
   ASSERT_TRUE(w.set_transform(ball, {9_fx, 0.5_fx, 0.5_fx}, {}).ok());
   ASSERT_TRUE(w.set_linear_velocity(ball, {6_fx, 0_fx, 0_fx}).ok());
-  const std::vector<PlayerInput> idle(2);
+  const std::vector<std::uint8_t> idle(2 * pushball::Input::size);  // nothing pressed
   int frames = 0;
   while (pushball::state_of(w).score[0] == 0 && frames < 60) {
-    s.step(idle);
+    s.step_encoded(idle);
     ++frames;
   }
   // 1.5 m to the line at about 6 m/s: a quarter of a second, give or take the rolling friction.
@@ -63,10 +63,10 @@ TEST(ExamplePushball, ABallOverTheGoalLineScoresOnceThenPlayRestartsFromTheStart
   EXPECT_EQ(st.last_scorer, 1U);
   EXPECT_EQ(st.kickoff, pushball::kickoff_frames);
   for (int f = 1; f < pushball::kickoff_frames; ++f)
-    s.step(idle);
+    s.step_encoded(idle);
   EXPECT_EQ(pushball::state_of(w).score[0], 1U) << "counted once, though the ball stays in";
   EXPECT_EQ(pushball::state_of(w).kickoff, 1U);
-  s.step(idle);
+  s.step_encoded(idle);
   EXPECT_EQ(pushball::state_of(w).kickoff, 0U);
   // Placed at the start before the step, then one step of gravity against the ground: at rest.
   EXPECT_EQ(w.body(ball)->position.x, 0_fx);
@@ -80,9 +80,9 @@ TEST(ExamplePushball, TheEndWallBesideTheMouthStopsTheBallWithoutAGoal) {
   const BodyId ball = pushball::find(w, pushball::ball_tag);
   ASSERT_TRUE(w.set_transform(ball, {8_fx, 0.5_fx, 5_fx}, {}).ok());
   ASSERT_TRUE(w.set_linear_velocity(ball, {8_fx, 0_fx, 0_fx}).ok());
-  const std::vector<PlayerInput> idle(2);
+  const std::vector<std::uint8_t> idle(2 * pushball::Input::size);  // nothing pressed
   for (int f = 0; f < 120; ++f)
-    s.step(idle);
+    s.step_encoded(idle);
   EXPECT_EQ(pushball::state_of(w).score[0], 0U);
   EXPECT_LT(w.body(ball)->position.x, 10_fx) << "the wall's face is at x = 10";
 }
@@ -91,9 +91,10 @@ TEST(ExamplePushball, ADashIsAnImpulseOfEightNewtonSecondsThenWaitsOutItsCooldow
   Scenario s = make();
   World& w = s.world();
   const BodyId puck = pushball::find(w, pushball::player_tag + 0);
-  std::vector<PlayerInput> inputs(2);
-  inputs[0].buttons = PlayerInput::dash;
-  s.step(inputs);
+  pushball::Input dash;
+  dash.buttons = pushball::Input::dash;
+  const std::vector<std::uint8_t> inputs = pushball::encode_frame(dash, {});
+  s.step_encoded(inputs);
   // J / m = 8 / 4 = 2 m/s along +x (no stick: towards the other goal), less at most one step of
   // sliding friction and damping.
   const Fixed v = w.body(puck)->linear_velocity.x;
@@ -103,7 +104,7 @@ TEST(ExamplePushball, ADashIsAnImpulseOfEightNewtonSecondsThenWaitsOutItsCooldow
   int dashes = 1;
   Fixed previous = v;
   for (int f = 0; f < 2 * pushball::dash_cooldown_frames; ++f) {
-    s.step(inputs);
+    s.step_encoded(inputs);
     const Fixed now = w.body(puck)->linear_velocity.x;
     if (now > previous + 1_fx) ++dashes;
     previous = now;
@@ -137,12 +138,9 @@ TEST(ExamplePushball, ItsToolRecordsVerifiesAndSyncTestsItsRuns) {
   auto at = replay::seek(reader.value(), 450);
   ASSERT_TRUE(at.ok()) << at.message();
   Scenario straight = make();
-  std::vector<PlayerInput> inputs(2);
-  for (std::uint64_t f = 1; f <= 450; ++f) {
-    for (std::uint32_t p = 0; p < 2; ++p)
-      inputs[p] = scripted_input(1, f, p);
-    straight.step(inputs);
-  }
+  for (std::uint64_t f = 1; f <= 450; ++f)
+    straight.step_encoded(
+        pushball::encode_frame(pushball::scripted(1, f, 0), pushball::scripted(1, f, 1)));
   EXPECT_EQ(at->world().save(), straight.world().save());
   // The same through the tool: the state at 450, as recorded, written for diff.
   TempFile state("seek450.state");

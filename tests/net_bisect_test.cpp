@@ -71,7 +71,7 @@ TEST_P(NetBisect, PeersReportsNameTheInjectedFrameBodyAndField) {
     net::SessionConfig c;
     c.players = kPlayers;
     c.local_player = p;
-    c.input_size = net::ScenarioGame::input_size;
+    c.input_size = games.back()->input_size();
     c.check_interval = kInterval;
     for (std::uint32_t q = 0; q < kPlayers; ++q)
       if (q != p) c.remotes.push_back({q, q});

@@ -196,7 +196,7 @@ TEST(NetConditions, ANudgedBodyIsDetectedWithinOneCheckInterval) {
     net::SessionConfig c;
     c.players = players;
     c.local_player = p;
-    c.input_size = net::ScenarioGame::input_size;
+    c.input_size = scenarios.back()->info().input_size;
     c.check_interval = interval;
     for (std::uint32_t q = 0; q < players; ++q)
       if (q != p) c.remotes.push_back({q, q});

@@ -51,7 +51,7 @@ TEST(NetReplay, EveryPeerRecordsTheSameReplayAndItVerifies) {
     net::SessionConfig c;
     c.players = players;
     c.local_player = p;
-    c.input_size = net::ScenarioGame::input_size;
+    c.input_size = games.back()->input_size();
     for (std::uint32_t q = 0; q < players; ++q)
       if (q != p) c.remotes.push_back({q, q});
     if (p == 0) c.spectators = {players};
@@ -71,7 +71,7 @@ TEST(NetReplay, EveryPeerRecordsTheSameReplayAndItVerifies) {
       net::ScenarioRecorder::create(temp_path("spectator"), spectator_game).value();
   net::SpectatorConfig sc;
   sc.players = players;
-  sc.input_size = net::ScenarioGame::input_size;
+  sc.input_size = spectator_game.input_size();
   sc.host = 0;
   auto spectator =
       net::SpectatorSession::create(sc, spectator_game, network.endpoint(players)).value();

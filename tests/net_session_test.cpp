@@ -578,7 +578,9 @@ TEST(NetSession, ARestartAfterTheSeatWasGivenUpNeverRejoins) {
   o.rejoin_tick = 300 + 8 * 60;
   Match m(o);
   EXPECT_FALSE(m.run());
+  ASSERT_LT(m.ticks(), o.rejoin_tick) << "the match ended before the restarted process came up";
   m.idle(300);
+  ASSERT_GT(m.ticks(), o.rejoin_tick + 100);
   EXPECT_TRUE(m.record(0).has(EventType::match_ended));
   EXPECT_FALSE(m.record(0).has(EventType::rejoined));
   EXPECT_FALSE(m.session(1).running()) << "still waiting for a snapshot nobody sends";

@@ -1,6 +1,8 @@
 // A game's own scenario (register_scenario): created by name like the built-ins, listed, refused
 // with the problem named, and recorded, verified and seeked through replay/ with its game state.
+#include <array>
 #include <cstdint>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -174,6 +176,143 @@ TEST(ScenarioRegister, AGameStateSetAfterFrameZeroIsARecordingErrorThatSaysWhy) 
       << recorded.message();
 }
 
+/// "dial": a game with its own input — 2 bytes per player, a signed 16-bit push along x, little-
+/// endian — that adds each player's pushes up in its game state and kicks the ball with them.
+void control_dial(World& w, std::span<const std::uint8_t> inputs, const ScenarioParams& p) {
+  std::vector<std::uint8_t> state(w.game_state().begin(), w.game_state().end());
+  for (std::uint32_t i = 0; i < p.players; ++i) {
+    const auto push = static_cast<std::int16_t>(
+        static_cast<std::uint16_t>(inputs[2 * i] | (std::uint16_t{inputs[2 * i + 1]} << 8)));
+    std::uint32_t total = 0;
+    for (int k = 0; k < 4; ++k)
+      total |= std::uint32_t{state[4 * i + static_cast<std::size_t>(k)]} << (8 * k);
+    total += static_cast<std::uint32_t>(push);  // modulo 2^32: a running sum with wrap-around
+    for (int k = 0; k < 4; ++k)
+      state[4 * i + static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(total >> (8 * k));
+    (void)w.apply_force(BodyId{2}, {Fixed::from_int(push) / 4096_fx, 0_fx, 0_fx});
+  }
+  (void)w.set_game_state(state);
+}
+
+ScenarioDefinition dial() {
+  ScenarioDefinition d = tally();
+  d.name = "dial";
+  d.summary = "a ball pushed by each player's 16-bit dial";
+  d.control = nullptr;
+  d.input_size = 2;
+  d.control_bytes = control_dial;
+  return d;
+}
+
+void ensure_dial() {
+  static const bool registered = [] {
+    const Status s = register_scenario(dial());
+    EXPECT_TRUE(s.ok()) << s.message();
+    return true;
+  }();
+  (void)registered;
+}
+
+std::int32_t dial_total(const World& w, std::uint32_t player) {
+  std::uint32_t n = 0;
+  for (int k = 0; k < 4; ++k)
+    n |= std::uint32_t{w.game_state()[4 * player + static_cast<std::size_t>(k)]} << (8 * k);
+  return static_cast<std::int32_t>(n);
+}
+
+TEST(ScenarioRegister, AGameWithItsOwnInputGetsItsBytesAsTheyAre) {
+  ensure_dial();
+  const ScenarioInfo* info = find_scenario("dial");
+  ASSERT_NE(info, nullptr);
+  EXPECT_EQ(info->input_size, 2U);
+  auto s = Scenario::create("dial", {.players = 3});
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_FALSE(s->takes_player_input());
+  // -2, 300 and (missing bytes) 0, then 1000, -1 and 7: the totals are the sums.
+  s->step_encoded(std::vector<std::uint8_t>{0xFE, 0xFF, 0x2C, 0x01});
+  s->step_encoded(std::vector<std::uint8_t>{0xE8, 0x03, 0xFF, 0xFF, 0x07, 0x00, 0x99});
+  EXPECT_EQ(dial_total(s->world(), 0), -2 + 1000);
+  EXPECT_EQ(dial_total(s->world(), 1), 300 - 1);
+  EXPECT_EQ(dial_total(s->world(), 2), 7);
+  // PlayerInputs mean nothing to it: step() gives every player the zero input.
+  const std::vector<PlayerInput> stick(3, PlayerInput{PlayerInput::dash, 100, 100});
+  s->step(stick);
+  EXPECT_EQ(dial_total(s->world(), 0), 998);
+  // Without a script of its own, its stand-in's bytes are a pure function of (seed, frame, player)
+  // that changes with each of them.
+  std::array<std::uint8_t, 2> a{};
+  std::array<std::uint8_t, 2> again{};
+  s->scripted(5, 30, 1, a);
+  s->scripted(5, 30, 1, again);
+  EXPECT_EQ(a, again);
+  std::set<std::array<std::uint8_t, 2>> seen;
+  for (std::uint64_t f = 0; f < 300; f += 15)
+    for (std::uint32_t p = 0; p < 3; ++p) {
+      s->scripted(5, f, p, a);
+      seen.insert(a);
+    }
+  EXPECT_GT(seen.size(), 50U) << "60 decisions, nearly all different";
+}
+
+TEST(ScenarioRegister, AGameWithItsOwnInputRecordsVerifiesSeeksAndSyncTests) {
+  ensure_dial();
+  test::TempFile file("dial.dsr");
+  auto scenario = Scenario::create("dial", {.seed = 4});
+  ASSERT_TRUE(scenario.ok());
+  replay::RecordOptions options;
+  options.frames = 150;
+  options.keyframe_interval = 40;
+  options.input_bytes = [](std::uint64_t frame, std::span<std::uint8_t> out) {
+    ASSERT_EQ(out.size(), 4U);  // two players of 2 bytes
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = static_cast<std::uint8_t>(frame * 7 + i * 61);
+  };
+  auto recorded = replay::record(scenario.value(), file.path(), options);
+  ASSERT_TRUE(recorded.ok()) << recorded.message();
+  auto reader = replay::ReplayReader::open(file.path());
+  ASSERT_TRUE(reader.ok()) << reader.message();
+  EXPECT_EQ(reader->fingerprint().input_size, 2U);
+  auto verified = replay::verify(reader.value());
+  ASSERT_TRUE(verified.ok()) << verified.message();
+  EXPECT_TRUE(verified->ok) << verified->note;
+  EXPECT_EQ(verified->final_hash, recorded->final_hash);
+  auto at = replay::seek(reader.value(), 99);
+  ASSERT_TRUE(at.ok()) << at.message();
+  auto straight = Scenario::create("dial", {.seed = 4});
+  std::vector<std::uint8_t> bytes(4);
+  for (std::uint64_t f = 1; f <= 99; ++f) {
+    options.input_bytes(f, bytes);
+    straight->step_encoded(bytes);
+  }
+  EXPECT_EQ(at->world().save(), straight->world().save());
+  // The running sums in the game state are the inputs' (a formula, not a read-back).
+  std::int32_t expected = 0;
+  for (std::uint64_t f = 1; f <= 99; ++f)
+    expected += static_cast<std::int16_t>(static_cast<std::uint16_t>(
+        static_cast<std::uint8_t>(f * 7) | (static_cast<std::uint8_t>(f * 7 + 61) << 8)));
+  EXPECT_EQ(dial_total(at->world(), 0), expected);
+
+  // PlayerInputs are refused by name for such a game; the sync test takes its bytes.
+  auto other = Scenario::create("dial", {.seed = 4});
+  replay::RecordOptions wrong;
+  wrong.inputs = [](std::uint64_t, std::span<PlayerInput>) {};
+  auto refused = replay::record(other.value(), "", wrong);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("takes its own input of 2 bytes"), std::string::npos)
+      << refused.message();
+  auto sync_scenario = Scenario::create("dial", {.seed = 4});
+  net::ScenarioGame game(sync_scenario.value());
+  EXPECT_EQ(game.input_size(), 2U);
+  auto sync = net::SyncTestSession::create({2, game.input_size(), 6}, game);
+  ASSERT_TRUE(sync.ok()) << sync.message();
+  for (std::uint64_t f = 1; f <= 120; ++f) {
+    options.input_bytes(f, bytes);
+    auto ok = sync->advance_frame(bytes);
+    ASSERT_TRUE(ok.ok()) << ok.message();
+    ASSERT_TRUE(ok.value()) << "frame " << f;
+  }
+}
+
 TEST(ScenarioRegister, BadDefinitionsAreRefusedNamingTheProblem) {
   ensure_tally();
   const auto refused = [](ScenarioDefinition d, const std::string& expected) {
@@ -218,6 +357,18 @@ TEST(ScenarioRegister, BadDefinitionsAreRefusedNamingTheProblem) {
   d.name = "tally2";
   d.default_frames = 0;
   refused(d, "default_frames must be >= 1");
+  d = tally();
+  d.name = "tally2";
+  d.input_size = 65;
+  refused(d, "input_size is at most 64 bytes, got 65");
+  d.input_size = 2;
+  refused(d, "takes control_bytes, not control");
+  d.control = nullptr;
+  refused(d, "needs control_bytes");
+  d = tally();
+  d.name = "tally2";
+  d.control_bytes = control_dial;
+  refused(d, "control_bytes and script are for a game's own input: set input_size");
   EXPECT_EQ(find_scenario("tally2"), nullptr) << "nothing was registered";
 }
 

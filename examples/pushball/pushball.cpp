@@ -85,7 +85,7 @@ void build(World& w, const detsim::ScenarioParams&) {
   (void)w.describe_game_state(fields);
 }
 
-void control(World& w, std::span<const detsim::PlayerInput> inputs, const detsim::ScenarioParams&) {
+void control(World& w, std::span<const std::uint8_t> inputs, const detsim::ScenarioParams&) {
   State s = state_of(w);
   const BodyId ball = find(w, ball_tag);
   if (s.kickoff > 0) {
@@ -95,15 +95,15 @@ void control(World& w, std::span<const detsim::PlayerInput> inputs, const detsim
         place(w, find(w, player_tag + p), player_start(p));
     }
   } else {
-    for (std::uint32_t p = 0; p < 2 && p < inputs.size(); ++p) {
+    for (std::uint32_t p = 0; p < 2 && (p + 1) * Input::size <= inputs.size(); ++p) {
       const BodyId puck = find(w, player_tag + p);
-      const detsim::PlayerInput& in = inputs[p];
-      const Vec3 stick{Fixed::from_int(in.move_x) / 127_fx, 0_fx,
-                       Fixed::from_int(in.move_z) / 127_fx};
+      const Input in = Input::decode(inputs.subspan(p * Input::size, Input::size));
+      const Vec3 stick{Fixed::from_int(in.aim_x) / 32767_fx, 0_fx,
+                       Fixed::from_int(in.aim_z) / 32767_fx};
       (void)w.apply_force(puck, stick * 40_fx);
       if (s.cooldown[p] > 0) {
         --s.cooldown[p];
-      } else if ((in.buttons & detsim::PlayerInput::dash) != 0) {
+      } else if ((in.buttons & Input::dash) != 0) {
         const Vec3 toward = stick == Vec3{} ? Vec3{p == 0 ? 1_fx : -1_fx, 0_fx, 0_fx} : stick;
         (void)w.apply_linear_impulse(puck, toward * 8_fx);
         s.cooldown[p] = dash_cooldown_frames;
@@ -121,7 +121,48 @@ void control(World& w, std::span<const detsim::PlayerInput> inputs, const detsim
   (void)w.set_game_state(s.encode());
 }
 
+// SplitMix64's finaliser: the scripted player's decisions.
+std::uint64_t mix(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9U;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBU;
+  return z ^ (z >> 31);
+}
+
 }  // namespace
+
+void Input::encode(std::span<std::uint8_t> out) const {
+  out[0] = static_cast<std::uint8_t>(static_cast<std::uint16_t>(aim_x));
+  out[1] = static_cast<std::uint8_t>(static_cast<std::uint16_t>(aim_x) >> 8);
+  out[2] = static_cast<std::uint8_t>(static_cast<std::uint16_t>(aim_z));
+  out[3] = static_cast<std::uint8_t>(static_cast<std::uint16_t>(aim_z) >> 8);
+  out[4] = buttons;
+}
+
+Input Input::decode(std::span<const std::uint8_t> in) {
+  const auto axis = [&](std::size_t at) {
+    const auto raw = static_cast<std::uint16_t>(get(in, at, 2));
+    // Two's complement; -32768 counts as -32767 so that every aim has an opposite.
+    return static_cast<std::int16_t>(raw == 0x8000U ? -32767 : static_cast<std::int16_t>(raw));
+  };
+  return {axis(0), axis(2), static_cast<std::uint8_t>(get(in, 4, 1))};
+}
+
+std::vector<std::uint8_t> encode_frame(const Input& player1, const Input& player2) {
+  std::vector<std::uint8_t> out(2 * Input::size);
+  player1.encode(std::span<std::uint8_t>(out).first(Input::size));
+  player2.encode(std::span<std::uint8_t>(out).subspan(Input::size));
+  return out;
+}
+
+Input scripted(std::uint64_t seed, std::uint64_t frame, std::uint32_t player) {
+  const std::uint64_t h =
+      mix(mix(seed ^ 0x5C1A7B0E11D00DULL) ^ (std::uint64_t{player} << 48) ^ (frame / 15));
+  Input in;
+  in.aim_x = static_cast<std::int16_t>(static_cast<std::int32_t>(h & 0xFFFFU) - 32768);
+  in.aim_z = static_cast<std::int16_t>(static_cast<std::int32_t>((h >> 16) & 0xFFFFU) - 32768);
+  if (frame % 15 == 0 && ((h >> 32) & 3U) == 0) in.buttons = Input::dash;
+  return in;
+}
 
 std::vector<std::uint8_t> State::encode() const {
   std::vector<std::uint8_t> out;
@@ -163,7 +204,10 @@ detsim::ScenarioDefinition definition() {
   d.default_players = 2;
   d.uses_seed = false;
   d.build = build;
-  d.control = control;
+  d.input_size = Input::size;
+  d.control_bytes = control;
+  d.script = [](std::uint64_t seed, std::uint64_t frame, std::uint32_t player,
+                std::span<std::uint8_t> out) { scripted(seed, frame, player).encode(out); };
   return d;
 }
 

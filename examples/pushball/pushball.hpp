@@ -30,6 +30,26 @@ struct State {
   [[nodiscard]] static State decode(std::span<const std::uint8_t> bytes);
 };
 
+/// A player's input for one frame: the game's own, 5 bytes (little-endian), finer than a
+/// PlayerInput's stick. Replays, sessions, reports and every tool carry these bytes as they are
+/// (ScenarioDefinition::input_size); all zero is "nothing pressed", which a gone player gets.
+struct Input {
+  static constexpr std::size_t size = 5;
+  static constexpr std::uint8_t dash = 1;  ///< buttons bit 0
+  std::int16_t aim_x = 0;                  ///< -32767 .. 32767: the push, towards +x
+  std::int16_t aim_z = 0;
+  std::uint8_t buttons = 0;
+
+  /// Writes the 5 bytes to out[0 .. 4].
+  void encode(std::span<std::uint8_t> out) const;
+  [[nodiscard]] static Input decode(std::span<const std::uint8_t> in);
+};
+/// One frame's inputs, both players', as Scenario::step_encoded takes them.
+[[nodiscard]] std::vector<std::uint8_t> encode_frame(const Input& player1, const Input& player2);
+/// The scripted stand-in player (the tools' --bot and runs without inputs): it holds an aim for a
+/// quarter of a second and dashes at the start of one decision in four.
+[[nodiscard]] Input scripted(std::uint64_t seed, std::uint64_t frame, std::uint32_t player);
+
 /// The fields diff and bisect name (score.player1, cooldown.player2, ...).
 [[nodiscard]] std::vector<detsim::GameField> state_fields();
 

@@ -208,12 +208,12 @@ class Local {
   /// the states of the frames in `keep`.
   void step_to(std::uint64_t to, const std::set<std::uint64_t>& keep) {
     const std::size_t unit = in_.unit();
-    std::vector<PlayerInput> inputs;
+    std::vector<std::uint8_t> inputs;
     State bytes;
     while (frame() < to && frame() < in_.last) {
       const std::span<const std::uint8_t> step(in_.inputs.data() + Side::at(frame()) * unit, unit);
-      detail::decode_inputs(step, inputs, in_.gone_at(frame()));
-      scenario_.step(inputs);
+      detail::gone_zeroed(step, in_.fp.input_size, in_.gone_at(frame()), inputs);
+      scenario_.step_encoded(inputs);
       hashes_[frame()] = scenario_.world().save(bytes);
       if (keep.count(frame()) != 0) states_[frame()] = bytes;
     }

@@ -41,11 +41,11 @@ std::string chunk_name(std::uint32_t type);
 void write_fingerprint(const Fingerprint& f, ByteWriter& w);
 /// Reads and validates a fingerprint payload; false with the reader's error set.
 bool read_fingerprint(ByteReader& r, Fingerprint& f);
-/// One frame's inputs of a scenario (players * PlayerInput::encoded_size bytes) decoded into `out`;
-/// a player whose bit is set in `gone` (a desync report's "disconnected" byte) gets the neutral
-/// input.
-void decode_inputs(std::span<const std::uint8_t> bytes, std::vector<PlayerInput>& out,
-                   std::uint8_t gone = 0);
+/// One frame's inputs of a scenario (players inputs of input_size bytes) into `out`, with the
+/// inputs of every player whose bit is set in `gone` (a desync report's "disconnected" byte) zero:
+/// what Scenario::step_encoded takes.
+void gone_zeroed(std::span<const std::uint8_t> bytes, std::size_t input_size, std::uint8_t gone,
+                 std::vector<std::uint8_t>& out);
 void encode_hashes(const StateHashes& h, ByteWriter& w);
 StateHashes decode_hashes(ByteReader& r, const std::vector<std::string>& sections);
 

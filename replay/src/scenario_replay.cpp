@@ -13,7 +13,6 @@
 
 namespace detsim::replay {
 
-using detail::decode_inputs;
 using detail::hex64;
 
 namespace {
@@ -95,15 +94,13 @@ std::string fixed_text(Fixed v) {
 
 }  // namespace
 
-void detail::decode_inputs(std::span<const std::uint8_t> bytes, std::vector<PlayerInput>& out,
-                           std::uint8_t gone) {
-  out.resize(bytes.size() / PlayerInput::encoded_size);
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    out[i] = i < 8 && ((gone >> i) & 1U) != 0
-                 ? PlayerInput{}
-                 : decode_input(std::span<const std::uint8_t, PlayerInput::encoded_size>(
-                       bytes.data() + i * PlayerInput::encoded_size, PlayerInput::encoded_size));
-  }
+void detail::gone_zeroed(std::span<const std::uint8_t> bytes, std::size_t input_size,
+                         std::uint8_t gone, std::vector<std::uint8_t>& out) {
+  out.assign(bytes.begin(), bytes.end());
+  for (std::size_t p = 0; p < 8 && input_size > 0 && (p + 1) * input_size <= out.size(); ++p)
+    if (((gone >> p) & 1U) != 0)
+      std::fill_n(out.begin() + static_cast<std::ptrdiff_t>(p * input_size), input_size,
+                  std::uint8_t{0});
 }
 
 Fingerprint fingerprint_of(const Scenario& scenario, std::uint32_t keyframe_interval) {
@@ -118,7 +115,7 @@ Fingerprint fingerprint_of(const Scenario& scenario, std::uint32_t keyframe_inte
   f.substeps = def.substeps;
   f.iterations = def.iterations;
   f.players = scenario.params().players;
-  f.input_size = PlayerInput::encoded_size;
+  f.input_size = scenario.info().input_size;
   f.keyframe_interval = keyframe_interval;
   const StateHashes initial = scenario.world().hashes();
   f.initial_hash = initial.total;
@@ -142,15 +139,16 @@ Expected<Scenario> scenario_of(const Fingerprint& f, const std::string& name) {
         where + "recorded with state encoding " + std::to_string(f.state_version) +
         " (its hashes and keyframes are of it), " + "this build writes and reads encoding " +
         std::to_string(state_encoding_version) + "; detsim " + f.detsim_version + " recorded it");
-  if (find_scenario(f.scenario) == nullptr)
+  const ScenarioInfo* info = find_scenario(f.scenario);
+  if (info == nullptr)
     return Status::error(where + "scenario \"" + f.scenario +
                          "\" is not one of this program's scenarios (`scenarios` lists them; a "
                          "game's own scenario is known to the program that registers it: its tool "
                          "built on detsim::cli::run_cli)");
-  if (f.input_size != PlayerInput::encoded_size)
+  if (f.input_size != info->input_size)
     return Status::error(where + "inputs of " + std::to_string(f.input_size) +
-                         " bytes, this build's scenarios take " +
-                         std::to_string(PlayerInput::encoded_size));
+                         " bytes, this build's " + f.scenario + " takes " +
+                         std::to_string(info->input_size));
   if (f.players != f.params.players)
     return Status::error(where + std::to_string(f.players) + " inputs per frame for " +
                          std::to_string(f.params.players) + " players");
@@ -187,18 +185,27 @@ Expected<RecordResult> record(Scenario& scenario, const std::string& path,
   }
   const std::uint32_t players = scenario.params().players;
   const std::uint64_t seed = scenario.params().seed;
+  const std::size_t size = scenario.info().input_size;
+  const bool own_input = !scenario.takes_player_input();
+  if (options.inputs && own_input)
+    return Status::error("record: " + std::string(scenario.info().name) +
+                         " takes its own input of " + std::to_string(size) +
+                         " bytes, not PlayerInput: give RecordOptions::input_bytes");
   std::vector<PlayerInput> inputs(players);
-  std::vector<std::uint8_t> bytes;
+  std::vector<std::uint8_t> bytes(players * size);
   HashChain chain;
   RecordResult result;
   for (std::uint64_t f = 1; f <= frames; ++f) {
-    if (options.inputs) {
+    if (options.input_bytes) {
+      options.input_bytes(f, bytes);
+    } else if (options.inputs) {
       options.inputs(f, inputs);
+      encode_inputs(inputs, bytes);
     } else {
       for (std::uint32_t p = 0; p < players; ++p)
-        inputs[p] = scripted_input(seed, f, p);
+        scenario.scripted(seed, f, p, std::span<std::uint8_t>(bytes).subspan(p * size, size));
     }
-    scenario.step(inputs);
+    scenario.step_encoded(bytes);
     if (options.after_step) {
       if (Status s = options.after_step(scenario); !s) return s;
     }
@@ -207,7 +214,6 @@ Expected<RecordResult> record(Scenario& scenario, const std::string& path,
     result.final_hash = hashes.total;
     result.frames = f;
     if (writer) {
-      encode_inputs(inputs, bytes);
       if (Status s = writer->frame(bytes, hashes); !s) return s;
       if (f % options.keyframe_interval == 0) {
         if (Status s = writer->keyframe(f, scenario.world().save()); !s) return s;
@@ -253,12 +259,10 @@ Expected<VerifyResult> verify(const ReplayReader& reader, const VerifyOptions& o
   if (reporting) report.remember(scenario.world());
   const std::vector<KeyframeInfo>& keyframes = reader.keyframes();
   std::size_t next_keyframe = 0;
-  std::vector<PlayerInput> inputs;
   HashChain chain;
   Status stop_error;
   const Status read = reader.for_each_frame(1, total, [&](const FrameRecord& record) {
-    decode_inputs(record.inputs, inputs);
-    scenario.step(inputs);
+    scenario.step_encoded(record.inputs);
     if (options.after_step) {
       if (Status s = options.after_step(scenario); !s) {
         stop_error = s;
@@ -341,10 +345,8 @@ Expected<Scenario> seek(const ReplayReader& reader, std::uint64_t frame,
                            " does not restore: " + s.message());
     from = k.frame;
   }
-  std::vector<PlayerInput> inputs;
   const Status read = reader.for_each_frame(from + 1, frame, [&](const FrameRecord& record) {
-    decode_inputs(record.inputs, inputs);
-    scenario.step(inputs);
+    scenario.step_encoded(record.inputs);
     return true;
   });
   if (!read) return read;

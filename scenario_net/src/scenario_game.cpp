@@ -21,11 +21,15 @@ void ScenarioGame::load(std::span<const std::uint8_t> state) {
 }
 
 void ScenarioGame::advance(const FrameInputs& inputs, bool resimulating) {
-  inputs_.assign(inputs.players(), PlayerInput{});
-  if (inputs.input_size == input_size) {
+  // Inputs of another size than the scenario's (a session misconfigured) count as neutral.
+  const std::size_t size = input_size();
+  inputs_.assign(inputs.players() * size, 0);
+  if (inputs.input_size == size) {
     for (std::size_t p = 0; p < inputs.players(); ++p) {
       if (inputs.status[p] == InputStatus::disconnected) continue;
-      inputs_[p] = decode_input(inputs.input(p).first<PlayerInput::encoded_size>());
+      const std::span<const std::uint8_t> input = inputs.input(p);
+      std::copy(input.begin(), input.end(),
+                inputs_.begin() + static_cast<std::ptrdiff_t>(p * size));
     }
   }
   step_and_hook();
@@ -33,7 +37,7 @@ void ScenarioGame::advance(const FrameInputs& inputs, bool resimulating) {
 }
 
 void ScenarioGame::step_and_hook() {
-  scenario_->step(inputs_);
+  scenario_->step_encoded(inputs_);
   if (after_step_) {
     Status s = after_step_(*scenario_);
     if (!s && after_step_status_.ok()) after_step_status_ = std::move(s);
@@ -44,7 +48,8 @@ Expected<std::vector<std::vector<std::uint8_t>>> ScenarioGame::resimulate(
     std::span<const std::uint8_t> state, std::span<const std::uint8_t> frames) {
   World& world = scenario_->world();
   const std::size_t players = scenario_->params().players;
-  const std::size_t unit = 1 + players * input_size;
+  const std::size_t size = input_size();
+  const std::size_t unit = 1 + players * size;
   if (frames.size() % unit != 0)
     return Status::error("re-simulation: confirmed frames are not whole frames of " +
                          std::to_string(unit) + " bytes");
@@ -54,12 +59,11 @@ Expected<std::vector<std::vector<std::uint8_t>>> ScenarioGame::resimulate(
   out.reserve(frames.size() / unit);
   for (std::size_t at = 0; at < frames.size(); at += unit) {
     const std::uint8_t disconnected = frames[at];
-    inputs_.assign(players, PlayerInput{});
-    for (std::size_t p = 0; p < players; ++p) {
-      if (p < 8 && ((disconnected >> p) & 1U) != 0) continue;
-      inputs_[p] =
-          decode_input(frames.subspan(at + 1 + p * input_size).first<PlayerInput::encoded_size>());
-    }
+    inputs_.assign(frames.begin() + static_cast<std::ptrdiff_t>(at + 1),
+                   frames.begin() + static_cast<std::ptrdiff_t>(at + unit));
+    for (std::size_t p = 0; p < players && p < 8; ++p)
+      if (((disconnected >> p) & 1U) != 0)
+        std::fill_n(inputs_.begin() + static_cast<std::ptrdiff_t>(p * size), size, std::uint8_t{0});
     step_and_hook();
     out.emplace_back();
     world.save(out.back());

@@ -193,6 +193,8 @@ struct ScenarioEntry {
   WorldDef world;
   std::function<void(World&, const ScenarioParams&)> build;
   std::function<void(World&, std::span<const PlayerInput>, const ScenarioParams&)> control;
+  std::function<void(World&, std::span<const std::uint8_t>, const ScenarioParams&)> control_bytes;
+  std::function<void(std::uint64_t, std::uint64_t, std::uint32_t, std::span<std::uint8_t>)> script;
 };
 
 }  // namespace scenes_detail
@@ -287,8 +289,24 @@ Status register_scenario(const ScenarioDefinition& d) {
   if (d.default_count > d.max_count)
     return Status::error(which + "default_count " + std::to_string(d.default_count) +
                          " exceeds max_count " + std::to_string(d.max_count));
-  if (d.max_players > 0 && !d.control)
+  if (d.input_size > max_scenario_input_size)
+    return Status::error(which + "input_size is at most " +
+                         std::to_string(max_scenario_input_size) + " bytes, got " +
+                         std::to_string(d.input_size));
+  if (d.input_size == 0 && (d.control_bytes || d.script))
+    return Status::error(which +
+                         "control_bytes and script are for a game's own input: set input_size "
+                         "(its bytes per player), or use control with PlayerInput");
+  if (d.input_size > 0 && d.control)
+    return Status::error(which + "a game with its own input (input_size " +
+                         std::to_string(d.input_size) +
+                         ") takes control_bytes, not control (which takes PlayerInput)");
+  if (d.max_players > 0 && d.input_size == 0 && !d.control)
     return Status::error(which + "a scenario with players needs control: their inputs go there");
+  if (d.max_players > 0 && d.input_size > 0 && !d.control_bytes)
+    return Status::error(which +
+                         "a scenario with players needs control_bytes: their inputs go "
+                         "there");
   if (Status s = World::create(d.world).status(); !s)
     return Status::error(which + "world: " + s.message());
   Registry& r = registry();
@@ -301,12 +319,23 @@ Status register_scenario(const ScenarioDefinition& d) {
   e.name = d.name;
   e.summary = d.summary;
   e.count_unit = d.count_unit;
-  e.info = ScenarioInfo{e.name,        e.summary,         d.default_frames, d.min_players,
-                        d.max_players, d.default_players, d.default_count,  d.max_count,
-                        d.uses_seed,   e.count_unit};
+  e.info =
+      ScenarioInfo{e.name,
+                   e.summary,
+                   d.default_frames,
+                   d.min_players,
+                   d.max_players,
+                   d.default_players,
+                   d.default_count,
+                   d.max_count,
+                   d.uses_seed,
+                   e.count_unit,
+                   d.input_size == 0 ? std::uint32_t{PlayerInput::encoded_size} : d.input_size};
   e.world = d.world;
   e.build = d.build;
   e.control = d.control;
+  e.control_bytes = d.control_bytes;
+  e.script = d.script;
   return Status::success();
 }
 
@@ -353,8 +382,59 @@ void Scenario::step(std::span<const PlayerInput> inputs) {
     const std::size_t n = std::min<std::size_t>({inputs.size(), params_.players, frame.size()});
     std::copy_n(inputs.begin(), n, frame.begin());
     entry_->control(world_, std::span<const PlayerInput>(frame.data(), params_.players), params_);
+  } else if (entry_->control_bytes) {
+    step_encoded({});
+    return;
   }
   world_.step();
+}
+
+void Scenario::step_encoded(std::span<const std::uint8_t> inputs) {
+  const std::size_t size = entry_->info.input_size;
+  if (entry_->control_bytes) {
+    std::array<std::uint8_t, max_scenario_players * max_scenario_input_size> frame{};
+    const std::size_t used = std::size_t{params_.players} * size;
+    std::copy_n(inputs.begin(), std::min(inputs.size(), used), frame.begin());
+    entry_->control_bytes(world_, std::span<const std::uint8_t>(frame.data(), used), params_);
+  } else if (entry_->control) {
+    std::array<PlayerInput, max_scenario_players> frame{};
+    for (std::uint32_t p = 0; p < params_.players; ++p) {
+      std::array<std::uint8_t, PlayerInput::encoded_size> bytes{};  // missing: neutral
+      const std::size_t at = std::size_t{p} * size;
+      if (at < inputs.size())
+        std::copy_n(inputs.begin() + static_cast<std::ptrdiff_t>(at),
+                    std::min(size, inputs.size() - at), bytes.begin());
+      frame[p] = decode_input(bytes);
+    }
+    entry_->control(world_, std::span<const PlayerInput>(frame.data(), params_.players), params_);
+  }
+  world_.step();
+}
+
+bool Scenario::takes_player_input() const noexcept {
+  return !entry_->control_bytes;
+}
+
+void Scenario::scripted(std::uint64_t seed, std::uint64_t frame, std::uint32_t player,
+                        std::span<std::uint8_t> out) const {
+  if (entry_->script) {
+    entry_->script(seed, frame, player, out);
+    return;
+  }
+  if (!entry_->control_bytes) {
+    std::array<std::uint8_t, PlayerInput::encoded_size> bytes{};
+    encode_input(scripted_input(seed, frame, player), bytes);
+    std::copy_n(bytes.begin(), std::min(out.size(), bytes.size()), out.begin());
+    return;
+  }
+  // A game's own input without a script: a hash of (seed, player, decision), a decision every
+  // quarter second, 8 bytes of it at a time.
+  const std::uint64_t decision =
+      mix(mix(seed ^ 0x13198A2E03707344U) ^ (std::uint64_t{player} << 48) ^ (frame / 15));
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::uint64_t word = mix(decision + i / 8);
+    out[i] = static_cast<std::uint8_t>(word >> (8 * (i % 8)));
+  }
 }
 
 BodyId Scenario::player_body(std::uint32_t player) const {

@@ -29,7 +29,7 @@ void Match::start_session(std::uint32_t p, bool rejoin) {
   config.mode = options_.mode;
   config.players = options_.players;
   config.local_player = p;
-  config.input_size = options_.arena ? net::ScenarioGame::input_size : 4;
+  config.input_size = options_.arena ? PlayerInput::encoded_size : 4;
   config.input_delay = options_.input_delay;
   config.max_prediction = options_.max_prediction;
   config.check_interval = options_.check_interval;
@@ -173,7 +173,7 @@ void Match::idle(std::uint64_t ticks) {
     const std::uint64_t now = tick_ * 16'667;
     network_->advance_to(now);
     for (std::uint32_t p = 0; p < options_.players; ++p) {
-      if (!sessions_[p]) continue;
+      if (!restarted_peer_up(p)) continue;
       sessions_[p]->poll(now);
       for (const net::Event& e : sessions_[p]->take_events())
         records_[p].events.push_back(e);

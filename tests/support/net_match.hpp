@@ -147,7 +147,8 @@ class Match {
   /// Ticks until every peer confirmed options.frames frames (or max_ticks); true if they did.
   bool run();
 
-  /// Polls every peer for `ticks` more ticks without advancing (acknowledgements settle).
+  /// Polls every peer for `ticks` more ticks without advancing (acknowledgements settle; a
+  /// restart_peer comes back up at its rejoin_tick here too).
   void idle(std::uint64_t ticks);
 
   std::uint32_t players() const { return options_.players; }

@@ -114,7 +114,7 @@ Status Demo::set_up(const std::string& replay_path) {
     config.mode = net::SessionMode::rollback;
     config.players = demo_players;
     config.local_player = p;
-    config.input_size = net::ScenarioGame::input_size;
+    config.input_size = peer.game->input_size();
     config.input_delay = demo_input_delay;
     config.fingerprint = session_fingerprint(*peer.scenario, config.mode, args_.frames);
     for (std::uint32_t q = 0; q < demo_players; ++q)

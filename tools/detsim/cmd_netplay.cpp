@@ -161,7 +161,7 @@ Status Netplay::start() {
   config.mode = plan_.mode;
   config.players = args_.players;
   config.local_player = args_.me;
-  config.input_size = net::ScenarioGame::input_size;
+  config.input_size = game_->input_size();
   config.input_delay = args_.input_delay;
   config.fingerprint = session_fingerprint(*scenario_, plan_.mode, args_.frames);
   config.match_key = plan_.match_key;
@@ -308,13 +308,12 @@ void Netplay::advance() {
     ++skipped_;
     return;
   }
-  PlayerInput input;
   // The bot plays by frame, not by time: the inputs, and so the final hash, depend only on the
-  // arguments, never on the network's timing.
+  // arguments, never on the network's timing. Without one the player's input is all zero (no
+  // button pressed).
+  std::vector<std::uint8_t> bytes(game_->input_size());
   if (args_.bot)
-    input = scripted_input(args_.bot_seed, s.current_frame() + args_.input_delay, args_.me);
-  std::array<std::uint8_t, PlayerInput::encoded_size> bytes{};
-  encode_input(input, bytes);
+    scenario_->scripted(args_.bot_seed, s.current_frame() + args_.input_delay, args_.me, bytes);
   auto result = s.advance_frame(bytes);
   if (result.ok() && result.value() != net::Advance::advanced) {
     ++stalled_;
@@ -347,7 +346,7 @@ std::string Netplay::checks_behind() const {
 
 std::string Netplay::session_failure() {
   // A broken session returns its reason from advance_frame, and changes nothing.
-  const std::array<std::uint8_t, PlayerInput::encoded_size> none{};
+  const std::vector<std::uint8_t> none(game_->input_size());
   const auto result = session_->advance_frame(none);
   return result.ok() ? "(no reason given)" : result.status().message();
 }

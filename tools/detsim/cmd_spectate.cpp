@@ -88,7 +88,7 @@ Status Spectate::start() {
   }
   net::SpectatorConfig config;
   config.players = args_.players;
-  config.input_size = net::ScenarioGame::input_size;
+  config.input_size = game_->input_size();
   // The players' own fingerprint: a spectator of another match (or length) is never served.
   config.fingerprint = session_fingerprint(*scenario_, plan_.mode, args_.frames);
   config.host = host_.id;

@@ -34,21 +34,19 @@ SyncResult run_synctest(Scenario& s, std::uint64_t frames, std::uint32_t distanc
   SyncResult r;
   net::ScenarioGame game(s);
   const std::uint32_t players = std::max<std::uint32_t>(s.params().players, 1);
-  auto created = net::SyncTestSession::create(
-      net::SyncTestConfig{players, net::ScenarioGame::input_size, distance}, game);
+  auto created =
+      net::SyncTestSession::create(net::SyncTestConfig{players, game.input_size(), distance}, game);
   if (!created) {
     r.error = created.message();
     return r;
   }
   net::SyncTestSession session = std::move(created).value();
-  std::vector<std::uint8_t> inputs(std::size_t{players} * net::ScenarioGame::input_size);
+  const std::size_t size = game.input_size();
+  std::vector<std::uint8_t> inputs(std::size_t{players} * size);
   for (std::uint64_t f = 1; f <= frames; ++f) {
     // The step to state f takes the scripted inputs of frame f (as `detsim run` does).
-    for (std::uint32_t p = 0; p < players; ++p) {
-      encode_input(scripted_input(s.params().seed, f, p),
-                   std::span<std::uint8_t, PlayerInput::encoded_size>(
-                       inputs.data() + std::size_t{p} * net::ScenarioGame::input_size, 3));
-    }
+    for (std::uint32_t p = 0; p < players; ++p)
+      s.scripted(s.params().seed, f, p, std::span<std::uint8_t>(inputs).subspan(p * size, size));
     auto ok = session.advance_frame(inputs);
     if (!ok) {
       r.error = ok.message();

@@ -21,6 +21,9 @@ using Progress = std::function<bool(std::uint64_t done, std::uint64_t total)>;
 /// The inputs of every player at a frame (player order). Default: scripted_input with the
 /// scenario's seed.
 using InputSource = std::function<void(std::uint64_t frame, std::span<PlayerInput> out)>;
+/// The same in the scenario's input bytes (players * info().input_size, player order): the way
+/// to feed a game with its own input (ScenarioDefinition::input_size). Default: Scenario::scripted.
+using InputBytesSource = std::function<void(std::uint64_t frame, std::span<std::uint8_t> out)>;
 
 /// Called after each step, before the frame's hashes are taken (scenario.world().frame() is the
 /// frame just made): a fault injection (<detsim/sim/inject.hpp>) for tests and demos. An error
@@ -30,9 +33,10 @@ using AfterStep = std::function<Status(Scenario& scenario)>;
 struct RecordOptions {
   std::uint32_t frames = 0;  ///< 0: the scenario's default
   std::uint32_t keyframe_interval = default_keyframe_interval;
-  InputSource inputs;    ///< empty: scripted_input(seed, frame, player)
-  Progress progress;     ///< optional
-  AfterStep after_step;  ///< optional
+  InputSource inputs;  ///< empty: scripted_input(seed, frame, player); PlayerInput games only
+  InputBytesSource input_bytes;  ///< any game; takes precedence over `inputs`
+  Progress progress;             ///< optional
+  AfterStep after_step;          ///< optional
 };
 
 struct RecordResult {

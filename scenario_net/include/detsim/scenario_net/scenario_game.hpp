@@ -1,6 +1,7 @@
 // detsim::net::ScenarioGame: the Game adapter that lets a session drive a detsim Scenario (and so
 // its World) directly: save and load are World::save / World::restore, the hash is the frame's
-// state hash, and each player's input is a PlayerInput in its 3-byte canonical encoding.
+// state hash, and each player's input is the scenario's input bytes (a PlayerInput's 3-byte
+// canonical encoding, or a game's own input: ScenarioDefinition::input_size).
 //
 // It also remembers the per-part hashes of the states it saved recently, and the states at
 // keyframe frames, so that a ScenarioRecorder can write a replay of the confirmed frames without
@@ -23,19 +24,21 @@ namespace detsim::net {
 
 class ScenarioGame final : public Game {
  public:
-  /// The input size of a scenario session: PlayerInput's canonical encoding.
-  static constexpr std::uint32_t input_size = PlayerInput::encoded_size;
   /// How many recent saves' hashes are remembered (more than any prediction window).
   static constexpr std::size_t remembered_hashes = 64;
 
   /// Drives `scenario`, which must outlive this adapter.
   explicit ScenarioGame(Scenario& scenario) noexcept : scenario_(&scenario) {}
 
+  /// The input size of a session playing this scenario (SessionConfig::input_size): the
+  /// scenario's info().input_size.
+  [[nodiscard]] std::uint32_t input_size() const noexcept { return scenario_->info().input_size; }
+
   std::uint64_t save(std::vector<std::uint8_t>& state) override;
   /// Restores a state save() wrote. A state that does not restore (never the case for bytes this
   /// adapter saved) leaves the world unchanged and is counted by failed_loads().
   void load(std::span<const std::uint8_t> state) override;
-  /// Steps the scenario with every player's decoded input; a disconnected player's is neutral.
+  /// Steps the scenario with every player's input; a disconnected player's is all zero (neutral).
   void advance(const FrameInputs& inputs, bool resimulating) override;
 
   /// A debug hook run after each step, before the state is saved or hashed: a fault injection
@@ -80,7 +83,7 @@ class ScenarioGame final : public Game {
   Scenario* scenario_;
   std::function<Status(Scenario&)> after_step_;
   Status after_step_status_;
-  std::vector<PlayerInput> inputs_;
+  std::vector<std::uint8_t> inputs_;
   std::array<Remembered, remembered_hashes> remembered_{};
   std::array<Keyframe, 2> keyframes_{};
   std::uint32_t keyframe_interval_ = 0;

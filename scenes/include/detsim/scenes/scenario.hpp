@@ -46,6 +46,9 @@ struct ScenarioInfo {
   std::uint32_t max_count = 0;
   bool uses_seed = false;  ///< whether the seed changes anything but the RNG's unused state
   std::string_view count_unit = "bodies";  ///< what `count` counts: "bodies", "rows", "links", ...
+  /// Bytes of one player's input for one frame, as replays and sessions carry it: a PlayerInput's
+  /// 3 for the built-ins, a game's own size for one registered with ScenarioDefinition::input_size.
+  std::uint32_t input_size = PlayerInput::encoded_size;
 };
 
 /// Parameters of a scenario; zero means "the scenario's default".
@@ -60,6 +63,8 @@ struct ScenarioParams {
 
 /// The most players a scenario takes (and a session plays).
 inline constexpr std::uint32_t max_scenario_players = 8;
+/// The largest input a game's own scenario may take, in bytes (what a session datagram carries).
+inline constexpr std::uint32_t max_scenario_input_size = 64;
 
 /// A game's own scenario, for register_scenario(): how to build its scene and run its frames.
 /// Like the built-ins, its logic reads only the World (bodies, RNG, and the game's own state kept
@@ -81,8 +86,25 @@ struct ScenarioDefinition {
   /// Builds the scene at frame 0 into the new, empty world: bodies, joints, the game state.
   std::function<void(World&, const ScenarioParams&)> build;
   /// A frame's game logic, before the world steps: one input per player (players() of them).
-  /// Required when the scenario takes players.
+  /// Required when the scenario takes players, unless the game has its own input (below).
   std::function<void(World&, std::span<const PlayerInput>, const ScenarioParams&)> control;
+
+  /// A game whose input is not a PlayerInput sets its size in bytes (1 ..
+  /// max_scenario_input_size) and gives control_bytes instead of control; 0: PlayerInput. Every
+  /// tool carries the bytes as they are (replays, sessions, reports, bisect, the sync test).
+  std::uint32_t input_size = 0;
+  /// A frame's game logic for a game with its own input: `inputs` holds players() inputs of
+  /// input_size bytes each, in player order. A player without an input (gone from a session, or
+  /// not given) has all zero bytes: the game must read that as "nothing pressed".
+  std::function<void(World&, std::span<const std::uint8_t> inputs, const ScenarioParams&)>
+      control_bytes;
+  /// The scripted stand-in player for a game's own input (record without an input source, the
+  /// tools' --bot, the sync test): writes out.size() == input_size bytes for `player` at `frame`
+  /// of a match seeded with `seed`. Must be a pure function of the three. Empty: bytes of a hash
+  /// of (seed, player, frame / 15), a new decision every quarter second.
+  std::function<void(std::uint64_t seed, std::uint64_t frame, std::uint32_t player,
+                     std::span<std::uint8_t> out)>
+      script;
 };
 
 /// Adds a game's own scenario to this process's registry, so that Scenario::create, replays
@@ -115,8 +137,21 @@ class Scenario {
   [[nodiscard]] const World& world() const noexcept { return world_; }
 
   /// Runs the frame's game logic with one input per player (missing inputs count as neutral,
-  /// extra ones are ignored), then steps the world.
+  /// extra ones are ignored), then steps the world. A game with its own input (info().input_size
+  /// from ScenarioDefinition::input_size) takes step_encoded instead; here its players have zero
+  /// bytes.
   void step(std::span<const PlayerInput> inputs = {});
+  /// The same with every player's input in its bytes: players() inputs of info().input_size bytes
+  /// each, in player order (what replays and sessions carry); missing bytes count as zero, extra
+  /// ones are ignored.
+  void step_encoded(std::span<const std::uint8_t> inputs);
+  /// Whether the frame's logic takes PlayerInput (the built-ins, and control) rather than the
+  /// game's own bytes (control_bytes).
+  [[nodiscard]] bool takes_player_input() const noexcept;
+  /// The scripted stand-in's input for `player` at `frame` in its bytes (out.size() must be
+  /// info().input_size): scripted_input for PlayerInput scenarios, the game's own script else.
+  void scripted(std::uint64_t seed, std::uint64_t frame, std::uint32_t player,
+                std::span<std::uint8_t> out) const;
 
   /// The body a player controls (players 0 .. params().players - 1), or the null ID.
   [[nodiscard]] BodyId player_body(std::uint32_t player) const;
