@@ -802,6 +802,47 @@ TEST(CliNetplay, AKilledPlayerRestartedWithRejoinFinishesTheMatchWithTheSameHash
   FAIL() << "no free ports after 6 attempts";
 }
 
+TEST(CliNetplay, APlayerJoinsAnOpenSeatLateAndBothFinishWithTheSameHash) {
+  // Player 0 starts alone with --open-seat; player 1 starts 3 s later with --join and plays from
+  // the present on. Both finish the 600 frames on one hash.
+  for (int attempt = 0; attempt < 6; ++attempt) {
+    const std::uint16_t port_a = port_for(attempt + 50);
+    const auto port_b = static_cast<std::uint16_t>(port_a + 1);
+    Process host({"netplay", "--players", "2", "--frames", "600", "--me", "0", "--bot", "31",
+                  "--open-seat", "--bind", endpoint(port_a), "--peer", "1=" + endpoint(port_b)},
+                 "open_a");
+    std::this_thread::sleep_for(std::chrono::seconds(3));
+    if (host.poll()) {
+      if (bind_failed(host)) continue;
+      FAIL() << "the host ended early: " << host.out() << host.err();
+    }
+    Process joiner({"netplay", "--players", "2", "--frames", "600", "--me", "1", "--bot", "32",
+                    "--join", "--bind", endpoint(port_b), "--peer", "0=" + endpoint(port_a)},
+                   "open_b");
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    bool done_a = false;
+    bool done_b = false;
+    while (!(done_a && done_b) && std::chrono::steady_clock::now() < deadline) {
+      done_a = done_a || host.poll();
+      done_b = done_b || joiner.poll();
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    if (bind_failed(joiner)) continue;
+    ASSERT_TRUE(done_a && done_b) << host.err() << joiner.err();
+    EXPECT_EQ(host.exit_code(), 0) << host.out() << host.err();
+    EXPECT_EQ(joiner.exit_code(), 0) << joiner.out() << joiner.err();
+    EXPECT_TRUE(has(host.out(), "seat is open")) << host.out();
+    EXPECT_TRUE(has(host.err(), "rejoined at frame")) << host.err();
+    EXPECT_TRUE(has(joiner.out(), "rejoined the match at frame")) << joiner.out();
+    EXPECT_FALSE(has(host.err() + joiner.err(), "UNVERIFIED"));
+    const std::string hash = final_hash_of(host.out());
+    EXPECT_EQ(hash.size(), 16U) << host.out();
+    EXPECT_EQ(final_hash_of(joiner.out()), hash) << host.out() << joiner.out();
+    return;
+  }
+  FAIL() << "no free ports after 6 attempts";
+}
+
 TEST(CliNetplay, AnEightSecondOutageUnderPauseEndsWithTheSameHashOnBothSides) {
   // The outage over UDP: a relay drops everything both ways for 8 s, 3 s into the match.
   // With --partition pause neither side gives the other up; both wait, go on and agree.

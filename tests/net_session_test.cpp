@@ -84,6 +84,21 @@ TEST(NetSession, RejectsInvalidConfigsNamingTheField) {
               c.spectators = {5};
             }).find("a rejoining session serves no spectators"),
             std::string::npos);
+  EXPECT_NE(error_of([](net::SessionConfig& c) {
+              c.players = 3;
+              c.remotes = {{1, 1}, {2, 2}};
+              c.open_seats = {2};
+            }).find("open_seats are for two-player matches only"),
+            std::string::npos);
+  EXPECT_NE(error_of([](net::SessionConfig& c) {
+              c.open_seats = {0};
+            }).find("open_seats: player 0 is out of range, this machine's own, or listed twice"),
+            std::string::npos);
+  EXPECT_NE(error_of([](net::SessionConfig& c) {
+              c.open_seats = {1};
+              c.rejoin = true;
+            }).find("a joining session (rejoin) takes a seat, it opens none"),
+            std::string::npos);
 }
 
 TEST(NetSession, WrongLocalInputSizeIsAnErrorAndChangesNothing) {
@@ -586,6 +601,129 @@ TEST(NetSession, ARestartAfterTheSeatWasGivenUpNeverRejoins) {
   EXPECT_FALSE(m.session(1).running()) << "still waiting for a snapshot nobody sends";
   EXPECT_TRUE(m.record(1).hashes.empty());
   EXPECT_EQ(m.session(0).stats().snapshots_served, 0U);
+}
+
+/// Checks a match in which peer 1 joined an open seat late (or came back to a seat given up):
+/// peer 0 delivered every frame, and shows player 1 away (zero input, InputStatus::disconnected)
+/// exactly over [away_from, R) for the R the join named, playing before and after it; peer 1's
+/// new session delivered from the snapshot's frame on, alike. Returns R.
+std::uint64_t expect_joined_match(Match& m, std::uint64_t frames, std::uint64_t away_from) {
+  const test::PeerRecord& a = m.record(0);
+  const test::PeerRecord& b = m.record(1);
+  const std::size_t size = m.session(0).config().input_size;
+  EXPECT_GE(a.hashes.size(), frames);
+  EXPECT_EQ(m.offline_hashes(0), a.hashes);
+  std::optional<std::uint64_t> joined;
+  for (const net::Event& e : b.events)
+    if (e.type == EventType::rejoined && e.player == 1) joined = e.frame;
+  EXPECT_TRUE(joined.has_value());
+  if (!joined) return 0;
+  EXPECT_EQ(b.first_frame, *joined);
+  EXPECT_GE(b.first_frame + b.hashes.size(), frames);
+  for (std::size_t i = 0; i < b.hashes.size() && b.first_frame + i < a.hashes.size(); ++i) {
+    const std::size_t f = b.first_frame + i;
+    EXPECT_EQ(b.hashes[i], a.hashes[f]) << "frame " << f;
+    EXPECT_EQ(b.status[2 * i + 1], a.status[2 * f + 1]) << "frame " << f;
+  }
+  // Player 1 away from `away_from` to R, then back for good.
+  std::uint64_t back = away_from;
+  while (back < a.hashes.size() && a.status[2 * back + 1] == net::InputStatus::disconnected)
+    ++back;
+  std::size_t wrong = 0;
+  for (std::uint64_t f = 0; f < a.hashes.size(); ++f) {
+    const bool away = f >= away_from && f < back;
+    if (a.status[2 * f + 1] !=
+        (away ? net::InputStatus::disconnected : net::InputStatus::confirmed))
+      ++wrong;
+    for (std::size_t k = 0; away && k < size; ++k)
+      if (a.inputs[(2 * f + 1) * size + k] != 0) ++wrong;
+  }
+  EXPECT_EQ(wrong, 0U) << "player 1 away over [" << away_from << ", " << back << ") only";
+  EXPECT_GE(back, *joined) << "the join takes effect at the present, after the snapshot's frame";
+  EXPECT_LT(back, *joined + 60);
+  EXPECT_FALSE(a.has(EventType::desync));
+  EXPECT_FALSE(b.has(EventType::desync));
+  EXPECT_FALSE(a.has(EventType::check_missing));
+  EXPECT_GE(m.session(1).stats().checks_compared + 2,
+            (frames - b.first_frame) / m.session(0).config().check_interval);
+  return back;
+}
+
+TEST(NetSession, ALateJoinerTakesAnOpenSeatAtThePresentAndEveryFrameAgrees) {
+  // Player 0 starts alone with player 1's seat open; 5 s in, player 1's session joins (a
+  // spectator turned player, or a latecomer) and plays from the present on.
+  MatchOptions o;
+  o.frames = 900;
+  o.link.latency_us = 20'000;
+  o.max_ticks = 3000;
+  o.restart_peer = 1;  // down from the start: its first session never says anything
+  o.restart_tick = 0;
+  o.rejoin_tick = 300;
+  o.configure = [](std::uint32_t p, net::SessionConfig& c) {
+    if (p == 0) c.open_seats = {1};
+  };
+  Match m(o);
+  ASSERT_TRUE(m.run());
+  m.idle(60);
+  const std::uint64_t back = expect_joined_match(m, o.frames, 0);
+  EXPECT_GT(back, 250U) << "player 0 played alone until the join";
+  EXPECT_FALSE(m.record(0).has(EventType::disconnected)) << "an open seat is not a disconnect";
+}
+
+TEST(NetSession, AnOpenSeatNobodyTakesLeavesTheMatchToThePlayerAlone) {
+  MatchOptions o;
+  o.frames = 600;
+  o.max_ticks = 900;
+  o.restart_peer = 1;
+  o.restart_tick = 0;
+  o.rejoin_tick = ~std::uint64_t{0};
+  o.configure = [](std::uint32_t p, net::SessionConfig& c) {
+    if (p == 0) c.open_seats = {1};
+  };
+  Match m(o);
+  EXPECT_FALSE(m.run()) << "peer 1 never finishes: it never comes";
+  const test::PeerRecord& a = m.record(0);
+  ASSERT_GE(a.hashes.size(), 600U);
+  EXPECT_EQ(m.offline_hashes(0), a.hashes);
+  for (std::size_t f = 0; f < a.hashes.size(); ++f)
+    ASSERT_EQ(a.status[2 * f + 1], net::InputStatus::disconnected) << "frame " << f;
+  EXPECT_TRUE(m.session(0).running());
+  EXPECT_FALSE(a.has(EventType::disconnected));
+  EXPECT_FALSE(a.has(EventType::match_ended));
+}
+
+TEST(NetSession, UnderPlayOnARestartedPlayerComesBackToTheSeatItLost) {
+  // Down 8 s: player 0 takes it as gone after 5 and plays on alone (play_on); the restarted
+  // process then joins the seat again, from the present.
+  MatchOptions o;
+  o.frames = 1200;
+  o.link.latency_us = 20'000;
+  o.max_ticks = 4000;
+  o.restart_peer = 1;
+  o.restart_tick = 300;
+  o.rejoin_tick = 300 + 8 * 60;
+  o.configure = [](std::uint32_t, net::SessionConfig& c) {
+    c.partition = net::PartitionPolicy::play_on;
+  };
+  Match m(o);
+  ASSERT_TRUE(m.run());
+  m.idle(60);
+  EXPECT_TRUE(m.record(0).has(EventType::disconnected));
+  std::optional<std::uint64_t> gone;
+  for (const net::Event& e : m.record(0).events)
+    if (e.type == EventType::disconnected && e.player == 1) gone = e.frame;
+  ASSERT_TRUE(gone.has_value());
+  // Gone from the frame its inputs ended (the agreed frame can only be that or earlier).
+  std::uint64_t away_from = 0;
+  while (m.record(0).status[2 * away_from + 1] != net::InputStatus::disconnected)
+    ++away_from;
+  EXPECT_LE(away_from, *gone);
+  const std::uint64_t back = expect_joined_match(m, o.frames, away_from);
+  EXPECT_GT(back, away_from + 150) << "at least 3 s away";
+  // Before the restart, peer 1's first session saw the same frames.
+  const test::PeerRecord& before = m.earlier_record();
+  for (std::size_t f = 0; f < before.hashes.size(); ++f)
+    ASSERT_EQ(before.hashes[f], m.record(0).hashes[f]) << "frame " << f;
 }
 
 /// Alters every snapshot slice peer 1 receives (the plain framing: a peer on the path).

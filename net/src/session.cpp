@@ -34,6 +34,19 @@ Status validate(const SessionConfig& c) {
                " players)");
   if (c.rejoin && !c.spectators.empty())
     return bad("a rejoining session serves no spectators (they followed the earlier one)");
+  if (!c.open_seats.empty() && c.players != 2)
+    return bad("open_seats are for two-player matches only (this one has " +
+               std::to_string(c.players) + " players)");
+  if (!c.open_seats.empty() && c.rejoin)
+    return bad("open_seats: a joining session (rejoin) takes a seat, it opens none");
+  for (std::size_t i = 0; i < c.open_seats.size(); ++i) {
+    const std::uint32_t p = c.open_seats[i];
+    if (p >= c.players || p == c.local_player ||
+        std::find(c.open_seats.begin(), c.open_seats.begin() + static_cast<std::ptrdiff_t>(i), p) !=
+            c.open_seats.begin() + static_cast<std::ptrdiff_t>(i))
+      return bad("open_seats: player " + std::to_string(p) +
+                 " is out of range, this machine's own, or listed twice");
+  }
   if (c.local_player >= c.players)
     return bad("local_player must be below players (" + std::to_string(c.players) + "), got " +
                std::to_string(c.local_player));
@@ -87,6 +100,10 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
   for (std::uint32_t p = 0; p < c.players; ++p)
     queues.emplace_back(c.input_size, detail::input_capacity);
   disconnect_frame.assign(c.players, never);
+  absent_from.assign(c.players, 0);
+  absent_until.assign(c.players, 0);
+  for (const std::uint32_t p : c.open_seats)
+    disconnect_frame[p] = 0;  // away from the start, until a session of theirs joins
   std::vector<RemotePlayer> remotes = c.remotes;
   std::sort(remotes.begin(), remotes.end(),
             [](const RemotePlayer& a, const RemotePlayer& b) { return a.player < b.player; });
@@ -113,7 +130,10 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
   frame_inputs.resize(std::size_t{c.players} * c.input_size);
   frame_status.resize(c.players);
   scratch_input.resize(c.input_size);
-  running = peers.empty();
+  // Nobody to wait for: no peers, or only open seats.
+  running = std::all_of(peers.begin(), peers.end(), [&](const detail::Peer& peer) {
+    return disconnect_frame[peer.player] == 0;
+  });
   detail::State& zero = state_slot(0);
   zero.frame = 0;
   zero.hash = game->save(zero.bytes);
@@ -170,7 +190,7 @@ void Session::Impl::simulate(std::uint64_t frame, bool resimulating) {
   for (std::uint32_t p = 0; p < config.players; ++p) {
     detail::InputQueue& q = queues[p];
     std::span<const std::uint8_t> input;
-    if (frame >= disconnect_frame[p]) {
+    if (gone_at(p, frame)) {
       std::fill(scratch_input.begin(), scratch_input.end(), std::uint8_t{0});
       input = scratch_input;
       frame_status[p] = InputStatus::disconnected;
@@ -233,7 +253,7 @@ void Session::Impl::emit_confirmed() {
   for (; next_emit < limit; ++next_emit) {
     const std::uint64_t frame = next_emit;
     for (std::uint32_t p = 0; p < config.players; ++p) {
-      const bool gone = frame >= disconnect_frame[p];
+      const bool gone = gone_at(p, frame);
       frame_status[p] = gone ? InputStatus::disconnected : InputStatus::confirmed;
       const auto out = frame_inputs.begin() + static_cast<std::ptrdiff_t>(p * size);
       if (gone) {

@@ -157,6 +157,16 @@ struct Session::Impl {
     return states[static_cast<std::size_t>(frame % states.size())];
   }
   void raise(Event e) { events.push_back(e); }
+  /// Whether `player` takes no part in `frame`: gone from its disconnect frame on, or away in the
+  /// interval before it joined an open seat.
+  [[nodiscard]] bool gone_at(std::uint32_t player, std::uint64_t frame) const noexcept {
+    return frame >= disconnect_frame[player] ||
+           (frame >= absent_from[player] && frame < absent_until[player]);
+  }
+  /// Whether a new session of `peer`'s player may take its seat: a two-player match still going.
+  [[nodiscard]] bool seat_takeable(const detail::Peer& peer) const noexcept {
+    return config.players == 2 && !peer.spectator && broken.empty();
+  }
   /// Whether the players other than `player` that are still in the match are a strict majority.
   [[nodiscard]] bool majority_without(std::uint32_t player) const noexcept;
   /// The match goes on after a pause (PartitionPolicy::pause) or an outage: the progress guard
@@ -194,6 +204,10 @@ struct Session::Impl {
   /// The peer answered our rechallenge from `session`: a new session takes its seat.
   void rebind(detail::Peer& peer, std::uint64_t session);
   void serve_state(detail::Peer& peer, std::uint32_t offset);
+  /// The snapshot for `peer`, taken at its first request: the state of delivered_frame() and
+  /// what comes with it. A player whose seat was open (gone, or never there) joins at the
+  /// present: its absence ends there.
+  void take_snapshot(detail::Peer& peer);
   void receive_state(detail::Peer& peer, const protocol::StateChunk& chunk);
   /// Loads the whole snapshot received from `from`; an error (and `broken`) when it is invalid.
   Status load_snapshot(detail::Peer& from);
@@ -210,8 +224,12 @@ struct Session::Impl {
 
   std::vector<detail::InputQueue> queues;       ///< one per player
   std::vector<std::uint64_t> disconnect_frame;  ///< per player; ~0: connected
-  std::vector<detail::Peer> peers;              ///< by ascending player
-  std::vector<detail::Peer> spectators;         ///< in configuration order
+  /// Per player, the frames [absent_from, absent_until) it was away before it (re)joined an open
+  /// seat: its inputs there are zero with InputStatus::disconnected (empty: never away).
+  std::vector<std::uint64_t> absent_from;
+  std::vector<std::uint64_t> absent_until;
+  std::vector<detail::Peer> peers;       ///< by ascending player
+  std::vector<detail::Peer> spectators;  ///< in configuration order
   /// Every confirmed frame as a spectator receives it and desync evidence carries it (unit_size
   /// bytes each: a mask of disconnected players, then every input). Grows with the match by
   /// 1 + players * input_size bytes per frame (7 bytes at 2 players of 3 bytes: 1.5 MB an hour).

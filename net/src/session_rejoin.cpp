@@ -15,6 +15,8 @@
 #include <algorithm>
 #include <string>
 
+#include <detsim/core/assert.hpp>
+
 #include "secure_random.hpp"
 #include "session_impl.hpp"
 #include "snapshot.hpp"
@@ -37,9 +39,7 @@ void Session::Impl::handle_rejoin_hello(detail::Peer& peer, const protocol::Pack
   send(peer, reply);
   // A hello from the session we know asks nothing more; nor does any hello once the match cannot
   // take a player back (over, broken, or the seat given up).
-  if (p.header.session == peer.remote_session || config.players != 2 || !broken.empty() ||
-      peer.disconnected || awaiting_state)
-    return;
+  if (p.header.session == peer.remote_session || !seat_takeable(peer) || awaiting_state) return;
   // One challenge outstanding, the same until answered (a flood of forged hellos cannot replace
   // the one the genuine peer is answering), resent at most once per hello interval.
   if (!peer.rechallenge) peer.rechallenge = detail::secure_random_u64();
@@ -50,11 +50,44 @@ void Session::Impl::handle_rejoin_hello(detail::Peer& peer, const protocol::Pack
 }
 
 void Session::Impl::rebind(detail::Peer& peer, std::uint64_t session) {
-  // The snapshot: the state of the oldest frame not yet delivered (final everywhere: every peer
-  // holds its inputs, no correction reaches back to it), from the input just before it on.
+  peer.remote_session = session;
+  if (protection) {  // new keys both ways, and a fresh window for the new session's sequence
+    protection->bind(peer.channel, session);
+    peer.channel.window = {};
+  }
+  peer.rejoining = true;  // served a snapshot when it asks (take_snapshot), then plays
+  peer.snapshot = {};
+  peer.knows_us = false;  // until the new session sends beyond the handshake
+  peer.last_sequence.reset();
+  peer.ping_out.reset();
+  peer.needs_ack = false;
+  peer.acked_inputs = 0;  // its first input datagram says what it holds of ours
+  peer.reported_held = std::min(peer.reported_held, next_emit);
+}
+
+void Session::Impl::take_snapshot(detail::Peer& peer) {
+  const std::uint32_t joiner = peer.player;
+  if (disconnect_frame[joiner] != detail::never) {
+    // An open seat (never taken, or given up under play_on): the player is away until the
+    // present and plays from there. Its inputs until then are zero, and stay "disconnected".
+    absent_from[joiner] = disconnect_frame[joiner];
+    absent_until[joiner] = current;
+    disconnect_frame[joiner] = detail::never;
+    detail::InputQueue& q = queues[joiner];
+    std::fill(scratch_input.begin(), scratch_input.end(), std::uint8_t{0});
+    while (q.next_confirmed() < current)
+      q.confirm(scratch_input);
+    peer.disconnected = false;
+    peer.stats.disconnected = false;
+    peer.interrupted = false;
+    std::fill(peer.reported_gone.begin(), peer.reported_gone.end(), detail::never);
+  }
+  // The state of the oldest frame not yet delivered (final everywhere: every peer holds its
+  // inputs, no correction reaches back to it), from the input just before it on.
   const std::uint64_t frame = next_emit;
   const std::uint64_t first = frame == 0 ? 0 : frame - 1;
   const detail::State& state = state_slot(frame);
+  DETSIM_ASSERT(state.frame == frame);  // the ring holds every frame not yet delivered
   detail::Snapshot snapshot;
   snapshot.frame = frame;
   snapshot.present = current;
@@ -63,31 +96,21 @@ void Session::Impl::rebind(detail::Peer& peer, std::uint64_t session) {
     const detail::InputQueue& q = queues[p];
     detail::SnapshotPlayer& player = snapshot.players.emplace_back();
     player.disconnect = disconnect_frame[p];
+    player.absent_from = absent_from[p];
+    player.absent_until = absent_until[p];
     player.first = first;
     for (std::uint64_t f = first; f < q.next_confirmed(); ++f) {
-      if (!q.holds(f)) return;  // cannot happen (the queues span the window); keep the seat
-      const std::span<const std::uint8_t> input = q.confirmed(f);
+      // The queues span every frame not yet delivered (input_capacity); a frame they no longer
+      // hold would be a session bug: its input goes as zero rather than out of another frame.
+      const std::span<const std::uint8_t> input =
+          q.holds(f) ? q.confirmed(f) : std::span<const std::uint8_t>(scratch_input);
       player.inputs.insert(player.inputs.end(), input.begin(), input.end());
     }
   }
-  if (state.frame != frame) return;  // likewise: the ring holds every frame not yet delivered
   snapshot.log = frame_log;
   snapshot.state = state.bytes;
-
-  peer.remote_session = session;
-  if (protection) {  // new keys both ways, and a fresh window for the new session's sequence
-    protection->bind(peer.channel, session);
-    peer.channel.window = {};
-  }
   peer.snapshot = detail::encode_snapshot(snapshot);
-  peer.rejoining = true;
   ++stats.snapshots_served;
-  peer.knows_us = false;  // until the new session sends beyond the handshake
-  peer.last_sequence.reset();
-  peer.ping_out.reset();
-  peer.needs_ack = false;
-  peer.acked_inputs = 0;  // its first input datagram says what it holds of ours
-  peer.reported_held = std::min(peer.reported_held, frame);
   // Hash checks start over after the snapshot's frame on both sides (load_snapshot does the
   // same): the new session compares nothing before it, and took this machine's state there.
   const std::uint64_t interval = config.check_interval;
@@ -95,11 +118,13 @@ void Session::Impl::rebind(detail::Peer& peer, std::uint64_t session) {
   peer.checks_through = through;
   peer.acked_checks = through;
   peer.pending_checks.clear();
-  raise(Event{EventType::rejoined, peer.player, frame, 0, 0, {}});
+  peer.reported_held = std::min(peer.reported_held, frame);
+  raise(Event{EventType::rejoined, joiner, frame, 0, 0, {}});
   retire_checks();
 }
 
 void Session::Impl::serve_state(detail::Peer& peer, std::uint32_t offset) {
+  if (peer.snapshot.empty()) take_snapshot(peer);
   const std::vector<std::uint8_t>& bytes = peer.snapshot;
   if (offset >= bytes.size()) return;  // it has everything (its inputs are on their way)
   protocol::Packet p;
@@ -183,6 +208,8 @@ Status Session::Impl::load_snapshot(detail::Peer& from) {
     for (std::size_t at = 0; at < player.inputs.size(); at += size)
       q.confirm(std::span<const std::uint8_t>(player.inputs).subspan(at, size));
     disconnect_frame[p] = player.disconnect;
+    absent_from[p] = player.absent_from;
+    absent_until[p] = player.absent_until;
   }
   // The peer holds our inputs up to here; the restart lost the rest, which are zeros up to the
   // peer's present (the first input of this session goes after them).

@@ -43,7 +43,9 @@ void Session::Impl::receive_all() {
   transport->receive(inbox);
   for (const Datagram& d : inbox) {
     detail::Peer* peer = peer_by_id(d.from);
-    if (peer == nullptr || peer->disconnected) {
+    // A gone player's datagrams are dropped, but for the handshake of a new session of it that
+    // may take its seat again (session_rejoin.cpp; handle() lets nothing else through).
+    if (peer == nullptr || (peer->disconnected && !seat_takeable(*peer))) {
       ++stats.dropped_wrong_session;
       continue;
     }
@@ -110,6 +112,11 @@ void Session::Impl::reject(detail::Peer& peer, std::string_view reason) {
 
 void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
   using protocol::PacketType;
+  if (peer.disconnected && !peer.rejoining && p.header.type != PacketType::hello &&
+      p.header.type != PacketType::hello_reply) {
+    ++stats.dropped_wrong_session;  // the session that was taken as gone stays gone
+    return;
+  }
   if (p.header.type == PacketType::hello) {
     // Answered, never believed: a hello proves nothing about who sent it (its source address can
     // be spoofed), so it is not a sign of life either.
@@ -204,8 +211,11 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
     peer.synchronized = true;
     peer.stats.synchronized = true;
     raise(Event{EventType::synchronized, peer.player, current, 0, 0, {}});
-    // A rejoining session runs once the snapshot is loaded (load_snapshot), not before.
-    if (!peer.spectator && !awaiting_state &&
+    // A rejoining session runs once the snapshot is loaded (load_snapshot), not before; one
+    // that joins an open seat here asks for it, and the match was running already.
+    if (!peer.spectator && disconnect_frame[peer.player] != detail::never && seat_takeable(peer))
+      peer.rejoining = true;
+    if (!peer.spectator && !awaiting_state && !running &&
         std::all_of(peers.begin(), peers.end(),
                     [](const detail::Peer& x) { return x.synchronized; })) {
       running = true;
@@ -288,7 +298,10 @@ bool Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& 
     peer.advantage_x16 = smooth_signed(peer.advantage_x16, ahead);
   }
 
-  if (peer.rejoining) {  // the rejoined session has the snapshot: it plays from here
+  if (peer.rejoining) {
+    // The rejoined session has the snapshot: it plays from here. One that never asked for it
+    // (a session without SessionConfig::rejoin in an open seat) is not let in.
+    if (peer.snapshot.empty()) return true;
     peer.rejoining = false;
     peer.snapshot = {};
   }

@@ -59,6 +59,8 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot& s) {
   put(payload, s.input_size, 1);
   for (const SnapshotPlayer& p : s.players) {
     put(payload, p.disconnect, 8);
+    put(payload, p.absent_from, 8);
+    put(payload, p.absent_until, 8);
     put(payload, p.first, 8);
     put(payload, s.input_size == 0 ? 0 : p.inputs.size() / s.input_size, 4);
     payload.insert(payload.end(), p.inputs.begin(), p.inputs.end());
@@ -154,8 +156,13 @@ Expected<Snapshot> decode_snapshot(std::span<const std::uint8_t> bytes, std::uin
     SnapshotPlayer& player = s.players[p];
     std::uint64_t count = 0;
     std::span<const std::uint8_t> inputs;
-    if (!in.get(player.disconnect, 8) || !in.get(player.first, 8) || !in.get(count, 4))
+    if (!in.get(player.disconnect, 8) || !in.get(player.absent_from, 8) ||
+        !in.get(player.absent_until, 8) || !in.get(player.first, 8) || !in.get(count, 4))
       return bad("truncated at player " + std::to_string(p));
+    if (player.absent_from > player.absent_until || player.absent_until > s.present)
+      return bad("player " + std::to_string(p) + "'s absence " +
+                 std::to_string(player.absent_from) + " .. " + std::to_string(player.absent_until) +
+                 " is not an interval before the present");
     if (player.first != first)
       return bad("player " + std::to_string(p) + "'s inputs start at frame " +
                  std::to_string(player.first) + ", not " + std::to_string(first));

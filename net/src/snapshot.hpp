@@ -6,7 +6,8 @@
 //     envelope  magic "DSNP" | compression u8 (0: none, 1: zstd) | size u64 (of the payload
 //               uncompressed) | payload
 //     payload   frame u64 | present u64 | players u8 | input_size u8 |
-//               per player: disconnect u64 (~0: connected) | first u64 | count u32 |
+//               per player: disconnect u64 (~0: connected) | absent_from u64 |
+//                           absent_until u64 | first u64 | count u32 |
 //                           count * input_size bytes (the inputs of frames first ..) |
 //               log_size u64 | log bytes (every confirmed frame before `frame`, as a session's
 //                              frame log holds them: 1 + players * input_size bytes each) |
@@ -30,8 +31,10 @@ inline constexpr std::size_t max_snapshot_payload = std::size_t{256} << 20;
 
 struct SnapshotPlayer {
   std::uint64_t disconnect = ~std::uint64_t{0};  ///< the player's disconnect frame, or ~0
-  std::uint64_t first = 0;                       ///< the frame of inputs[0]
-  std::vector<std::uint8_t> inputs;              ///< whole inputs from `first` on
+  std::uint64_t absent_from = 0;     ///< the frames it was away before joining an open seat
+  std::uint64_t absent_until = 0;    ///< (empty when from == until)
+  std::uint64_t first = 0;           ///< the frame of inputs[0]
+  std::vector<std::uint8_t> inputs;  ///< whole inputs from `first` on
 };
 
 struct Snapshot {

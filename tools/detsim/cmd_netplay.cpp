@@ -167,6 +167,9 @@ Status Netplay::start() {
   config.match_key = plan_.match_key;
   config.partition = plan_.partition;
   config.rejoin = args_.rejoin;
+  if (args_.open_seat)
+    for (const net::UdpPeer& p : plan_.peers)
+      config.open_seats.push_back(p.id);
   config.frame_us =
       args_.fps == 0 ? 1000 : std::clamp<std::uint32_t>(1'000'000 / args_.fps, 1000, 1'000'000);
   for (const net::UdpPeer& p : plan_.peers)
@@ -324,6 +327,7 @@ void Netplay::advance() {
 bool Netplay::peers_at_end() const {
   for (const net::UdpPeer& p : plan_.peers) {
     const auto stats = session_->peer_stats(p.id);
+    if (args_.open_seat && stats && !stats->synchronized) continue;  // nobody took the seat
     if (!stats || stats->remote_frame < args_.frames) return false;
   }
   return true;
@@ -337,6 +341,7 @@ std::string Netplay::checks_behind() const {
   for (const net::UdpPeer& p : plan_.peers) {
     const auto stats = session_->peer_stats(p.id);
     if (!stats || stats->disconnected || stats->checks_received_through >= last) continue;
+    if (args_.open_seat && !stats->synchronized) continue;  // an open seat nobody took
     if (!out.empty()) out += ", ";
     out += who(p.id) + " (checks of frames " + std::to_string(stats->checks_received_through + 1) +
            " .. " + std::to_string(last) + ")";
@@ -385,7 +390,10 @@ int Netplay::run() {
       std::to_string(args_.input_delay) + ", " + std::to_string(args_.frames) + " frames");
   say(protection_line(plan_));
   for (const net::UdpPeer& p : plan_.peers)
-    say("waiting for player " + std::to_string(p.id) + " at " + p.endpoint.to_string());
+    say(args_.open_seat
+            ? "player " + std::to_string(p.id) + "'s seat is open: it may join at " +
+                  p.endpoint.to_string() + " at any time (--join)"
+            : "waiting for player " + std::to_string(p.id) + " at " + p.endpoint.to_string());
   for (std::size_t k = 0; k < plan_.spectators.size(); ++k)
     say("serving " + who(args_.players + static_cast<std::uint32_t>(k)));
 

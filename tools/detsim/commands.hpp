@@ -126,7 +126,8 @@ struct NetplayArgs {
   std::string key;       ///< --key: the match key, 64 hex digits; or empty
   std::string key_file;  ///< --key-file: a file holding it (64 hex digits, or 32 raw bytes)
   std::string partition = "end";  ///< --partition: end, pause or play-on
-  bool rejoin = false;            ///< --rejoin: take this player's seat again (a restart)
+  bool rejoin = false;            ///< --rejoin/--join: take this player's seat (again)
+  bool open_seat = false;         ///< --open-seat: start without the other player
 };
 int netplay_command(const NetplayArgs& args);
 

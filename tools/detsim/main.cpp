@@ -94,6 +94,7 @@ A player waits for its connected spectators to have every frame before it exits 
 If a player's process stops, it can be started again with the same arguments plus --rejoin: the
 other player sends the match's state (compressed) and the inputs since, and the match goes on; the
 frames the restart missed take no input from the rejoining player. Both end with the same hash.
+A player may also start alone with --open-seat; the other joins whenever it starts, with --join.
 
 Exit status: 0 the match completed; 1 a desync (the frame, both hashes and the player are
 printed; --desync-report writes this machine's side for bisection) or an unverified frame (a
@@ -189,11 +190,17 @@ void add_netplay(CLI::App& app, int& exit_code) {
                 "exit 2), pause (wait for the player to come back or --rejoin, however long) "
                 "or play-on (go on alone: the match splits); default end")
       ->type_name("POLICY");
-  c->add_flag("--rejoin", netplay.rejoin,
-              "Take this player's seat again in a match under way, after this machine's "
-              "process stopped: the other player sends the match's state and this one "
-              "re-simulates to the present (two players; the other must still hold the seat: "
-              "within 5 s of the stop, or --partition pause)");
+  c->add_flag("--rejoin,--join", netplay.rejoin,
+              "Take this player's seat in a match under way: again, after this machine's "
+              "process stopped, or for the first time when the other player runs --open-seat. "
+              "The other player sends the match's state and this one re-simulates to the "
+              "present (two players; a seat still held — within 5 s of the stop, or --partition "
+              "pause — continues where the peer's copy of this player's inputs ends; an open "
+              "seat, or one given up under --partition play-on, is taken from the present)");
+  c->add_flag("--open-seat", netplay.open_seat,
+              "Start without the other player: its seat is open (its input zero) until it "
+              "joins with --join, which it may do at any time; a match nobody joins ends "
+              "normally (two players)");
   add_inject_option(c, netplay.injections);
   c->add_option("--desync-report", netplay.desync_report,
                 "On a desync, write this machine's side to FILE: the inputs up to the divergent "

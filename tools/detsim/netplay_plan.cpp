@@ -41,6 +41,12 @@ Status check_role(const NetplayArgs& a) {
       return Status::error("--me " + std::to_string(a.me) + " must be below --players " +
                            std::to_string(a.players) + " (players are numbered 0 .. " +
                            std::to_string(a.players - 1) + ")");
+    if (a.open_seat && a.players != 2)
+      return Status::error("--open-seat works in two-player matches only (--players " +
+                           std::to_string(a.players) + ")");
+    if (a.open_seat && a.rejoin)
+      return Status::error(
+          "--open-seat and --rejoin: the player that opens a seat waits for the one that joins");
     if (a.rejoin && a.players != 2)
       return Status::error("--rejoin works in two-player matches only (--players " +
                            std::to_string(a.players) + ")");
@@ -60,6 +66,8 @@ Status check_role(const NetplayArgs& a) {
     return Status::error("--me cannot be combined with --spectate: a spectator plays no player");
   if (a.rejoin)
     return Status::error("--rejoin cannot be combined with --spectate: a spectator holds no seat");
+  if (a.open_seat)
+    return Status::error("--open-seat cannot be combined with --spectate: a spectator has no seat");
   if (!a.spectators.empty())
     return Status::error(
         "--spectator cannot be combined with --spectate: only players serve spectators");

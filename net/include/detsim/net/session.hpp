@@ -108,8 +108,14 @@ struct SessionConfig {
   /// which the session loads, re-simulating to the peer's present; advance_frame() reports
   /// Advance::synchronizing until then, and Event::rejoined says it is done. The peer must still
   /// hold the seat (within disconnect_timeout_us of the old session's last word, or paused).
-  /// Two-player matches only, for now.
+  /// The same session joins an open seat (open_seats on the other side, or a player the other
+  /// side took as gone under PartitionPolicy::play_on): its inputs count from the peer's present
+  /// on, and were zero (InputStatus::disconnected) before. Two-player matches only, for now.
   bool rejoin = false;
+  /// Players whose seat is open at the start: the match runs without them, their inputs zero
+  /// (InputStatus::disconnected), until a session of theirs joins with `rejoin` — a late joiner,
+  /// or a spectator turned player. Two-player matches only, for now.
+  std::vector<std::uint32_t> open_seats;
   std::vector<RemotePlayer> remotes;  ///< every other player, each exactly once
   /// Spectators this machine serves (at most 16; ids distinct from the remotes'): each receives
   /// every confirmed frame's inputs from here (SpectatorSession). Events about spectator k use
@@ -150,9 +156,9 @@ enum class EventType : std::uint8_t {
   /// would have no majority (`reason`: "no majority"). Event::resumed or Event::rejoined for that
   /// player says it goes on. `frame`: delivered_frame() then.
   paused,
-  /// A restarted process took `player`'s seat again (SessionConfig::rejoin) from a snapshot of
-  /// state frame `frame`: on the rejoining machine `player` is its own, on the others the one
-  /// that came back.
+  /// A restarted process took `player`'s seat again, or a late joiner an open seat
+  /// (SessionConfig::rejoin), from a snapshot of state frame `frame`: on the joining machine
+  /// `player` is its own, on the others the one that came.
   rejoined,
 };
 
