@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # The cross-architecture determinism matrix (part of the README's test command; docs/MATRIX.md).
 #
-# Each leg builds the detsim command for one CPU, compiler and optimisation level, then runs
+# Each leg builds the detsim command (and the example game's pushball-tool) for one CPU, compiler
+# and optimisation level, then runs
 #   detsim golden check --dir golden          (every golden scenario's hashes, and the golden replays)
 #   detsim verify golden/replays/*.dsr        (each golden replay, frame by frame)
+#   pushball-tool verify golden/games/*.dsr   (a game's own input bytes and state section)
 # natively or under qemu-user. Every leg must reproduce the same golden/ data, bit for bit.
 #
 # Usage: scripts/matrix.sh [--list] [--ci] [--budget SECONDS] [LEG ...] [LEG=BUILD_DIR ...]
@@ -107,6 +109,8 @@ done
 for name in "${!prebuilt[@]}"; do
   [ -x "${prebuilt[$name]}/tools/detsim" ] ||
     { echo "matrix: leg $name: no detsim in ${prebuilt[$name]}/tools" >&2; exit 2; }
+  [ -x "${prebuilt[$name]}/examples/pushball/pushball-tool" ] ||
+    { echo "matrix: leg $name: no pushball-tool in ${prebuilt[$name]}/examples/pushball" >&2; exit 2; }
 done
 
 # The selected legs' cross compilers (Debian's g++-12-<triplet>) and qemu-user, if missing.
@@ -142,23 +146,33 @@ build_leg() {
   case " $flags " in *" -march=native "*) build_flags="$flags -Wno-error=uninitialized -Wno-error=maybe-uninitialized" ;; esac
   cmake -S "$root" -B "$dir" -G Ninja "-DCMAKE_CXX_COMPILER=$cxx" -DCMAKE_BUILD_TYPE=Release \
     "-DCMAKE_CXX_FLAGS_RELEASE=$build_flags" "${cross[@]}" \
-    -DDETSIM_BUILD_TESTS=OFF -DDETSIM_INSTALL=OFF -DDETSIM_WITH_MPFR=OFF -DDETSIM_WERROR=ON \
+    -DDETSIM_BUILD_TESTS=OFF -DDETSIM_BUILD_EXAMPLES=ON -DDETSIM_INSTALL=OFF \
+    -DDETSIM_WITH_MPFR=OFF -DDETSIM_WERROR=ON \
     -DDETSIM_HEADER_ONLY_DEPS=ON -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=0 \
     -DDETSIM_CLI_PARSER_OPTIONS=-O0 >"$dir.log" 2>&1 &&
-    cmake --build "$dir" -j "$jobs" --target detsim >>"$dir.log" 2>&1
+    cmake --build "$dir" -j "$jobs" --target detsim pushball-tool >>"$dir.log" 2>&1
 }
 
-# check_leg EMULATOR BINARY: the golden check and the golden replays' verification. A cross binary
-# that this machine runs itself (i686 on an x86-64 kernel with 32-bit support) runs natively, on a
-# real CPU of its architecture and far faster than emulated; any other goes to its emulator.
+# check_leg EMULATOR BUILD_DIR: the golden check and the golden replays' verification, and the
+# example games' golden replays through their own tools (a game's own input bytes and game state
+# section). A cross binary that this machine runs itself (i686 on an x86-64 kernel with 32-bit
+# support) runs natively, on a real CPU of its architecture and far faster than emulated; any
+# other goes to its emulator.
 check_leg() {
-  local emu=$1 bin=$2 run=("$2")
-  if [ -n "$emu" ] && ! "$bin" --version >/dev/null 2>&1; then run=("$emu" "$bin"); fi
+  local emu=$1 dir=$2 bin=$2/tools/detsim game=$2/examples/pushball/pushball-tool
+  local run=("$bin") run_game=("$game")
+  if [ -n "$emu" ] && ! "$bin" --version >/dev/null 2>&1; then
+    run=("$emu" "$bin")
+    run_game=("$emu" "$game")
+  fi
   echo "running: ${run[*]}"
   "${run[@]}" golden check --dir "$root/golden" || return
   local replay
   for replay in "$root"/golden/replays/*.dsr; do
     "${run[@]}" verify "$replay" || return
+  done
+  for replay in "$root"/golden/games/pushball*.dsr; do
+    "${run_game[@]}" verify "$replay" || return
   done
 }
 
@@ -186,7 +200,7 @@ for name in "${selected[@]}"; do
     fi
   fi
   built=$SECONDS
-  if output=$(check_leg "$emu" "$dir/tools/detsim" 2>&1); then
+  if output=$(check_leg "$emu" "$dir" 2>&1); then
     echo "$output"
     results+=("$name|ok|$((built - start))|$((SECONDS - built))")
     ((SECONDS - start > longest)) && longest=$((SECONDS - start))

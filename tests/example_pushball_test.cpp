@@ -114,6 +114,17 @@ TEST(ExamplePushball, ADashIsAnImpulseOfEightNewtonSecondsThenWaitsOutItsCooldow
 
 // ---- the tools, through pushball-tool ----
 
+TEST(ExamplePushball, ItsGoldenReplayVerifiesFrameByFrame) {
+  // golden/games/pushball.dsr: what every leg of the determinism matrix reproduces too.
+  const std::string golden = std::string(DETSIM_SOURCE_DIR) + "/golden/games/pushball.dsr";
+  const test::CliResult verify = tool("verify " + golden + " --json");
+  EXPECT_EQ(verify.exit_code, 0) << verify.out << verify.err;
+  EXPECT_EQ(json_value(verify.out, "ok"), "true");
+  EXPECT_EQ(json_value(verify.out, "frames"), "600");
+  const test::CliResult info = tool("info " + golden + " --json");
+  EXPECT_EQ(json_value(info.out, "input_size"), "5") << info.out;
+}
+
 TEST(ExamplePushball, ItsToolRecordsVerifiesAndSyncTestsItsRuns) {
   TempFile replay("pushball.dsr");
   const test::CliResult scenarios = tool("scenarios --json");
