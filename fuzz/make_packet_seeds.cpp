@@ -94,6 +94,15 @@ int main(int argc, char** argv) {
   seeds.push_back({"ping", p, 4});
   p.header.type = protocol::PacketType::pong;
   seeds.push_back({"pong", p, 4});
+  p.header.type = protocol::PacketType::state_request;
+  p.state_request.offset = 16 * 1024;
+  seeds.push_back({"state_request", p, 4});
+  p.header.type = protocol::PacketType::state_chunk;
+  p.state_chunk.total = 40'000;
+  p.state_chunk.offset = 16 * 1024;
+  for (std::size_t i = 0; i < protocol::max_state_chunk; ++i)
+    p.state_chunk.data.push_back(static_cast<std::uint8_t>(i * 13 + 5));
+  seeds.push_back({"state_chunk", p, 4});
 
   struct InputSeed {
     std::size_t input_size;

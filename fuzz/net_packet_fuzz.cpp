@@ -12,7 +12,7 @@
 // decoder accepts frame varints only in their shortest form), equal it byte for byte for every
 // type but input (whose tokens the decoder accepts in any split), and encode again to itself.
 //
-// Bit 1 set, the sealed framing (protocol version 5), with a fixed match key:
+// Bit 1 set, the sealed framing (protocol version 5 and later), with a fixed match key:
 // - bit 0 clear: as a sealed datagram, through what a session does on receipt (header, replay
 //   window, tag; protection.hpp): the rejection paths, and the window's bookkeeping for the
 //   seeds' own sealed bytes, which open;
@@ -64,6 +64,12 @@ bool same(const protocol::Packet& a, const protocol::Packet& b) {
     case protocol::PacketType::ping:
     case protocol::PacketType::pong:
       return a.ping.time_us == b.ping.time_us;
+    case protocol::PacketType::state_request:
+      return a.state_request.offset == b.state_request.offset;
+    case protocol::PacketType::state_chunk:
+      return a.state_chunk.total == b.state_chunk.total &&
+             a.state_chunk.offset == b.state_chunk.offset &&
+             a.state_chunk.data == b.state_chunk.data;
   }
   return false;
 }

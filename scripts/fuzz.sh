@@ -5,6 +5,8 @@
 #           short replays), findings build-fuzz/findings
 #   packet  fuzz/net_packet_fuzz.cpp, the session wire protocol decoder: corpus
 #           build-fuzz/corpus-packet (seeded with valid datagrams), findings build-fuzz/findings-packet
+#   snapshot  fuzz/net_snapshot_fuzz.cpp, the rejoin snapshot decoder (net/src/snapshot.hpp):
+#           corpus build-fuzz/corpus-snapshot (seeded with valid snapshots, compressed and not)
 #   state   fuzz/state_restore_fuzz.cpp, World::restore (refusals change nothing, accepted bytes are
 #           canonical and step): corpus build-fuzz/corpus-state (seeded with saved scenario states)
 #   api     fuzz/world_api_fuzz.cpp, the World's API over hostile definitions and call sequences
@@ -20,9 +22,10 @@ build="${DETSIM_FUZZ_BUILD:-build-fuzz}"
 case "$target" in
   replay) fuzzer=replay_reader_fuzz seeds=make_seeds suffix="" max_len=65536 ;;
   packet) fuzzer=net_packet_fuzz seeds=make_packet_seeds suffix=-packet max_len=1300 ;;
+  snapshot) fuzzer=net_snapshot_fuzz seeds=make_snapshot_seeds suffix=-snapshot max_len=65536 ;;
   state) fuzzer=state_restore_fuzz seeds=make_state_seeds suffix=-state max_len=16384 ;;
   api) fuzzer=world_api_fuzz seeds="" suffix=-api max_len=4096 ;;
-  *) echo "usage: scripts/fuzz.sh [SECONDS] [replay|packet|state|api]" >&2; exit 2 ;;
+  *) echo "usage: scripts/fuzz.sh [SECONDS] [replay|packet|snapshot|state|api]" >&2; exit 2 ;;
 esac
 flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
 cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \

@@ -51,7 +51,7 @@ Status bad(const std::string& what) {
 
 }  // namespace
 
-std::vector<std::uint8_t> encode_snapshot(const Snapshot& s) {
+std::vector<std::uint8_t> encode_snapshot(const Snapshot& s, bool compress) {
   std::vector<std::uint8_t> payload;
   put(payload, s.frame, 8);
   put(payload, s.present, 8);
@@ -72,6 +72,12 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot& s) {
 
   std::vector<std::uint8_t> out(magic, magic + 4);
 #if DETSIM_WITH_ZSTD
+  if (!compress) {
+    out.push_back(uncompressed);
+    put(out, payload.size(), 8);
+    out.insert(out.end(), payload.begin(), payload.end());
+    return out;
+  }
   out.push_back(zstd_compressed);
   put(out, payload.size(), 8);
   const std::size_t bound = ZSTD_compressBound(payload.size());
@@ -92,6 +98,8 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot& s) {
     return out;
   }
   out.resize(4);  // out of memory, or a zstd error: send it uncompressed then
+#else
+  (void)compress;
 #endif
   out.push_back(uncompressed);
   put(out, payload.size(), 8);

@@ -46,8 +46,9 @@ struct Snapshot {
   std::vector<std::uint8_t> state;
 };
 
-/// The snapshot's bytes (zstd-compressed where the build has zstd).
-[[nodiscard]] std::vector<std::uint8_t> encode_snapshot(const Snapshot& snapshot);
+/// The snapshot's bytes: zstd-compressed where the build has zstd and `compress` says so.
+[[nodiscard]] std::vector<std::uint8_t> encode_snapshot(const Snapshot& snapshot,
+                                                        bool compress = true);
 
 /// The snapshot in `bytes`, checked against a session of `players` players with inputs of
 /// `input_size` bytes holding `capacity` inputs per player; errors say which field is wrong.
