@@ -27,6 +27,7 @@ using test::Process;
 using test::Relay;
 using test::RelayedPair;
 using test::run_through_relay;
+using test::wait_for_both;
 const char* const test_key = test::netplay_test_key;
 
 TEST(CliNetplay, AKilledPlayerRestartedWithRejoinFinishesTheMatchWithTheSameHash) {
@@ -60,15 +61,8 @@ TEST(CliNetplay, AKilledPlayerRestartedWithRejoinFinishesTheMatchWithTheSameHash
     std::vector<std::string> again = b;
     again.push_back("--rejoin");
     Process rejoiner(again, "rejoin_b2");
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(90);
-    bool done_a = false;
-    bool done_b = false;
-    while (!(done_a && done_b) && std::chrono::steady_clock::now() < deadline) {
-      done_a = done_a || stayer.poll();
-      done_b = done_b || rejoiner.poll();
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    ASSERT_TRUE(done_a && done_b) << stayer.err() << rejoiner.err();
+    ASSERT_TRUE(wait_for_both(stayer, rejoiner, std::chrono::seconds(90)))
+        << stayer.err() << rejoiner.err();
     ASSERT_EQ(stayer.exit_code(), 0) << stayer.out() << stayer.err();
     ASSERT_EQ(rejoiner.exit_code(), 0) << rejoiner.out() << rejoiner.err();
     EXPECT_TRUE(has(stayer.err(), "rejoined at frame")) << stayer.err();
@@ -101,16 +95,9 @@ TEST(CliNetplay, APlayerJoinsAnOpenSeatLateAndBothFinishWithTheSameHash) {
     Process joiner({"netplay", "--players", "2", "--frames", "600", "--me", "1", "--bot", "32",
                     "--join", "--bind", endpoint(port_b), "--peer", "0=" + endpoint(port_a)},
                    "open_b");
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    bool done_a = false;
-    bool done_b = false;
-    while (!(done_a && done_b) && std::chrono::steady_clock::now() < deadline) {
-      done_a = done_a || host.poll();
-      done_b = done_b || joiner.poll();
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
+    const bool both = wait_for_both(host, joiner, std::chrono::seconds(60));
     if (bind_failed(joiner)) continue;
-    ASSERT_TRUE(done_a && done_b) << host.err() << joiner.err();
+    ASSERT_TRUE(both) << host.err() << joiner.err();
     EXPECT_EQ(host.exit_code(), 0) << host.out() << host.err();
     EXPECT_EQ(joiner.exit_code(), 0) << joiner.out() << joiner.err();
     EXPECT_TRUE(has(host.out(), "seat is open")) << host.out();

@@ -64,14 +64,16 @@ ScenarioDefinition tally() {
   return d;
 }
 
-/// Registered once per process (the registry never forgets).
+/// Registers `definition` unless a scenario of its name is known (the registry never forgets,
+/// and tests of one process share it).
+void ensure_registered(const ScenarioDefinition& definition) {
+  if (find_scenario(definition.name) != nullptr) return;
+  const Status s = register_scenario(definition);
+  EXPECT_TRUE(s.ok()) << s.message();
+}
+
 void ensure_tally() {
-  static const bool registered = [] {
-    const Status s = register_scenario(tally());
-    EXPECT_TRUE(s.ok()) << s.message();
-    return true;
-  }();
-  (void)registered;
+  ensure_registered(tally());
 }
 
 std::uint32_t presses(const World& w, std::uint32_t player) {
@@ -205,12 +207,7 @@ ScenarioDefinition dial() {
 }
 
 void ensure_dial() {
-  static const bool registered = [] {
-    const Status s = register_scenario(dial());
-    EXPECT_TRUE(s.ok()) << s.message();
-    return true;
-  }();
-  (void)registered;
+  ensure_registered(dial());
 }
 
 std::int32_t dial_total(const World& w, std::uint32_t player) {

@@ -273,4 +273,17 @@ inline std::string final_hash_of(const std::string& out) {
   return at == std::string::npos ? "" : out.substr(at + 11, 16);
 }
 
+/// Polls `a` and `b` until both exited or `limit` passed; true when both exited.
+inline bool wait_for_both(Process& a, Process& b, std::chrono::seconds limit) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  bool done_a = false;
+  bool done_b = false;
+  while (!(done_a && done_b) && std::chrono::steady_clock::now() < deadline) {
+    done_a = done_a || a.poll();
+    done_b = done_b || b.poll();
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return done_a && done_b;
+}
+
 }  // namespace detsim::test
