@@ -124,6 +124,10 @@ int main(int argc, char** argv) {
     for (std::size_t c = 0; c < s.checks; ++c)
       q.input.checks.push_back(
           {static_cast<std::uint32_t>(60 + 10 * c), 0x9E3779B97F4A7C15ULL * c});
+    if (s.checks >= 2) {  // a player gone, and one taken back after an absence
+      q.input.gone = {{1, 95}};
+      q.input.back = {{2, 80, 99}};
+    }
     seeds.push_back(
         {"input_" + std::to_string(s.input_size) + "x" + std::to_string(s.count), q, s.input_size});
   }

@@ -60,7 +60,7 @@ bool same(const protocol::Packet& a, const protocol::Packet& b) {
              a.input.advantage == b.input.advantage && a.input.start_frame == b.input.start_frame &&
              a.input.count == b.input.count && a.input.deltas == b.input.deltas &&
              a.input.checks == b.input.checks && a.input.held_frame == b.input.held_frame &&
-             a.input.gone == b.input.gone;
+             a.input.gone == b.input.gone && a.input.back == b.input.back;
     case protocol::PacketType::ping:
     case protocol::PacketType::pong:
       return a.ping.time_us == b.ping.time_us;

@@ -1,5 +1,6 @@
 // Netplay matches that survive, between real processes over UDP on 127.0.0.1: a player killed
-// and started again with --rejoin, a late player joining an --open-seat, and an 8-second outage
+// and started again with --rejoin (of two, and of three), a late player joining an --open-seat,
+// and an 8-second outage
 // under --partition pause. Each ends with the same final hash on both processes. The same on the
 // simulated network, with every field checked: net_rejoin_test.cpp.
 #include <chrono>
@@ -73,6 +74,69 @@ TEST(CliNetplay, AKilledPlayerRestartedWithRejoinFinishesTheMatchWithTheSameHash
     const std::string hash = final_hash_of(stayer.out());
     EXPECT_EQ(hash.size(), 16U) << stayer.out();
     EXPECT_EQ(final_hash_of(rejoiner.out()), hash) << stayer.out() << rejoiner.out();
+    return;
+  }
+  FAIL() << "no free ports after 6 attempts";
+}
+
+TEST(CliNetplay, AKilledPlayerOfThreeRestartedWithRejoinFinishesWithEveryoneOnOneHash) {
+  // Three processes, sealed; player 2's is killed 4 s in and started again a second later with
+  // --rejoin. Players 0 and 1 take its old process as gone from one agreed frame, one of them
+  // serves the snapshot and both take player 2 back at the same frame: all three end on one
+  // final hash, with every hash check compared.
+  if (!net::protection::available()) GTEST_SKIP() << "built without libsodium: no --key";
+  for (int attempt = 0; attempt < 6; ++attempt) {
+    const std::uint16_t base = port_for(attempt + 60);
+    std::vector<std::vector<std::string>> args(3);
+    for (std::uint32_t p = 0; p < 3; ++p) {
+      args[p] = {"netplay",
+                 "--players",
+                 "3",
+                 "--frames",
+                 "900",
+                 "--key",
+                 test_key,
+                 "--me",
+                 std::to_string(p),
+                 "--bot",
+                 std::to_string(31 + p),
+                 "--bind",
+                 endpoint(static_cast<std::uint16_t>(base + p))};
+      for (std::uint32_t q = 0; q < 3; ++q)
+        if (q != p)
+          args[p].insert(
+              args[p].end(),
+              {"--peer", std::to_string(q) + "=" + endpoint(static_cast<std::uint16_t>(base + q))});
+    }
+    Process zero(args[0], "rejoin3_a");
+    Process one(args[1], "rejoin3_b");
+    auto first = std::make_unique<Process>(args[2], "rejoin3_c1");
+    std::this_thread::sleep_for(std::chrono::seconds(4));
+    if (zero.poll() || one.poll() || first->poll()) {
+      if (bind_failed(zero) || bind_failed(one) || bind_failed(*first)) continue;  // other ports
+      FAIL() << "a process ended early: " << zero.err() << one.err() << first->err();
+    }
+    first->kill();
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    std::vector<std::string> again = args[2];
+    again.push_back("--rejoin");
+    Process rejoiner(again, "rejoin3_c2");
+    ASSERT_TRUE(wait_for_both(zero, rejoiner, std::chrono::seconds(90)))
+        << zero.err() << rejoiner.err();
+    ASSERT_TRUE(wait_for_both(one, rejoiner, std::chrono::seconds(30))) << one.err();
+    for (const Process* p : {&zero, &one, &rejoiner}) {
+      ASSERT_EQ(p->exit_code(), 0) << p->out() << p->err();
+      EXPECT_TRUE(has(p->out(), "desyncs      0")) << p->out();
+      EXPECT_FALSE(has(p->err(), "UNVERIFIED")) << p->err();
+    }
+    EXPECT_TRUE(has(zero.err(), "rejoined at frame")) << zero.err();
+    EXPECT_TRUE(has(one.err(), "rejoined at frame")) << one.err();
+    EXPECT_TRUE(has(rejoiner.out(), "rejoined the match at frame")) << rejoiner.out();
+    EXPECT_TRUE(has(rejoiner.out(), "frames       900,")) << rejoiner.out();
+    const std::string hash = final_hash_of(zero.out());
+    EXPECT_EQ(hash.size(), 16U) << zero.out();
+    EXPECT_EQ(final_hash_of(one.out()), hash) << one.out();
+    EXPECT_EQ(final_hash_of(rejoiner.out()), hash) << zero.out() << rejoiner.out();
     return;
   }
   FAIL() << "no free ports after 6 attempts";

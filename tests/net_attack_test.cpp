@@ -23,40 +23,10 @@ using net::protocol::Packet;
 using net::protocol::PacketType;
 using test::Match;
 using test::MatchOptions;
+using test::Tamper;
+using test::tamper;
 
 constexpr std::uint32_t input_size = 4;  // CounterGame's
-
-/// A peer's transport that rewrites what it sends: `edit(to, packet, n)` sees the n-th decoded
-/// datagram to `to` and may change it (or return false to drop it). Datagrams it cannot decode
-/// pass unchanged.
-class Tamper final : public net::Transport {
- public:
-  using Edit = std::function<bool(net::PeerId to, Packet& packet, std::uint64_t n)>;
-  Tamper(net::Transport& inner, Edit edit) : inner_(inner), edit_(std::move(edit)) {}
-  void send(net::PeerId to, std::span<const std::uint8_t> bytes) override {
-    Packet p;
-    if (net::protocol::decode(bytes, input_size, p) != net::protocol::DecodeError::none) {
-      inner_.send(to, bytes);
-      return;
-    }
-    if (!edit_(to, p, count_++)) return;
-    std::vector<std::uint8_t> out;
-    if (net::protocol::encode(p, input_size, out)) inner_.send(to, out);
-  }
-  void receive(std::vector<net::Datagram>& out) override { inner_.receive(out); }
-
- private:
-  net::Transport& inner_;
-  Edit edit_;
-  std::uint64_t count_ = 0;
-};
-
-MatchOptions::Wrap tamper(std::uint32_t who, Tamper::Edit edit) {
-  return [who, edit](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
-    if (p != who) return nullptr;
-    return std::make_unique<Tamper>(inner, edit);
-  };
-}
 
 const net::Event* find(const test::PeerRecord& r, EventType type) {
   for (const net::Event& e : r.events)

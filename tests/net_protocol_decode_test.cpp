@@ -311,6 +311,38 @@ TEST(NetProtocolDecode, GoneReportsAreBoundedAndNamePlayersBelowEight) {
   EXPECT_FALSE(encode(many, 4, out));
 }
 
+TEST(NetProtocolDecode, BackReportsShareTheCountByteAndAreBounded) {
+  // The list byte: gone count in the low nibble, back count in the high one; each back report
+  // is a player and two frames relative to ack_frame (10 here).
+  const auto crafted = [](const Bytes& lists) {
+    Writer w;
+    w.header(3, 1, 2).varint(10).frame(20, 10).frame(30, 10).u8(0).frame(40, 10).u8(0);
+    w.frame(10, 10).raw(lists).u8(0);
+    return w.sealed();
+  };
+  Packet p;
+  // One gone report (player 1 from 9), two back reports: player 2 over [10, 15), 5 over [9, 9).
+  ASSERT_EQ(decode(crafted({0x21, 1, 1, 2, 0, 10, 5, 1, 1}), 4, p), DecodeError::none);
+  ASSERT_EQ(p.input.gone.size(), 1U);
+  EXPECT_EQ(p.input.gone[0], (GoneReport{1, 9}));
+  ASSERT_EQ(p.input.back.size(), 2U);
+  EXPECT_EQ(p.input.back[0], (BackReport{2, 10, 15}));
+  EXPECT_EQ(p.input.back[1], (BackReport{5, 9, 9}));
+  EXPECT_EQ(decode(crafted({0x10, 8, 0, 0}), 4, p), DecodeError::bad_field);  // player 8
+  Bytes nine = {0x90};
+  for (std::uint8_t player = 0; player < 9; ++player)
+    nine.insert(nine.end(), {static_cast<std::uint8_t>(player % 8), 0, 0});
+  EXPECT_EQ(decode(crafted(nine), 4, p), DecodeError::bad_field);           // 9 back reports
+  EXPECT_EQ(decode(crafted({0x10, 2, 0}), 4, p), DecodeError::bad_length);  // `until` missing
+  EXPECT_EQ(decode(crafted({0xF0}), 4, p), DecodeError::bad_field);         // 15 back reports
+  Packet many = input_packet(0, {});
+  many.input.back.assign(max_gone_reports + 1, BackReport{1, 11, 12});
+  Bytes out;
+  EXPECT_FALSE(encode(many, 4, out));
+  many.input.back.assign(1, BackReport{8, 11, 12});
+  EXPECT_FALSE(encode(many, 4, out));
+}
+
 TEST(NetProtocolDecode, NonCanonicalTokensAreAcceptedAndReencodeCanonically) {
   // The decoder accepts any tokens that produce exactly count * input_size bytes: a literal token
   // covering zeros, or a zero run split in two. encode() then writes the canonical tokens, so the

@@ -130,15 +130,20 @@ TEST(NetProtocolRoundTrip, FullInputAtMaximum) {
   p.header = {PacketType::input, max_u64, 0xFFFF};
   p.input.ack_frame = p.input.check_ack = p.input.current_frame = p.input.start_frame =
       p.input.held_frame = max_u32;
-  for (std::uint8_t player = 0; player < max_gone_reports; ++player)
+  for (std::uint8_t player = 0; player < max_gone_reports; ++player) {
     p.input.gone.push_back({player, max_u32 - player});
+    p.input.back.push_back({player, max_u32 - 2U * player, max_u32 - player});
+  }
   p.input.advantage = std::numeric_limits<std::int8_t>::max();
   expect_round_trip(p, 1, input_bytes(p, literal_tokens(p.input.deltas)));
   far_frames(p);
   const Bytes expected = input_bytes(p, literal_tokens(p.input.deltas));
+  // Both lists full: 8 gone reports (player, frame) and 8 back reports (player, from, until).
   EXPECT_EQ(expected.size(), header_size + 4 * max_varint_size + 2 + 255 + 2 + 1 +
                                  max_checks_per_packet * (max_varint_size + 8) + max_varint_size +
-                                 1 + max_gone_reports * (1 + max_varint_size) + trailer_size);
+                                 1 + max_gone_reports * (1 + max_varint_size) +
+                                 max_gone_reports * (1 + 2 * max_varint_size) + trailer_size);
+  EXPECT_LE(expected.size(), max_datagram);
   expect_round_trip(p, 1, expected);
 }
 

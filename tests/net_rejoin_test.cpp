@@ -347,34 +347,6 @@ TEST(NetRejoin, UnderPlayOnARestartedPlayerComesBackToTheSeatItLost) {
     ASSERT_EQ(before.hashes[f], m.record(0).hashes[f]) << "frame " << f;
 }
 
-/// Alters every snapshot slice peer 1 receives (the plain framing: a peer on the path).
-class SnapshotCorrupter final : public net::Transport {
- public:
-  explicit SnapshotCorrupter(net::Transport& inner) : inner_(inner) {}
-  void send(net::PeerId to, std::span<const std::uint8_t> bytes) override {
-    inner_.send(to, bytes);
-  }
-  void receive(std::vector<net::Datagram>& out) override {
-    const std::size_t from = out.size();
-    inner_.receive(out);
-    for (std::size_t i = from; i < out.size(); ++i) {
-      net::protocol::Packet p;
-      if (net::protocol::decode(out[i].bytes, 4, p) != net::protocol::DecodeError::none ||
-          p.header.type != net::protocol::PacketType::state_chunk)
-        continue;
-      p.state_chunk.data[p.state_chunk.data.size() / 2] ^= 0x40U;
-      std::vector<std::uint8_t> bytes;
-      ASSERT_TRUE(net::protocol::encode(p, 4, bytes));
-      out[i].bytes = std::move(bytes);
-      ++altered;
-    }
-  }
-  std::size_t altered = 0;
-
- private:
-  net::Transport& inner_;
-};
-
 TEST(NetRejoin, AnAlteredSnapshotIsRefusedWithAReasonAndLoadsNothing) {
   MatchOptions o;
   o.match_key.reset();
@@ -384,17 +356,19 @@ TEST(NetRejoin, AnAlteredSnapshotIsRefusedWithAReasonAndLoadsNothing) {
   o.restart_peer = 1;
   o.restart_tick = 300;
   o.rejoin_tick = 360;
-  SnapshotCorrupter* corrupter = nullptr;
-  o.wrap = [&corrupter](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
-    if (p != 1) return nullptr;
-    auto t = std::make_unique<SnapshotCorrupter>(inner);
-    corrupter = t.get();
-    return t;
-  };
+  // Every snapshot slice peer 0 sends is altered on the way (the plain framing: a peer on the
+  // path).
+  std::uint64_t altered = 0;
+  o.wrap = test::tamper(0, [&altered](net::PeerId, net::protocol::Packet& p, std::uint64_t) {
+    if (p.header.type == net::protocol::PacketType::state_chunk) {
+      p.state_chunk.data[p.state_chunk.data.size() / 2] ^= 0x40U;
+      ++altered;
+    }
+    return true;
+  });
   Match m(o);
   EXPECT_FALSE(m.run());
-  ASSERT_NE(corrupter, nullptr);
-  EXPECT_GT(corrupter->altered, 0U);
+  EXPECT_GT(altered, 0U);
   const net::Event* end = nullptr;
   for (const net::Event& e : m.record(1).events)
     if (e.type == EventType::match_ended) end = &e;

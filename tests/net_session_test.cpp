@@ -75,9 +75,9 @@ TEST(NetSession, RejectsInvalidConfigsNamingTheField) {
             std::string::npos);
   EXPECT_NE(error_of([](net::SessionConfig& c) {
               c.rejoin = true;
-              c.players = 3;
-              c.remotes = {{1, 1}, {2, 2}};
-            }).find("rejoin is for two-player matches only (this one has 3 players)"),
+              c.players = 1;
+              c.remotes = {};
+            }).find("rejoin needs a match of two or more players (this one has 1)"),
             std::string::npos);
   EXPECT_NE(error_of([](net::SessionConfig& c) {
               c.rejoin = true;
@@ -87,8 +87,8 @@ TEST(NetSession, RejectsInvalidConfigsNamingTheField) {
   EXPECT_NE(error_of([](net::SessionConfig& c) {
               c.players = 3;
               c.remotes = {{1, 1}, {2, 2}};
-              c.open_seats = {2};
-            }).find("open_seats are for two-player matches only"),
+              c.open_seats = {3};
+            }).find("open_seats: player 3 is out of range, this machine's own, or listed twice"),
             std::string::npos);
   EXPECT_NE(error_of([](net::SessionConfig& c) {
               c.open_seats = {0};

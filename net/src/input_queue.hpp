@@ -51,6 +51,13 @@ class InputQueue {
     next_confirmed_ = frame;
   }
 
+  /// Forgets the confirmed inputs from `frame` on (a player taken back into a match after an
+  /// absence: what its earlier session sent beyond the agreed disconnect frame never counted).
+  /// No-op when the queue holds none from `frame`.
+  void truncate(std::uint64_t frame) noexcept {
+    next_confirmed_ = std::min(next_confirmed_, frame);
+  }
+
   /// Appends the confirmed input of frame next_confirmed().
   void confirm(std::span<const std::uint8_t> input) noexcept {
     std::copy(input.begin(), input.end(),

@@ -161,8 +161,11 @@ bool body_ok(const Packet& p, std::size_t input_size) {
   const InputBody& b = p.input;
   return b.deltas.size() == std::size_t{b.count} * input_size &&
          b.checks.size() <= max_checks_per_packet && b.gone.size() <= max_gone_reports &&
+         b.back.size() <= max_gone_reports &&
          std::all_of(b.gone.begin(), b.gone.end(),
-                     [](const GoneReport& g) { return g.player < max_gone_reports; });
+                     [](const GoneReport& g) { return g.player < max_gone_reports; }) &&
+         std::all_of(b.back.begin(), b.back.end(),
+                     [](const BackReport& r) { return r.player < max_gone_reports; });
 }
 
 }  // namespace
@@ -215,10 +218,15 @@ void put_body(const Packet& packet, std::vector<std::uint8_t>& out) {
       put_frame(out, b.start_frame, b.ack_frame);
       out.push_back(b.count);
       put_frame(out, b.held_frame, b.ack_frame);
-      out.push_back(static_cast<std::uint8_t>(b.gone.size()));
+      out.push_back(static_cast<std::uint8_t>(b.gone.size() | b.back.size() << 4));
       for (const GoneReport& g : b.gone) {
         out.push_back(g.player);
         put_frame(out, g.frame, b.ack_frame);
+      }
+      for (const BackReport& r : b.back) {
+        out.push_back(r.player);
+        put_frame(out, r.from, b.ack_frame);
+        put_frame(out, r.until, b.ack_frame);
       }
       run_length_encode(b.deltas, out);
       out.push_back(static_cast<std::uint8_t>(b.checks.size()));
@@ -278,14 +286,23 @@ DecodeError get_body(Reader& in, PacketType type, std::size_t input_size, Packet
       b.start_frame = in.frame(b.ack_frame, bad);
       b.count = in.u8();
       b.held_frame = in.frame(b.ack_frame, bad);
-      const std::uint8_t gone = in.u8();
+      const std::uint8_t lists = in.u8();
+      const std::size_t gone = lists & 0x0FU;
+      const std::size_t back = lists >> 4U;
       if (!in.ok()) return DecodeError::bad_length;
-      if (bad || gone > max_gone_reports) return DecodeError::bad_field;
+      if (bad || gone > max_gone_reports || back > max_gone_reports) return DecodeError::bad_field;
       b.gone.resize(gone);
       for (GoneReport& g : b.gone) {
         g.player = in.u8();
         g.frame = in.frame(b.ack_frame, bad);
         if (g.player >= max_gone_reports) bad = true;
+      }
+      b.back.resize(back);
+      for (BackReport& r : b.back) {
+        r.player = in.u8();
+        r.from = in.frame(b.ack_frame, bad);
+        r.until = in.frame(b.ack_frame, bad);
+        if (r.player >= max_gone_reports) bad = true;
       }
       if (!in.ok()) return DecodeError::bad_length;
       if (bad) return DecodeError::bad_field;

@@ -29,14 +29,10 @@ Status validate(const SessionConfig& c) {
       c.partition != PartitionPolicy::pause)
     return bad("partition must be end_match, play_on or pause, got " +
                std::to_string(static_cast<unsigned>(c.partition)));
-  if (c.rejoin && c.players != 2)
-    return bad("rejoin is for two-player matches only (this one has " + std::to_string(c.players) +
-               " players)");
+  if (c.rejoin && c.players < 2)
+    return bad("rejoin needs a match of two or more players (this one has 1)");
   if (c.rejoin && !c.spectators.empty())
     return bad("a rejoining session serves no spectators (they followed the earlier one)");
-  if (!c.open_seats.empty() && c.players != 2)
-    return bad("open_seats are for two-player matches only (this one has " +
-               std::to_string(c.players) + " players)");
   if (!c.open_seats.empty() && c.rejoin)
     return bad("open_seats: a joining session (rejoin) takes a seat, it opens none");
   for (std::size_t i = 0; i < c.open_seats.size(); ++i) {
@@ -143,7 +139,7 @@ Session::Impl::Impl(const SessionConfig& c, Game& g, Transport& t)
 
 bool Session::Impl::gone_final(std::uint32_t player) const noexcept {
   for (const detail::Peer& peer : peers) {
-    if (!peer.synchronized || peer.disconnected) continue;
+    if (!seated(peer)) continue;
     if (peer.reported_gone[player] != disconnect_frame[player]) return false;
   }
   return true;
@@ -165,7 +161,7 @@ std::uint64_t Session::Impl::emit_limit() const noexcept {
   std::uint64_t limit =
       std::min({confirmed_frame(), current, first_incorrect.value_or(detail::never)});
   for (const detail::Peer& peer : peers)
-    if (peer.synchronized && !peer.disconnected) limit = std::min(limit, peer.reported_held);
+    if (seated(peer)) limit = std::min(limit, peer.reported_held);
   return limit;
 }
 
@@ -191,8 +187,11 @@ void Session::Impl::simulate(std::uint64_t frame, bool resimulating) {
     detail::InputQueue& q = queues[p];
     std::span<const std::uint8_t> input;
     if (gone_at(p, frame)) {
-      std::fill(scratch_input.begin(), scratch_input.end(), std::uint8_t{0});
-      input = scratch_input;
+      // Zero, and recorded as what the frame used: an input that arrives for it after the
+      // player is taken back (session_rejoin.cpp) is compared with what was simulated.
+      const std::span<std::uint8_t> used = q.used_mut(frame);
+      std::fill(used.begin(), used.end(), std::uint8_t{0});
+      input = used;
       frame_status[p] = InputStatus::disconnected;
     } else if (frame < q.next_confirmed()) {
       input = q.confirmed(frame);
@@ -288,7 +287,7 @@ void Session::Impl::add_local_check(std::uint64_t frame, std::uint64_t hash,
   if (local_checks.size() >= detail::max_pending_checks) {
     // A peer whose check of the dropped frame has not arrived can no longer be compared with it.
     for (detail::Peer& peer : peers)
-      if (!peer.disconnected && peer.checks_through < local_checks.front().frame)
+      if (seated(peer) && peer.checks_through < local_checks.front().frame)
         check_missing(peer, local_checks.front().frame);
     local_checks.pop_front();
   }
@@ -333,7 +332,7 @@ void Session::Impl::check_missing(detail::Peer& peer, std::uint64_t frame) {
 
 void Session::Impl::check_deadlines() {
   for (detail::Peer& peer : peers) {
-    if (!peer.synchronized || peer.disconnected || peer.check_missing) continue;
+    if (!seated(peer) || peer.check_missing) continue;
     // Checks arrive in frame order: the first local check beyond what arrived is the one due.
     for (const detail::LocalCheck& c : local_checks) {
       if (c.frame <= peer.checks_through) continue;
@@ -348,7 +347,7 @@ void Session::Impl::retire_checks() {
     const std::uint64_t frame = local_checks.front().frame;
     bool everyone = true;
     for (const detail::Peer& peer : peers) {
-      if (peer.disconnected) continue;
+      if (!seated(peer)) continue;
       // Kept until the peer's hash was compared with it here AND the peer acknowledged ours:
       // retiring it earlier would leave a slower peer without our hash for the frame (its
       // checks arrive in order, so it would then never compare another).

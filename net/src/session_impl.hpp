@@ -86,6 +86,12 @@ struct Peer {
   std::optional<std::uint64_t> last_rechallenge_us;
   std::vector<std::uint8_t> snapshot;
   bool rejoining = false;
+  /// Three or more players: a back report took the player back before a new session of it was
+  /// bound here. Until one is (rebind), the old session's datagrams are dropped.
+  bool returning = false;
+  /// On a rejoining machine, three or more players: this peer has not yet taken us back (no back
+  /// report of ours from it yet), so what it says it holds of ours is about the old session.
+  bool awaiting_back = false;
   bool needs_ack = false;  ///< received data since the last packet we sent
   std::uint16_t send_sequence = 0;
   std::optional<std::uint16_t> last_sequence;
@@ -163,9 +169,17 @@ struct Session::Impl {
     return frame >= disconnect_frame[player] ||
            (frame >= absent_from[player] && frame < absent_until[player]);
   }
-  /// Whether a new session of `peer`'s player may take its seat: a two-player match still going.
+  /// Whether a new session of `peer`'s player may take its seat: a match still going.
   [[nodiscard]] bool seat_takeable(const detail::Peer& peer) const noexcept {
-    return config.players == 2 && !peer.spectator && broken.empty();
+    return !peer.spectator && broken.empty();
+  }
+  /// A match of three or more players: a return goes through a disconnect, then a back report.
+  [[nodiscard]] bool shared() const noexcept { return config.players > 2; }
+  /// Whether `peer` has a say in what is final (disconnect frames, emission, hash checks): in
+  /// step with us, and not a new session that has not been given the match yet.
+  [[nodiscard]] bool seated(const detail::Peer& peer) const noexcept {
+    return peer.synchronized && !peer.disconnected && !peer.returning &&
+           !(peer.rejoining && peer.snapshot.empty());
   }
   /// Whether the players other than `player` that are still in the match are a strict majority.
   [[nodiscard]] bool majority_without(std::uint32_t player) const noexcept;
@@ -209,6 +223,18 @@ struct Session::Impl {
   /// present: its absence ends there.
   void take_snapshot(detail::Peer& peer);
   void receive_state(detail::Peer& peer, const protocol::StateChunk& chunk);
+  /// Whether `peer`'s snapshot may be taken now: in a match of three or more, once every peer
+  /// agrees on the frame its old session is gone from (a return starts from there).
+  [[nodiscard]] bool snapshot_ready(const detail::Peer& peer) const noexcept;
+  /// Takes `player` back into the match: away over [from, until), its inputs from `until` on to
+  /// come from its new session. What its old session sent from `from` on is forgotten.
+  void readmit(std::uint32_t player, std::uint64_t from, std::uint64_t until);
+  /// A back report from `peer` (which plays with us): about this machine's own player, it says
+  /// the peer took us back; about another, the player is readmitted here at the same frame.
+  void take_back(detail::Peer& peer, const protocol::BackReport& report);
+  /// The peer a rejoining session asks for the snapshot: the lowest-numbered player that
+  /// answered (chosen once); nullptr until one did.
+  [[nodiscard]] detail::Peer* snapshot_server() noexcept;
   /// Loads the whole snapshot received from `from`; an error (and `broken`) when it is invalid.
   Status load_snapshot(detail::Peer& from);
   void request_state();
@@ -262,6 +288,11 @@ struct Session::Impl {
   std::vector<std::uint8_t> incoming;
   std::uint32_t incoming_total = 0;
   std::optional<std::uint64_t> last_request_us;
+  std::optional<std::size_t>
+      server_index;  ///< index in `peers` of the snapshot's server, once asked
+  /// The highest held frame this machine ever told a peer: a player taken back returns no
+  /// earlier, so no peer can have delivered a frame with it gone that it plays in.
+  std::uint64_t max_held_sent = 0;
   /// PartitionPolicy::pause: Event::paused was raised and no silent player came back yet.
   bool paused = false;
   std::uint64_t agreed_frame = 0;

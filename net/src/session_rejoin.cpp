@@ -12,6 +12,23 @@
 // to the stayer's present with zeros (the restart lost them), re-simulates to the present and
 // plays on. The stayer re-simulates those frames when the zeros arrive, as after any
 // misprediction: both sides end on the same frames, the hash checks compare them again.
+//
+// With three or more players, several machines hold the seat, each with its own share of the old
+// session's inputs, so a return cannot simply pick up where one of them stands. It goes through
+// the absence path instead, which is also how a late joiner takes an open seat:
+//   1. Each peer that binds the new session takes the old one as gone from its own holdings (a
+//      peer that does not hear from it times it out); the gone reports converge on one frame D,
+//      the lowest any peer holds, as for any disconnect.
+//   2. The peer the joiner asks (the lowest-numbered one that answered) waits until every peer
+//      reports D, then picks R: no earlier than its present, D + 1, and every held frame it ever
+//      reported, so no peer can have delivered a frame from R on (a peer's delivery waits for
+//      every peer's held frame). It readmits the player — away over [D, R), playing from R — and
+//      snapshots the match.
+//   3. Every input datagram carries a back report (player, D, R) for every player that came
+//      back. A peer that takes the player as gone from D readmits it at R too, re-simulating
+//      from R if it is past it; the joiner's own datagrams carry it as well. Until a peer has,
+//      it says it still takes the player as gone from D, and its held frame counts for nothing
+//      from R on; the joiner ignores what it acknowledges until its back report arrives.
 #include <algorithm>
 #include <string>
 
@@ -50,12 +67,22 @@ void Session::Impl::handle_rejoin_hello(detail::Peer& peer, const protocol::Pack
 }
 
 void Session::Impl::rebind(detail::Peer& peer, std::uint64_t session) {
+  if (peer.returning) {
+    // A back report took the player back already (readmit): the new session plays at once.
+    peer.returning = false;
+    peer.rejoining = false;
+  } else {
+    peer.rejoining = true;  // served a snapshot when it asks (take_snapshot), then plays
+    // Three or more players: the old session is gone from what this machine holds of it, and
+    // the player returns through the absence path (the file comment).
+    if (shared() && disconnect_frame[peer.player] == detail::never) disconnect(peer, "rejoining");
+  }
   peer.remote_session = session;
-  if (protection) {  // new keys both ways, and a fresh window for the new session's sequence
+  peer.answered = true;  // our rechallenge, answered, binds it as the first challenge would
+  if (protection) {      // new keys both ways, and a fresh window for the new session's sequence
     protection->bind(peer.channel, session);
     peer.channel.window = {};
   }
-  peer.rejoining = true;  // served a snapshot when it asks (take_snapshot), then plays
   peer.snapshot = {};
   peer.knows_us = false;  // until the new session sends beyond the handshake
   peer.last_sequence.reset();
@@ -65,22 +92,83 @@ void Session::Impl::rebind(detail::Peer& peer, std::uint64_t session) {
   peer.reported_held = std::min(peer.reported_held, next_emit);
 }
 
-void Session::Impl::take_snapshot(detail::Peer& peer) {
-  const std::uint32_t joiner = peer.player;
-  if (disconnect_frame[joiner] != detail::never) {
-    // An open seat (never taken, or given up under play_on): the player is away until the
-    // present and plays from there. Its inputs until then are zero, and stay "disconnected".
-    absent_from[joiner] = disconnect_frame[joiner];
-    absent_until[joiner] = current;
-    disconnect_frame[joiner] = detail::never;
-    detail::InputQueue& q = queues[joiner];
-    std::fill(scratch_input.begin(), scratch_input.end(), std::uint8_t{0});
-    while (q.next_confirmed() < current)
-      q.confirm(scratch_input);
+bool Session::Impl::snapshot_ready(const detail::Peer& peer) const noexcept {
+  if (!shared()) return true;
+  return disconnect_frame[peer.player] != detail::never && gone_final(peer.player);
+}
+
+void Session::Impl::readmit(std::uint32_t player, std::uint64_t from, std::uint64_t until) {
+  absent_from[player] = from;
+  absent_until[player] = until;
+  disconnect_frame[player] = detail::never;
+  detail::InputQueue& q = queues[player];
+  q.truncate(from);
+  std::fill(scratch_input.begin(), scratch_input.end(), std::uint8_t{0});
+  while (q.next_confirmed() < until)
+    q.confirm(scratch_input);
+  const std::uint64_t interval = config.check_interval;
+  for (detail::Peer& peer : peers) {
+    peer.reported_gone[player] = detail::never;  // reports about the absence are old news
+    if (peer.player != player) continue;
+    std::fill(peer.reported_gone.begin(), peer.reported_gone.end(), detail::never);
     peer.disconnected = false;
     peer.stats.disconnected = false;
     peer.interrupted = false;
-    std::fill(peer.reported_gone.begin(), peer.reported_gone.end(), detail::never);
+    peer.last_receive_us = now_us;  // its timeout counts from its return
+    // Hash checks start over from the return (the snapshot's server moves them to its frame).
+    peer.checks_through = interval == 0 ? 0 : until / interval * interval;
+    peer.acked_checks = peer.checks_through;
+    peer.pending_checks.clear();
+    peer.desynced = false;
+    peer.check_missing = false;
+  }
+  // Frames from `until` on were simulated with the player gone: it plays in them now.
+  if (until < current) first_incorrect = std::min(first_incorrect.value_or(until), until);
+}
+
+void Session::Impl::take_back(detail::Peer& peer, const protocol::BackReport& r) {
+  const std::uint32_t player = r.player;
+  if (player >= config.players) {
+    ++stats.ignored_back_reports;
+    return;
+  }
+  if (player == config.local_player) {  // the peer took this machine back: it speaks of us now
+    if (peer.awaiting_back && r.from == absent_from[player] && r.until == absent_until[player])
+      peer.awaiting_back = false;
+    return;
+  }
+  // Nothing to do about a player that is with us, nor about an absence that is over.
+  if (disconnect_frame[player] == detail::never || r.until <= absent_until[player]) return;
+  // The return must start where every peer took the player as gone, and at a frame this machine
+  // has not delivered yet and can hold: else it cannot be taken as the others take it.
+  if (disconnect_frame[player] != r.from || r.until <= r.from || r.until < next_emit ||
+      r.until > window_start() + detail::input_capacity) {
+    ++stats.ignored_back_reports;
+    return;
+  }
+  readmit(player, r.from, r.until);
+  for (detail::Peer& returning : peers) {
+    if (returning.player != player) continue;
+    if (returning.rejoining) {
+      returning.rejoining = false;  // its new session is bound: it plays from `until`
+      returning.snapshot = {};
+    } else {
+      returning.returning = true;  // the old session is bound: the next handshake replaces it
+      returning.knows_us = true;   // so that a new session's hello is met with a rechallenge
+    }
+  }
+  raise(Event{EventType::rejoined, player, r.until, 0, 0, {}});
+}
+
+void Session::Impl::take_snapshot(detail::Peer& peer) {
+  const std::uint32_t joiner = peer.player;
+  if (disconnect_frame[joiner] != detail::never) {
+    // An open seat (never taken, or given up): the player is away from where every peer took it
+    // as gone to R, and plays from there. R is no earlier than the present, nor than any held
+    // frame this machine ever reported (the file comment says why).
+    const std::uint64_t from = disconnect_frame[joiner];
+    const std::uint64_t until = std::max({from + 1, current, max_held_sent, confirmed_frame()});
+    readmit(joiner, from, until);
   }
   // The state of the oldest frame not yet delivered (final everywhere: every peer holds its
   // inputs, no correction reaches back to it), from the input just before it on.
@@ -90,7 +178,7 @@ void Session::Impl::take_snapshot(detail::Peer& peer) {
   DETSIM_ASSERT(state.frame == frame);  // the ring holds every frame not yet delivered
   detail::Snapshot snapshot;
   snapshot.frame = frame;
-  snapshot.present = current;
+  snapshot.present = std::max(current, absent_until[joiner]);  // the joiner plays from R on
   snapshot.input_size = config.input_size;
   for (std::uint32_t p = 0; p < config.players; ++p) {
     const detail::InputQueue& q = queues[p];
@@ -124,7 +212,10 @@ void Session::Impl::take_snapshot(detail::Peer& peer) {
 }
 
 void Session::Impl::serve_state(detail::Peer& peer, std::uint32_t offset) {
-  if (peer.snapshot.empty()) take_snapshot(peer);
+  if (peer.snapshot.empty()) {
+    if (!snapshot_ready(peer)) return;  // the joiner asks again
+    take_snapshot(peer);
+  }
   const std::vector<std::uint8_t>& bytes = peer.snapshot;
   if (offset >= bytes.size()) return;  // it has everything (its inputs are on their way)
   protocol::Packet p;
@@ -142,9 +233,19 @@ void Session::Impl::serve_state(detail::Peer& peer, std::uint32_t offset) {
   }
 }
 
+detail::Peer* Session::Impl::snapshot_server() noexcept {
+  if (!server_index) {
+    for (std::size_t i = 0; i < peers.size() && !server_index; ++i)
+      if (peers[i].synchronized) server_index = i;
+    if (!server_index) return nullptr;
+  }
+  return &peers[*server_index];
+}
+
 void Session::Impl::request_state() {
-  detail::Peer& server = peers.front();  // two-player matches: the other player
-  if (!server.synchronized || !broken.empty()) return;
+  detail::Peer* chosen = snapshot_server();
+  if (chosen == nullptr || !broken.empty()) return;
+  detail::Peer& server = *chosen;
   // Asked again when what was asked for arrived (receive_state), or after two round trips (or
   // two frames) without it: lost slices are asked for anew from the first missing byte.
   const std::uint64_t wait = std::max<std::uint64_t>(2 * config.frame_us, server.rtt_x16 / 8);
@@ -157,7 +258,7 @@ void Session::Impl::request_state() {
 }
 
 void Session::Impl::receive_state(detail::Peer& peer, const protocol::StateChunk& chunk) {
-  if (!awaiting_state || &peer != &peers.front()) {
+  if (!awaiting_state || !server_index || &peer != &peers[*server_index]) {
     ++stats.dropped_implausible;  // nobody asked this machine's session for a snapshot
     return;
   }
@@ -190,6 +291,12 @@ Status Session::Impl::load_snapshot(detail::Peer& from) {
                          " sent is invalid (" + decoded.status().message() +
                          "); start this player again to retry");
   const detail::Snapshot& s = *decoded;
+  const detail::SnapshotPlayer& own = s.players[config.local_player];
+  if (shared() && (own.disconnect != detail::never || own.absent_until == 0))
+    return Status::error("rejoin: the snapshot player " + std::to_string(from.player) +
+                         " sent does not take this player back (a match of " +
+                         std::to_string(config.players) +
+                         " players returns it from an agreed frame); start this player again");
 
   game->load(s.state);
   current = s.frame;
@@ -224,6 +331,21 @@ Status Session::Impl::load_snapshot(detail::Peer& from) {
   from.acked_checks = through;
   from.pending_checks.clear();
   from.reported_held = s.frame;
+  // The other peers take this player back at R when the server's back report (or ours)
+  // reaches them; what they acknowledge counts from then, and their hash checks from R on.
+  const std::uint64_t back = absent_until[config.local_player];
+  const std::uint64_t back_through = interval == 0 ? 0 : back / interval * interval;
+  for (detail::Peer& peer : peers) {
+    // A player gone in the snapshot is an open seat to this session (never synchronized, so it
+    // has no say): a new session of it may still join, through any peer.
+    if (&peer == &from || !shared() || disconnect_frame[peer.player] != detail::never) continue;
+    peer.awaiting_back = true;
+    peer.acked_inputs = back;
+    peer.checks_through = back_through;
+    peer.acked_checks = back_through;
+    peer.pending_checks.clear();
+    peer.reported_held = s.frame;
+  }
 
   awaiting_state = false;
   running = true;

@@ -112,9 +112,10 @@ void Session::Impl::reject(detail::Peer& peer, std::string_view reason) {
 
 void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
   using protocol::PacketType;
-  if (peer.disconnected && !peer.rejoining && p.header.type != PacketType::hello &&
-      p.header.type != PacketType::hello_reply) {
-    ++stats.dropped_wrong_session;  // the session that was taken as gone stays gone
+  if (((peer.disconnected && !peer.rejoining) || peer.returning) &&
+      p.header.type != PacketType::hello && p.header.type != PacketType::hello_reply) {
+    // The session that was taken as gone stays gone; so does one whose player came back.
+    ++stats.dropped_wrong_session;
     return;
   }
   if (p.header.type == PacketType::hello) {
@@ -210,14 +211,17 @@ void Session::Impl::handle(detail::Peer& peer, const protocol::Packet& p) {
   if (!peer.synchronized && peer.answered) {
     peer.synchronized = true;
     peer.stats.synchronized = true;
+    peer.returning = false;  // a player taken back plays with the session this handshake bound
     raise(Event{EventType::synchronized, peer.player, current, 0, 0, {}});
     // A rejoining session runs once the snapshot is loaded (load_snapshot), not before; one
     // that joins an open seat here asks for it, and the match was running already.
     if (!peer.spectator && disconnect_frame[peer.player] != detail::never && seat_takeable(peer))
       peer.rejoining = true;
+    // An open seat is not waited for.
     if (!peer.spectator && !awaiting_state && !running &&
-        std::all_of(peers.begin(), peers.end(),
-                    [](const detail::Peer& x) { return x.synchronized; })) {
+        std::all_of(peers.begin(), peers.end(), [&](const detail::Peer& x) {
+          return x.synchronized || disconnect_frame[x.player] != detail::never;
+        })) {
       running = true;
       window_start_us = now_us;  // the progress guard counts from here
       raise(Event{EventType::running, 0, current, 0, 0, {}});
@@ -279,14 +283,22 @@ bool Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& 
     peer.stats.remote_frame = b.current_frame;
     return true;
   }
+  // Nothing is taken before this rejoining session has the match (load_snapshot).
+  if (awaiting_state) return true;
   // Every field is checked before any is used: an implausible datagram changes nothing.
   if (fresh && !plausible(peer, b)) return false;
+  // Back reports first (session_rejoin.cpp): one may say the peer took this machine back, so
+  // that what it acknowledges below is about this session; a new session that has not been
+  // given the match yet speaks for itself only.
+  for (const protocol::BackReport& r : b.back)
+    if (seated(peer) || r.player == peer.player) take_back(peer, r);
   const detail::InputQueue& mine = queues[config.local_player];
-  // Acknowledgements never move backwards, nor beyond what was sent.
-  if (b.ack_frame <= mine.next_confirmed())
+  // Acknowledgements never move backwards, nor beyond what was sent. From a peer that has not
+  // taken this rejoined machine back yet, they are about its old session: not ours.
+  if (b.ack_frame <= mine.next_confirmed() && !peer.awaiting_back)
     peer.acked_inputs = std::max<std::uint64_t>(peer.acked_inputs, b.ack_frame);
   const std::uint64_t last_check = local_checks.empty() ? agreed_frame : local_checks.back().frame;
-  if (b.check_ack <= std::max(last_check, peer.acked_checks))
+  if (b.check_ack <= std::max(last_check, peer.acked_checks) && !peer.awaiting_back)
     peer.acked_checks = std::max<std::uint64_t>(peer.acked_checks, b.check_ack);
   if (fresh) {  // time sync from the newest datagram only: a late one's frames are out of date
     peer.remote_frame = b.current_frame;
@@ -326,6 +338,7 @@ bool Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& 
   }
   if (!b.checks.empty()) peer.needs_ack = true;
   for (const protocol::HashCheck& c : b.checks) {
+    if (peer.awaiting_back) break;  // compared from the frame it takes us back at
     if (config.check_interval == 0 || c.frame == 0 || c.frame % config.check_interval != 0) {
       ++stats.dropped_out_of_window;
       break;
@@ -340,12 +353,22 @@ bool Session::Impl::handle_input(detail::Peer& peer, const protocol::InputBody& 
   retire_checks();
   // Disconnect agreement, with the peers this machine still plays with only.
   if (peer.disconnected) return true;
-  if (fresh) peer.reported_held = b.held_frame;  // a late datagram's may be out of date
+  if (fresh && !peer.awaiting_back) {  // a late datagram's may be out of date
+    // A peer that still takes a player as gone from before that player's return holds none of
+    // its inputs from the return on, whatever frame it says it holds.
+    std::uint64_t held = b.held_frame;
+    for (const protocol::GoneReport& g : b.gone)
+      if (g.player < config.players && g.frame < absent_until[g.player])
+        held = std::min(held, absent_until[g.player]);
+    peer.reported_held = held;
+  }
   for (const protocol::GoneReport& g : b.gone) {
     if (g.player >= config.players) {
       ++stats.dropped_out_of_window;
       continue;
     }
+    // About an absence that is over (the player came back after it): old news.
+    if (g.frame < absent_until[g.player]) continue;
     // Corroborated disconnects: a report about this machine's own player, or about a player it
     // still hears from (the sender itself included), is not believed. One peer alone cannot
     // remove a player the others still play with; a peer this machine no longer hears either is
@@ -386,7 +409,9 @@ void Session::Impl::send_inputs(detail::Peer& peer) {
   b.advantage =
       static_cast<std::int8_t>(std::clamp<std::int64_t>(peer.advantage_x16 / 16, -127, 127));
   std::uint64_t start = std::min(peer.acked_inputs, mine.next_confirmed());
-  if (start > 0 && !mine.holds(start - 1)) start = mine.next_confirmed();  // too far behind
+  if ((start > 0 && !mine.holds(start - 1)) ||
+      (start < mine.next_confirmed() && !mine.holds(start)))
+    start = mine.next_confirmed();  // too far behind (or not known yet): its acks will say
   const std::size_t size = config.input_size;
   const std::size_t most = std::min<std::size_t>(protocol::max_inputs_per_packet, 900 / (size + 1));
   const auto count =
@@ -406,11 +431,18 @@ void Session::Impl::send_inputs(detail::Peer& peer) {
     if (b.checks.size() == protocol::max_checks_per_packet) break;
     b.checks.push_back(protocol::HashCheck{wire_frame(c.frame), c.hash});
   }
-  b.held_frame = wire_frame(confirmed_frame());
+  const std::uint64_t held = confirmed_frame();
+  max_held_sent = std::max(max_held_sent, held);
+  b.held_frame = wire_frame(held);
   b.gone.clear();
-  for (std::uint32_t q = 0; q < config.players; ++q)
+  b.back.clear();
+  for (std::uint32_t q = 0; q < config.players; ++q) {
+    const auto player = static_cast<std::uint8_t>(q);
     if (disconnect_frame[q] != detail::never)
-      b.gone.push_back({static_cast<std::uint8_t>(q), wire_frame(disconnect_frame[q])});
+      b.gone.push_back({player, wire_frame(disconnect_frame[q])});
+    if (absent_until[q] != 0)
+      b.back.push_back({player, wire_frame(absent_from[q]), wire_frame(absent_until[q])});
+  }
   peer.needs_ack = false;
   send(peer, p);
 }
@@ -456,15 +488,21 @@ void Session::Impl::send_due() {
   const std::uint64_t logged = unit_size ? frame_log.size() / unit_size : 0;
   for (std::vector<detail::Peer>* group : {&peers, &spectators}) {
     for (detail::Peer& peer : *group) {
-      if (peer.disconnected) continue;
-      if (!peer.answered &&
+      // A new session bound to a gone player's seat is kept alive (below) until it plays.
+      if (peer.disconnected && !peer.rejoining) continue;
+      // A rejoining session says hello until the peer has bound it (it then sends more than the
+      // handshake): the peer's challenge that binds it answers a hello, and either may be lost.
+      const bool unbound = !peer.answered || (config.rejoin && !peer.knows_us);
+      if (unbound &&
           (!peer.hello_sent || now_us - peer.last_hello_us >= config.hello_interval_us)) {
         send_hello(peer, peer.challenge);
         peer.hello_sent = true;
         peer.last_hello_us = now_us;
       }
       if (!peer.synchronized) continue;
-      if (now_us - peer.last_ping_us >= config.ping_interval_us) {
+      // A rejoining session gets no inputs from here until it plays: pings keep it hearing us.
+      const bool keepalive = peer.rejoining && now_us - peer.last_send_us >= config.keepalive_us;
+      if (now_us - peer.last_ping_us >= config.ping_interval_us || keepalive) {
         protocol::Packet ping;
         ping.header.type = protocol::PacketType::ping;
         ping.ping.time_us = now_us;
@@ -528,7 +566,7 @@ void Session::Impl::check_progress() {
   if (!held_back) return;
   std::vector<detail::Peer*> blamed;
   for (detail::Peer& peer : peers)
-    if (peer.synchronized && !peer.disconnected && holds_back(peer)) blamed.push_back(&peer);
+    if (seated(peer) && holds_back(peer)) blamed.push_back(&peer);
   for (detail::Peer* peer : blamed)
     disconnect(*peer, "no progress");
 }

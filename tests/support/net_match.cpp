@@ -130,6 +130,8 @@ bool Match::run() {
           const PlayerInput bot = scripted_input(options_.seed, tick_, p);
           if (options_.arena) {
             encode_input(bot, std::span<std::uint8_t, PlayerInput::encoded_size>(input.data(), 3));
+          } else if (options_.zero_input_peer == p) {
+            std::fill(input.begin(), input.end(), std::uint8_t{0});
           } else {
             for (std::size_t i = 0; i < input.size(); ++i)
               input[i] = static_cast<std::uint8_t>(

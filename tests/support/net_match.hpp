@@ -12,6 +12,7 @@
 
 #include <detsim/net/game.hpp>
 #include <detsim/net/protection.hpp>
+#include <detsim/net/protocol.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/net/spectator.hpp>
@@ -21,7 +22,8 @@
 namespace detsim::test {
 
 /// A cheap deterministic game: its state is the frame and an accumulator that mixes in every
-/// input byte, so any difference in any input of any frame changes every later hash. `fault_frame`
+/// input byte and whether each player was there (InputStatus::disconnected or not), so any
+/// difference in any input of any frame changes every later hash. `fault_frame`
 /// perturbs the state on this machine only (a stand-in for non-determinism).
 class CounterGame final : public net::Game {
  public:
@@ -54,6 +56,8 @@ class CounterGame final : public net::Game {
   void advance(const net::FrameInputs& inputs, bool resimulating) override {
     for (std::size_t i = 0; i < inputs.bytes.size(); ++i)
       acc_ = mix(acc_ + inputs.bytes[i] + i);
+    for (std::size_t p = 0; p < inputs.status.size(); ++p)
+      if (inputs.status[p] == net::InputStatus::disconnected) acc_ = mix(acc_ ^ (p + 1));
     if (fault_frame && *fault_frame == frame_) acc_ += 1;
     ++frame_;
     ++(resimulating ? resimulated : simulated);
@@ -117,6 +121,8 @@ struct MatchOptions {
   std::function<bool(std::uint32_t peer, std::uint64_t tick)> active;
   /// Called for each peer every tick before it advances (mid-match changes).
   std::function<void(std::uint32_t peer, std::uint64_t tick, net::Session&)> on_tick;
+  /// A peer whose player presses nothing: its input is all zero.
+  std::optional<std::uint32_t> zero_input_peer;
   /// Wraps peer p's transport (hostile-datagram tests); nullptr keeps the network's endpoint.
   using Wrap =
       std::function<std::unique_ptr<net::Transport>(std::uint32_t peer, net::Transport& inner)>;
@@ -138,6 +144,41 @@ struct MatchOptions {
   std::uint64_t restart_tick = 0;
   std::uint64_t rejoin_tick = 0;
 };
+
+/// A peer's transport that rewrites what it sends (the plain framing: what a malicious peer, or
+/// a relay, could do): `edit(to, packet, n)` sees the n-th decoded datagram to `to` and may change
+/// it (or return false to drop it). Datagrams it cannot decode pass unchanged.
+class Tamper final : public net::Transport {
+ public:
+  using Edit = std::function<bool(net::PeerId to, net::protocol::Packet& packet, std::uint64_t n)>;
+  Tamper(net::Transport& inner, Edit edit, std::size_t input_size = 4)
+      : inner_(inner), edit_(std::move(edit)), input_size_(input_size) {}
+  void send(net::PeerId to, std::span<const std::uint8_t> bytes) override {
+    net::protocol::Packet p;
+    if (net::protocol::decode(bytes, input_size_, p) != net::protocol::DecodeError::none) {
+      inner_.send(to, bytes);
+      return;
+    }
+    if (!edit_(to, p, count_++)) return;
+    std::vector<std::uint8_t> out;
+    if (net::protocol::encode(p, input_size_, out)) inner_.send(to, out);
+  }
+  void receive(std::vector<net::Datagram>& out) override { inner_.receive(out); }
+
+ private:
+  net::Transport& inner_;
+  Edit edit_;
+  std::size_t input_size_;
+  std::uint64_t count_ = 0;
+};
+
+/// MatchOptions::wrap that puts a Tamper on peer `who`'s transport (CounterGame's inputs).
+inline MatchOptions::Wrap tamper(std::uint32_t who, Tamper::Edit edit) {
+  return [who, edit](std::uint32_t p, net::Transport& inner) -> std::unique_ptr<net::Transport> {
+    if (p != who) return nullptr;
+    return std::make_unique<Tamper>(inner, edit);
+  };
+}
 
 /// N peers, each with its own game and session, over one SimNetwork.
 class Match {

@@ -154,9 +154,11 @@ inline Bytes input_bytes(const Packet& p, std::span<const std::uint8_t> tokens) 
       .frame(b.start_frame, b.ack_frame)
       .u8(b.count)
       .frame(b.held_frame, b.ack_frame)
-      .u8(b.gone.size());
+      .u8(b.gone.size() | b.back.size() << 4);
   for (const GoneReport& g : b.gone)
     w.u8(g.player).frame(g.frame, b.ack_frame);
+  for (const BackReport& r : b.back)
+    w.u8(r.player).frame(r.from, b.ack_frame).frame(r.until, b.ack_frame);
   w.raw(tokens).u8(b.checks.size());
   for (const HashCheck& c : b.checks)
     w.frame(c.frame, b.ack_frame).u64(c.hash);
@@ -201,11 +203,13 @@ inline Bytes plain_bytes(const Packet& p) {
 // --- Exact sizes of an input packet's parts
 // -------------------------------------------------------
 
-/// held_frame, the gone count and the gone reports.
+/// held_frame, the list counts, the gone reports and the back reports.
 inline std::size_t status_size(const InputBody& b) {
   std::size_t n = frame_size(b.held_frame, b.ack_frame) + 1;
   for (const GoneReport& g : b.gone)
     n += 1 + frame_size(g.frame, b.ack_frame);
+  for (const BackReport& r : b.back)
+    n += 1 + frame_size(r.from, b.ack_frame) + frame_size(r.until, b.ack_frame);
   return n;
 }
 
@@ -282,6 +286,8 @@ inline void far_frames(Packet& p) {
     c.frame = 0;
   for (GoneReport& g : p.input.gone)
     g.frame = 0;
+  for (BackReport& r : p.input.back)
+    r.from = r.until = 0;
 }
 
 inline std::vector<HashCheck> max_checks() {
@@ -324,8 +330,8 @@ inline testing::AssertionResult same_packet(const Packet& a, const Packet& b) {
         return testing::AssertionFailure() << "input fields differ";
       if (x.deltas != y.deltas) return testing::AssertionFailure() << "input deltas differ";
       if (x.checks != y.checks) return testing::AssertionFailure() << "input checks differ";
-      if (x.held_frame != y.held_frame || x.gone != y.gone)
-        return testing::AssertionFailure() << "input held frame or gone reports differ";
+      if (x.held_frame != y.held_frame || x.gone != y.gone || x.back != y.back)
+        return testing::AssertionFailure() << "input held frame, gone or back reports differ";
       break;
     }
     case PacketType::ping:

@@ -265,6 +265,13 @@ bool Netplay::handle_events() {
                        static_cast<unsigned long long>(e.frame));
           break;
         }
+        if (e.reason == "rejoining") {  // its process restarted (--rejoin): it comes back
+          std::fprintf(stderr,
+                       "detsim netplay: %s restarted: its old process is gone from frame %llu, "
+                       "and it rejoins\n",
+                       who.c_str(), static_cast<unsigned long long>(e.frame));
+          break;
+        }
         failure_ = who + " disconnected at frame " + std::to_string(e.frame) + " (" +
                    disconnect_reason(e.reason) + ")";
         return false;

@@ -91,10 +91,10 @@ replay as the players. Player 0 above could serve one at 127.0.0.1:7002 with
 A player waits for its connected spectators to have every frame before it exits (up to
 --timeout; a spectator that lags is only warned about).
 
-If a player's process stops, it can be started again with the same arguments plus --rejoin: the
-other player sends the match's state (compressed) and the inputs since, and the match goes on; the
-frames the restart missed take no input from the rejoining player. Both end with the same hash.
-A player may also start alone with --open-seat; the other joins whenever it starts, with --join.
+If a player's process stops, it can be started again with the same arguments plus --rejoin: a
+peer sends the match's state (compressed) and the inputs since, and the match goes on; the frames
+the restart missed take no input from the rejoining player. All end with the same hash. A player
+may also start alone with --open-seat; the others join whenever they start, with --join.
 
 Exit status: 0 the match completed; 1 a desync (the frame, both hashes and the player are
 printed; --desync-report writes this machine's side for bisection) or an unverified frame (a
@@ -193,14 +193,15 @@ void add_netplay(CLI::App& app, int& exit_code) {
   c->add_flag("--rejoin,--join", netplay.rejoin,
               "Take this player's seat in a match under way: again, after this machine's "
               "process stopped, or for the first time when the other player runs --open-seat. "
-              "The other player sends the match's state and this one re-simulates to the "
-              "present (two players; a seat still held — within 5 s of the stop, or --partition "
-              "pause — continues where the peer's copy of this player's inputs ends; an open "
-              "seat, or one given up under --partition play-on, is taken from the present)");
+              "A peer sends the match's state and this one re-simulates to the present (two "
+              "players: a seat still held — within 5 s of the stop, or --partition pause — "
+              "continues where the peer's copy of this player's inputs ends; an open seat, or "
+              "one given up under --partition play-on, is taken from the present. Three or more: "
+              "always from the present, after the peers agree where the old process stopped)");
   c->add_flag("--open-seat", netplay.open_seat,
-              "Start without the other player: its seat is open (its input zero) until it "
-              "joins with --join, which it may do at any time; a match nobody joins ends "
-              "normally (two players)");
+              "Start without the other players: their seats are open (their inputs zero) until "
+              "each joins with --join, which it may do at any time; a match nobody joins ends "
+              "normally");
   add_inject_option(c, netplay.injections);
   c->add_option("--desync-report", netplay.desync_report,
                 "On a desync, write this machine's side to FILE: the inputs up to the divergent "

@@ -41,15 +41,12 @@ Status check_role(const NetplayArgs& a) {
       return Status::error("--me " + std::to_string(a.me) + " must be below --players " +
                            std::to_string(a.players) + " (players are numbered 0 .. " +
                            std::to_string(a.players - 1) + ")");
-    if (a.open_seat && a.players != 2)
-      return Status::error("--open-seat works in two-player matches only (--players " +
-                           std::to_string(a.players) + ")");
     if (a.open_seat && a.rejoin)
       return Status::error(
           "--open-seat and --rejoin: the player that opens a seat waits for the one that joins");
-    if (a.rejoin && a.players != 2)
-      return Status::error("--rejoin works in two-player matches only (--players " +
-                           std::to_string(a.players) + ")");
+    if ((a.rejoin || a.open_seat) && a.players < 2)
+      return Status::error(std::string(a.rejoin ? "--rejoin" : "--open-seat") +
+                           " needs a match of two or more players (--players 1)");
     if (a.rejoin && !a.record.empty())
       return Status::error(
           "--rejoin cannot be combined with --record: a rejoining player sees the match only "

@@ -30,9 +30,10 @@
 //     hello        fingerprint u64 | players u8 | player u8 | input_size u8 | challenge u64
 //     hello_reply  challenge u64 (the hello's, echoed; the header carries the replier's session)
 //     input        ack_frame v | check_ack z | current_frame z | advantage i8 | start_frame z |
-//                  count u8 | held_frame z | gone u8 | gone x (player u8, frame z) |
-//                  deltas: run-length coded bytes (below) | checks u8 | checks x (frame z, hash
-//                  u64)
+//                  count u8 | held_frame z | lists u8 (gone count, low nibble; back count,
+//                  high nibble) | gone x (player u8, frame z) | back x (player u8, from z,
+//                  until z) | deltas: run-length coded bytes (below) | checks u8 | checks x (frame
+//                  z, hash u64)
 //     ping, pong   time u64 (microseconds of the pinging side's clock)
 //     state_request  offset v (the snapshot bytes the rejoining sender holds)
 //     state_chunk    total v | offset v | length v | length bytes (a slice of the snapshot)
@@ -61,8 +62,9 @@ namespace detsim::net::protocol {
 
 /// Changes whenever the layout above changes; peers of different versions drop each other's
 /// datagrams (counted as bad_version) and never synchronise. Version 5 added the sealed framing,
-/// version 6 the state transfer that lets a restarted player rejoin (state_request, state_chunk).
-inline constexpr std::uint8_t version = 6;
+/// version 6 the state transfer that lets a restarted player rejoin (state_request, state_chunk),
+/// version 7 the back reports that take a player back into a match of three or more.
+inline constexpr std::uint8_t version = 7;
 inline constexpr std::uint8_t magic0 = 'D';
 inline constexpr std::uint8_t magic1 = 'N';
 inline constexpr std::size_t header_size = 14;
@@ -139,6 +141,17 @@ struct GoneReport {
 /// The most players a session has, and so gone reports one datagram carries.
 inline constexpr std::size_t max_gone_reports = 8;
 
+/// "`player` was away over [from, until) and plays again from `until`": how the peers of a match
+/// of three or more take a rejoining player back at the one frame its snapshot's server chose
+/// (docs/NET.md, "Rejoining"). `from` is the disconnect frame they agreed on.
+struct BackReport {
+  std::uint8_t player = 0;
+  std::uint32_t from = 0;
+  std::uint32_t until = 0;
+
+  friend constexpr bool operator==(const BackReport&, const BackReport&) noexcept = default;
+};
+
 struct InputBody {
   std::uint32_t ack_frame = 0;       ///< the sender holds every input of the receiver before it
   std::uint32_t check_ack = 0;       ///< the sender holds every hash check of the receiver up to it
@@ -151,6 +164,8 @@ struct InputBody {
   /// The sender holds every player's input (or knows it gone for good) before this frame.
   std::uint32_t held_frame = 0;
   std::vector<GoneReport> gone;  ///< every player the sender takes as gone, ascending player
+  /// Every player the sender took back after an absence (its latest one), ascending player.
+  std::vector<BackReport> back;
 };
 
 struct PingBody {

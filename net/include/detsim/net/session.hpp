@@ -110,11 +110,15 @@ struct SessionConfig {
   /// hold the seat (within disconnect_timeout_us of the old session's last word, or paused).
   /// The same session joins an open seat (open_seats on the other side, or a player the other
   /// side took as gone under PartitionPolicy::play_on): its inputs count from the peer's present
-  /// on, and were zero (InputStatus::disconnected) before. Two-player matches only, for now.
+  /// on, and were zero (InputStatus::disconnected) before. In a match of three or more players
+  /// every return goes that way: the peers take the old session as gone, agree on the frame
+  /// (as for any disconnect), and the lowest-numbered peer that answers serves the snapshot and
+  /// names the frame R the player is back from, which it and the snapshot carry to every other
+  /// peer (docs/NET.md, "Rejoining").
   bool rejoin = false;
   /// Players whose seat is open at the start: the match runs without them, their inputs zero
   /// (InputStatus::disconnected), until a session of theirs joins with `rejoin` — a late joiner,
-  /// or a spectator turned player. Two-player matches only, for now.
+  /// or a spectator turned player. Every peer of the match lists the same open seats.
   std::vector<std::uint32_t> open_seats;
   std::vector<RemotePlayer> remotes;  ///< every other player, each exactly once
   /// Spectators this machine serves (at most 16; ids distinct from the remotes'): each receives
@@ -136,7 +140,8 @@ enum class EventType : std::uint8_t {
   running,       ///< every peer is synchronized: frames can advance
   interrupted,   ///< `player` has been silent for disconnect_warning_us
   resumed,       ///< `player` was heard from again after an interruption
-  disconnected,  ///< `player` is gone (`reason`: "silent", "no progress" or "reported gone"):
+  disconnected,  ///< `player` is gone (`reason`: "silent", "no progress", "reported gone", or
+                 ///< "rejoining": a new session of it came, in a match of three or more):
                  ///< its inputs are zero from `frame` on (InputStatus::disconnected)
   desync,        ///< `player` hashed confirmed frame `frame` differently
   /// a hello from `player`'s peer did not match this session (`reason`: what differed, or "not
@@ -158,7 +163,9 @@ enum class EventType : std::uint8_t {
   paused,
   /// A restarted process took `player`'s seat again, or a late joiner an open seat
   /// (SessionConfig::rejoin), from a snapshot of state frame `frame`: on the joining machine
-  /// `player` is its own, on the others the one that came.
+  /// `player` is its own, on the others the one that came. In a match of three or more, the
+  /// peers that did not serve the snapshot raise it when they take the player back, with
+  /// `frame` the first frame it plays in again.
   rejoined,
 };
 
@@ -244,6 +251,10 @@ struct SessionStats {
   /// Rejoining peers this machine sent a snapshot to, and the snapshot bytes sent (resends too).
   std::uint64_t snapshots_served = 0;
   std::uint64_t snapshot_bytes_sent = 0;
+  /// Back reports (a player taken back at a frame) that could not be taken: about a player this
+  /// machine does not take as gone from the report's frame, or naming a frame it has delivered
+  /// already or cannot hold.
+  std::uint64_t ignored_back_reports = 0;
 };
 
 /// Predicts a remote player's input for a frame not received yet: writes the prediction to `out`
