@@ -14,7 +14,9 @@
 
 #include <detsim/net/protection.hpp>
 
+#include "support/cli.hpp"
 #include "support/netplay_processes.hpp"
+#include "support/replay_files.hpp"
 
 namespace detsim {
 namespace {
@@ -25,16 +27,22 @@ using test::final_hash_of;
 using test::has;
 using test::port_for;
 using test::Process;
+using test::read_bytes;
 using test::Relay;
 using test::RelayedPair;
 using test::run_through_relay;
+using test::TempFile;
 using test::wait_for_both;
 const char* const test_key = test::netplay_test_key;
 
 TEST(CliNetplay, AKilledPlayerRestartedWithRejoinFinishesTheMatchWithTheSameHash) {
   // Player 1's process is killed 4 s into a sealed match and started again a second later with
   // --rejoin: it takes its seat from player 0's snapshot, and both finish on one final hash.
+  // Both record: the rejoined process re-simulates the frames before its return from the
+  // snapshot's log, so the two replays are the same bytes.
   if (!net::protection::available()) GTEST_SKIP() << "built without libsodium: no --key";
+  TempFile replay_a("rejoin_a.dsr");
+  TempFile replay_b("rejoin_b.dsr");
   for (int attempt = 0; attempt < 6; ++attempt) {
     const std::uint16_t port_a = port_for(attempt + 40);
     const auto port_b = static_cast<std::uint16_t>(port_a + 1);
@@ -44,7 +52,8 @@ TEST(CliNetplay, AKilledPlayerRestartedWithRejoinFinishesTheMatchWithTheSameHash
     std::vector<std::string> b = common;
     for (const std::string& arg :
          {std::string("--me"), std::string("0"), std::string("--bot"), std::string("21"),
-          std::string("--bind"), endpoint(port_a), std::string("--peer"), "1=" + endpoint(port_b)})
+          std::string("--bind"), endpoint(port_a), std::string("--peer"), "1=" + endpoint(port_b),
+          std::string("--record"), replay_a.path()})
       a.push_back(arg);
     for (const std::string& arg :
          {std::string("--me"), std::string("1"), std::string("--bot"), std::string("22"),
@@ -60,7 +69,7 @@ TEST(CliNetplay, AKilledPlayerRestartedWithRejoinFinishesTheMatchWithTheSameHash
     first->kill();
     std::this_thread::sleep_for(std::chrono::seconds(1));
     std::vector<std::string> again = b;
-    again.push_back("--rejoin");
+    again.insert(again.end(), {"--rejoin", "--record", replay_b.path()});
     Process rejoiner(again, "rejoin_b2");
     ASSERT_TRUE(wait_for_both(stayer, rejoiner, std::chrono::seconds(90)))
         << stayer.err() << rejoiner.err();
@@ -74,6 +83,11 @@ TEST(CliNetplay, AKilledPlayerRestartedWithRejoinFinishesTheMatchWithTheSameHash
     const std::string hash = final_hash_of(stayer.out());
     EXPECT_EQ(hash.size(), 16U) << stayer.out();
     EXPECT_EQ(final_hash_of(rejoiner.out()), hash) << stayer.out() << rejoiner.out();
+    const std::vector<std::uint8_t> recorded = read_bytes(replay_a.path());
+    EXPECT_FALSE(recorded.empty());
+    EXPECT_TRUE(recorded == read_bytes(replay_b.path())) << "the two players' replays differ";
+    const test::CliResult verify = test::detsim_cli("verify " + replay_b.path());
+    EXPECT_EQ(verify.exit_code, 0) << verify.out << verify.err;
     return;
   }
   FAIL() << "no free ports after 6 attempts";

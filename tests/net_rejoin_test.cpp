@@ -203,6 +203,72 @@ TEST(NetRejoin, UnderPauseARestartedPlayerRejoinsAfterAnyAbsence) {
   expect_rejoined_match(m, o.frames);
 }
 
+TEST(NetRejoin, ReplayingTheMatchTheRejoinedSessionDeliversEveryFrameFromTheStart) {
+  // rejoin_replays_match: the new session re-simulates frames 0 .. S from the snapshot's log
+  // before it plays, so its listener sees the whole match, exactly as the other side's did.
+  MatchOptions o;
+  o.frames = 900;
+  o.link.latency_us = 20'000;
+  o.max_ticks = 3000;
+  o.restart_peer = 1;
+  o.restart_tick = 300;
+  o.rejoin_tick = 360;
+  o.configure = [](std::uint32_t p, net::SessionConfig& c) {
+    if (p == 1) c.rejoin_replays_match = c.rejoin;
+  };
+  Match m(o);
+  ASSERT_TRUE(m.run());
+  m.idle(60);
+  const test::PeerRecord& a = m.record(0);
+  const test::PeerRecord& after = m.record(1);
+  EXPECT_EQ(after.first_frame, 0U);
+  ASSERT_GE(after.hashes.size(), o.frames);
+  ASSERT_GE(a.hashes.size(), o.frames);
+  for (std::size_t f = 0; f < o.frames; ++f)
+    ASSERT_EQ(after.hashes[f], a.hashes[f]) << "frame " << f;
+  EXPECT_TRUE(std::equal(a.inputs.begin(),
+                         a.inputs.begin() + static_cast<std::ptrdiff_t>(o.frames * 2 * 4),
+                         after.inputs.begin()));
+  EXPECT_TRUE(std::equal(a.status.begin(),
+                         a.status.begin() + static_cast<std::ptrdiff_t>(o.frames * 2),
+                         after.status.begin()));
+  EXPECT_TRUE(after.has(EventType::rejoined));
+  EXPECT_FALSE(after.has(EventType::desync));
+}
+
+TEST(NetRejoin, ReplayingTheMatchRefusesASnapshotItsOwnFramesDoNotGive) {
+  // Peer 0's game goes wrong at frame 100 (its peer saw the desync), so its snapshot's state is
+  // not what the frames in it give: the replaying session refuses it by name.
+  MatchOptions o;
+  o.frames = 900;
+  o.link.latency_us = 20'000;
+  o.max_ticks = 1500;
+  o.restart_peer = 1;
+  o.restart_tick = 300;
+  o.rejoin_tick = 360;
+  o.fault_peer = 0;
+  o.fault_frame = 100;
+  o.configure = [](std::uint32_t p, net::SessionConfig& c) {
+    if (p == 1) c.rejoin_replays_match = c.rejoin;
+  };
+  Match m(o);
+  EXPECT_FALSE(m.run());
+  EXPECT_TRUE(m.earlier_record().has(EventType::desync));
+  const net::Event* end = nullptr;
+  for (const net::Event& e : m.record(1).events)
+    if (e.type == EventType::match_ended) end = &e;
+  ASSERT_NE(end, nullptr);
+  EXPECT_EQ(end->reason, "rejoin failed");
+  EXPECT_FALSE(m.record(1).has(EventType::rejoined));
+  const std::vector<std::uint8_t> input(4, 0);
+  auto refused = m.session(1).advance_frame(input);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("rejoin: the snapshot player 0 sent does not follow from its "
+                                   "own frames"),
+            std::string::npos)
+      << refused.message();
+}
+
 TEST(NetRejoin, ARestartAfterTheSeatWasGivenUpNeverRejoins) {
   // end_match: 8 s down ends the match on the side that stayed; the new session is not let in.
   MatchOptions o;

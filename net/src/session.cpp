@@ -31,6 +31,8 @@ Status validate(const SessionConfig& c) {
                std::to_string(static_cast<unsigned>(c.partition)));
   if (c.rejoin && c.players < 2)
     return bad("rejoin needs a match of two or more players (this one has 1)");
+  if (c.rejoin_replays_match && !c.rejoin)
+    return bad("rejoin_replays_match is for a rejoining session (set rejoin too)");
   if (c.rejoin && !c.spectators.empty())
     return bad("a rejoining session serves no spectators (they followed the earlier one)");
   if (!c.open_seats.empty() && c.rejoin)

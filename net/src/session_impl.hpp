@@ -14,6 +14,10 @@
 #include "input_queue.hpp"
 
 namespace detsim::net::detail {
+struct Snapshot;
+}  // namespace detsim::net::detail
+
+namespace detsim::net::detail {
 
 /// Frames of inputs each player's queue holds: enough for the prediction window, the input delay,
 /// the confirmed frames not yet emitted and the oldest input a peer's delta may refer to. A remote
@@ -237,6 +241,9 @@ struct Session::Impl {
   [[nodiscard]] detail::Peer* snapshot_server() noexcept;
   /// Loads the whole snapshot received from `from`; an error (and `broken`) when it is invalid.
   Status load_snapshot(detail::Peer& from);
+  /// SessionConfig::rejoin_replays_match: re-simulates `snapshot`'s frames from the game's state
+  /// at creation, delivering each; an error when they do not give the snapshot's state.
+  Status replay_match(const detail::Snapshot& snapshot, std::uint32_t server);
   void request_state();
 
   SessionConfig config;

@@ -298,6 +298,9 @@ Status Session::Impl::load_snapshot(detail::Peer& from) {
                          std::to_string(config.players) +
                          " players returns it from an agreed frame); start this player again");
 
+  if (config.rejoin_replays_match) {
+    if (Status replayed = replay_match(s, from.player); !replayed) return replayed;
+  }
   game->load(s.state);
   current = s.frame;
   next_emit = s.frame;
@@ -360,6 +363,32 @@ Status Session::Impl::load_snapshot(detail::Peer& from) {
   }
   for (detail::Peer& peer : peers)
     send_inputs(peer);
+  return Status::success();
+}
+
+Status Session::Impl::replay_match(const detail::Snapshot& s, std::uint32_t server) {
+  // The game is as the session found it at creation (nothing was simulated before the snapshot):
+  // the state every peer started from.
+  std::vector<std::uint8_t> state = state_slot(0).bytes;
+  const std::size_t size = config.input_size;
+  for (std::uint64_t frame = 0; frame < s.frame; ++frame) {
+    const auto unit = s.log.begin() + static_cast<std::ptrdiff_t>(frame * unit_size);
+    for (std::uint32_t p = 0; p < config.players; ++p)
+      frame_status[p] =
+          (unit[0] >> p & 1U) != 0 ? InputStatus::disconnected : InputStatus::confirmed;
+    std::copy(unit + 1, unit + static_cast<std::ptrdiff_t>(unit_size), frame_inputs.begin());
+    game->advance(FrameInputs{frame, size, frame_inputs, frame_status}, false);
+    const std::uint64_t hash = game->save(state);
+    if (confirmed_listener)
+      confirmed_listener(ConfirmedFrame{frame, frame_inputs, frame_status, hash});
+  }
+  if (state != s.state)
+    return Status::error("rejoin: the snapshot player " + std::to_string(server) +
+                         " sent does not follow from its own frames: re-simulated from the start, "
+                         "they give another state at frame " +
+                         std::to_string(s.frame) +
+                         " (a peer that is not deterministic, or one that lies); start this "
+                         "player again to retry");
   return Status::success();
 }
 

@@ -167,6 +167,9 @@ Status Netplay::start() {
   config.match_key = plan_.match_key;
   config.partition = plan_.partition;
   config.rejoin = args_.rejoin;
+  // A rejoining player records the whole match too: it re-simulates the frames before its return
+  // from the snapshot's log (which must then give the snapshot's state).
+  config.rejoin_replays_match = args_.rejoin && recorder_.has_value();
   if (args_.open_seat)
     for (const net::UdpPeer& p : plan_.peers)
       config.open_seats.push_back(p.id);

@@ -170,7 +170,8 @@ void add_netplay(CLI::App& app, int& exit_code) {
       ->type_name("SECONDS");
   c->add_option("--record", netplay.record,
                 "Record the confirmed frames to a replay file (the same bytes on every peer and "
-                "spectator)")
+                "spectator; with --rejoin, the frames before the return are re-simulated from "
+                "the snapshot's log, which must give the snapshot's state)")
       ->type_name("FILE");
   auto* key = c->add_option("--key", netplay.key,
                             "The match key, 64 hex digits (e.g. from `head -c 32 /dev/urandom | "

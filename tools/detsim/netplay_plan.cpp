@@ -47,10 +47,6 @@ Status check_role(const NetplayArgs& a) {
     if ((a.rejoin || a.open_seat) && a.players < 2)
       return Status::error(std::string(a.rejoin ? "--rejoin" : "--open-seat") +
                            " needs a match of two or more players (--players 1)");
-    if (a.rejoin && !a.record.empty())
-      return Status::error(
-          "--rejoin cannot be combined with --record: a rejoining player sees the match only "
-          "from its return on (record on the other player)");
     if (a.rejoin && !a.spectators.empty())
       return Status::error(
           "--rejoin cannot be combined with --spectator: spectators follow the earlier process");

@@ -116,6 +116,12 @@ struct SessionConfig {
   /// names the frame R the player is back from, which it and the snapshot carry to every other
   /// peer (docs/NET.md, "Rejoining").
   bool rejoin = false;
+  /// With `rejoin`: before it plays, the session re-simulates the whole match from the game's
+  /// state at creation (frame 0) through the snapshot's confirmed frames, delivering each to the
+  /// confirmed listener — so a recorder writes the whole match, as the other players' do — and
+  /// the snapshot's state must be the one those frames give, else the rejoin fails. It costs the
+  /// simulation of every frame so far, inside the poll() that completes the snapshot.
+  bool rejoin_replays_match = false;
   /// Players whose seat is open at the start: the match runs without them, their inputs zero
   /// (InputStatus::disconnected), until a session of theirs joins with `rejoin` — a late joiner,
   /// or a spectator turned player. Every peer of the match lists the same open seats.
