@@ -280,6 +280,66 @@ TEST(NetRejoinGroup, ALateJoinerTakesAnOpenSeatOfAThreePlayerMatch) {
     EXPECT_FALSE(m.record(p).has(EventType::disconnected)) << "an open seat is not a disconnect";
 }
 
+TEST(NetRejoinGroup, TwoLateJoinersTakeTheirOpenSeatsOneAfterTheOther) {
+  // Player 0 starts alone with both other seats open. Player 1 joins after 3 s: its snapshot has
+  // player 2's seat open too. Player 2 joins after 6 s, through whichever of the two answers
+  // first (player 0; or player 1, which joined late itself, when player 2's link to player 0 is
+  // slow); the other takes it back by the back report.
+  for (const bool slow_to_zero : {false, true}) {
+    SCOPED_TRACE(slow_to_zero ? "player 1 serves" : "player 0 serves");
+    MatchOptions o;
+    o.players = 3;
+    o.frames = 900;
+    o.link.latency_us = 20'000;
+    o.max_ticks = 4000;
+    o.restart_peer = 1;
+    o.restart_tick = 0;
+    o.rejoin_tick = 180;
+    o.more_restarts = {{2, 0, 360}};
+    o.configure = [](std::uint32_t p, net::SessionConfig& c) {
+      if (p == 0) c.open_seats = {1, 2};
+    };
+    if (slow_to_zero) {
+      o.setup = [](net::SimNetwork& network) {
+        net::LinkConditions slow;
+        slow.latency_us = 300'000;
+        ASSERT_TRUE(network.set_link(0, 2, slow).ok());
+        ASSERT_TRUE(network.set_link(2, 0, slow).ok());
+      };
+    }
+    Match m(o);
+    ASSERT_TRUE(m.run());
+    m.idle(60);
+    const test::PeerRecord& a = m.record(0);
+    ASSERT_GE(a.hashes.size(), o.frames);
+    EXPECT_EQ(m.offline_hashes(0), a.hashes);
+    const Away one = away_of(a, 3, 1);
+    const Away two = away_of(a, 3, 2);
+    EXPECT_EQ(one.from, 0U);
+    EXPECT_EQ(two.from, 0U);
+    EXPECT_GT(one.until, 120U);
+    EXPECT_GT(two.until, one.until + 120) << "player 2 came 3 s after player 1";
+    for (std::uint32_t p : {1U, 2U}) {
+      const test::PeerRecord& b = m.record(p);
+      EXPECT_GE(b.first_frame + b.hashes.size(), o.frames) << "peer " << p;
+      for (std::size_t i = 0; i < b.hashes.size() && b.first_frame + i < a.hashes.size(); ++i)
+        ASSERT_EQ(b.hashes[i], a.hashes[b.first_frame + i]) << "peer " << p << ", frame " << i;
+      EXPECT_TRUE(m.record(p).has(EventType::rejoined)) << "peer " << p;
+    }
+    EXPECT_EQ(m.session(slow_to_zero ? 1 : 0).stats().snapshots_served, slow_to_zero ? 1U : 2U);
+    // Player 1 took player 2 back too, whether it served the snapshot or got the back report.
+    bool saw_two = false;
+    for (const net::Event& e : m.record(1).events)
+      saw_two = saw_two || (e.type == EventType::rejoined && e.player == 2);
+    EXPECT_TRUE(saw_two);
+    for (std::uint32_t p = 0; p < 3; ++p) {
+      EXPECT_FALSE(m.record(p).has(EventType::desync)) << "peer " << p;
+      EXPECT_FALSE(m.record(p).has(EventType::check_missing)) << "peer " << p;
+      EXPECT_FALSE(m.record(p).has(EventType::disconnected)) << "peer " << p;
+    }
+  }
+}
+
 TEST(NetRejoinGroup, ABackReportFromAnotherFrameThanTheAgreedOneIsIgnored) {
   // Player 2 falls silent for good; peer 1 hears, from peer 0's datagrams, that it is back from
   // a frame nobody took it as gone at. It stays gone on both; they agree on every frame.

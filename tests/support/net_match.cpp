@@ -54,16 +54,21 @@ void Match::start_session(std::uint32_t p, bool rejoin) {
 }
 
 bool Match::restarted_peer_up(std::uint32_t p) {
-  if (options_.restart_peer != p) return true;
-  if (tick_ == options_.restart_tick && sessions_[p]) {  // the process dies: all of it is lost
-    sessions_[p].reset();
-    games_[p].reset();
-    earlier_record_ = std::move(records_[p]);
-    records_[p] = PeerRecord{};
-  }
-  if (tick_ == options_.rejoin_tick && !sessions_[p]) {
-    games_[p] = make_game(p);
-    start_session(p, true);
+  std::vector<MatchOptions::Restart> restarts = options_.more_restarts;
+  if (options_.restart_peer)
+    restarts.push_back({*options_.restart_peer, options_.restart_tick, options_.rejoin_tick});
+  for (const MatchOptions::Restart& r : restarts) {
+    if (r.peer != p) continue;
+    if (tick_ == r.restart_tick && sessions_[p]) {  // the process dies: all of it is lost
+      sessions_[p].reset();
+      games_[p].reset();
+      if (options_.restart_peer == p) earlier_record_ = std::move(records_[p]);
+      records_[p] = PeerRecord{};
+    }
+    if (tick_ == r.rejoin_tick && !sessions_[p]) {
+      games_[p] = make_game(p);
+      start_session(p, true);
+    }
   }
   return sessions_[p].has_value();
 }

@@ -143,6 +143,13 @@ struct MatchOptions {
   std::optional<std::uint32_t> restart_peer;
   std::uint64_t restart_tick = 0;
   std::uint64_t rejoin_tick = 0;
+  /// More restarts like restart_peer's, of other peers (their earlier records are not kept).
+  struct Restart {
+    std::uint32_t peer = 0;
+    std::uint64_t restart_tick = 0;
+    std::uint64_t rejoin_tick = 0;
+  };
+  std::vector<Restart> more_restarts;
 };
 
 /// A peer's transport that rewrites what it sends (the plain framing: what a malicious peer, or
