@@ -229,6 +229,15 @@ TEST(NetRejoinGroup, APeerThatHeldLessOfTheOldProcessSetsTheFrameOfTheReturn) {
   EXPECT_GT(before.hashes.size() + 60, away.from);
 }
 
+TEST(NetRejoinGroup, InLockstepARestartedPlayerOfThreeComesBackAlike) {
+  MatchOptions o = group(3, 1);
+  o.mode = net::SessionMode::lockstep;
+  Match m(o);
+  ASSERT_TRUE(m.run());
+  m.idle(60);
+  expect_group_return(m, o.frames, 1);
+}
+
 TEST(NetRejoinGroup, WhenPlayerZeroRestartsTheNextPlayerServesTheSnapshot) {
   MatchOptions o = group(3, 0);
   Match m(o);
