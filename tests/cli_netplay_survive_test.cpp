@@ -94,66 +94,77 @@ TEST(CliNetplay, AKilledPlayerRestartedWithRejoinFinishesTheMatchWithTheSameHash
 }
 
 TEST(CliNetplay, AKilledPlayerOfThreeRestartedWithRejoinFinishesWithEveryoneOnOneHash) {
-  // Three processes, sealed; player 2's is killed 4 s in and started again a second later with
-  // --rejoin. Players 0 and 1 take its old process as gone from one agreed frame, one of them
-  // serves the snapshot and both take player 2 back at the same frame: all three end on one
-  // final hash, with every hash check compared.
+  // Three processes, sealed; player 2's is killed 4 s in and started again with --rejoin, 1 s
+  // later (its seat still held: the new process's arrival disconnects the old one) or 7 s later
+  // (past the 5 s timeout: players 0 and 1 play on without it). Players 0 and 1 agree on the
+  // frame the old process is gone from, one of them serves the snapshot and both take player 2
+  // back at the same frame: all three end on one final hash, with every hash check compared.
   if (!net::protection::available()) GTEST_SKIP() << "built without libsodium: no --key";
-  for (int attempt = 0; attempt < 6; ++attempt) {
-    const std::uint16_t base = port_for(attempt + 60);
-    std::vector<std::vector<std::string>> args(3);
-    for (std::uint32_t p = 0; p < 3; ++p) {
-      args[p] = {"netplay",
-                 "--players",
-                 "3",
-                 "--frames",
-                 "900",
-                 "--key",
-                 test_key,
-                 "--me",
-                 std::to_string(p),
-                 "--bot",
-                 std::to_string(31 + p),
-                 "--bind",
-                 endpoint(static_cast<std::uint16_t>(base + p))};
-      for (std::uint32_t q = 0; q < 3; ++q)
-        if (q != p)
-          args[p].insert(
-              args[p].end(),
-              {"--peer", std::to_string(q) + "=" + endpoint(static_cast<std::uint16_t>(base + q))});
+  for (const int down_seconds : {1, 7}) {
+    SCOPED_TRACE("down " + std::to_string(down_seconds) + " s");
+    bool played = false;
+    for (int attempt = 0; attempt < 6 && !played; ++attempt) {
+      const std::uint16_t base = port_for(attempt + 60);
+      std::vector<std::vector<std::string>> args(3);
+      for (std::uint32_t p = 0; p < 3; ++p) {
+        args[p] = {"netplay",
+                   "--players",
+                   "3",
+                   "--frames",
+                   "900",
+                   "--key",
+                   test_key,
+                   "--me",
+                   std::to_string(p),
+                   "--bot",
+                   std::to_string(31 + p),
+                   "--bind",
+                   endpoint(static_cast<std::uint16_t>(base + p))};
+        for (std::uint32_t q = 0; q < 3; ++q)
+          if (q != p)
+            args[p].insert(args[p].end(),
+                           {"--peer", std::to_string(q) + "=" +
+                                          endpoint(static_cast<std::uint16_t>(base + q))});
+      }
+      Process zero(args[0], "rejoin3_a");
+      Process one(args[1], "rejoin3_b");
+      auto first = std::make_unique<Process>(args[2], "rejoin3_c1");
+      std::this_thread::sleep_for(std::chrono::seconds(4));
+      if (zero.poll() || one.poll() || first->poll()) {
+        if (bind_failed(zero) || bind_failed(one) || bind_failed(*first)) continue;  // other ports
+        FAIL() << "a process ended early: " << zero.err() << one.err() << first->err();
+      }
+      first->kill();
+      std::this_thread::sleep_for(std::chrono::seconds(down_seconds));
+      std::vector<std::string> again = args[2];
+      again.push_back("--rejoin");
+      Process rejoiner(again, "rejoin3_c2");
+      ASSERT_TRUE(wait_for_both(zero, rejoiner, std::chrono::seconds(90)))
+          << zero.err() << rejoiner.err();
+      ASSERT_TRUE(wait_for_both(one, rejoiner, std::chrono::seconds(30))) << one.err();
+      for (const Process* p : {&zero, &one, &rejoiner}) {
+        ASSERT_EQ(p->exit_code(), 0) << p->out() << p->err();
+        EXPECT_TRUE(has(p->out(), "desyncs      0")) << p->out();
+        EXPECT_FALSE(has(p->err(), "UNVERIFIED")) << p->err();
+      }
+      EXPECT_TRUE(has(zero.err(), "rejoined at frame")) << zero.err();
+      EXPECT_TRUE(has(one.err(), "rejoined at frame")) << one.err();
+      EXPECT_TRUE(has(rejoiner.out(), "rejoined the match at frame")) << rejoiner.out();
+      EXPECT_TRUE(has(rejoiner.out(), "frames       900,")) << rejoiner.out();
+      const std::string hash = final_hash_of(zero.out());
+      EXPECT_EQ(hash.size(), 16U) << zero.out();
+      EXPECT_EQ(final_hash_of(one.out()), hash) << one.out();
+      EXPECT_EQ(final_hash_of(rejoiner.out()), hash) << zero.out() << rejoiner.out();
+      for (const Process* p : {&zero, &one}) {
+        EXPECT_TRUE(has(p->err(), down_seconds == 1
+                                      ? "restarted: its old process is gone from frame"
+                                      : "the match goes on without it"))
+            << p->err();
+      }
+      played = true;
     }
-    Process zero(args[0], "rejoin3_a");
-    Process one(args[1], "rejoin3_b");
-    auto first = std::make_unique<Process>(args[2], "rejoin3_c1");
-    std::this_thread::sleep_for(std::chrono::seconds(4));
-    if (zero.poll() || one.poll() || first->poll()) {
-      if (bind_failed(zero) || bind_failed(one) || bind_failed(*first)) continue;  // other ports
-      FAIL() << "a process ended early: " << zero.err() << one.err() << first->err();
-    }
-    first->kill();
-    std::this_thread::sleep_for(std::chrono::seconds(1));
-    std::vector<std::string> again = args[2];
-    again.push_back("--rejoin");
-    Process rejoiner(again, "rejoin3_c2");
-    ASSERT_TRUE(wait_for_both(zero, rejoiner, std::chrono::seconds(90)))
-        << zero.err() << rejoiner.err();
-    ASSERT_TRUE(wait_for_both(one, rejoiner, std::chrono::seconds(30))) << one.err();
-    for (const Process* p : {&zero, &one, &rejoiner}) {
-      ASSERT_EQ(p->exit_code(), 0) << p->out() << p->err();
-      EXPECT_TRUE(has(p->out(), "desyncs      0")) << p->out();
-      EXPECT_FALSE(has(p->err(), "UNVERIFIED")) << p->err();
-    }
-    EXPECT_TRUE(has(zero.err(), "rejoined at frame")) << zero.err();
-    EXPECT_TRUE(has(one.err(), "rejoined at frame")) << one.err();
-    EXPECT_TRUE(has(rejoiner.out(), "rejoined the match at frame")) << rejoiner.out();
-    EXPECT_TRUE(has(rejoiner.out(), "frames       900,")) << rejoiner.out();
-    const std::string hash = final_hash_of(zero.out());
-    EXPECT_EQ(hash.size(), 16U) << zero.out();
-    EXPECT_EQ(final_hash_of(one.out()), hash) << one.out();
-    EXPECT_EQ(final_hash_of(rejoiner.out()), hash) << zero.out() << rejoiner.out();
-    return;
+    EXPECT_TRUE(played) << "no free ports after 6 attempts";
   }
-  FAIL() << "no free ports after 6 attempts";
 }
 
 TEST(CliNetplay, APlayerJoinsAnOpenSeatLateAndBothFinishWithTheSameHash) {

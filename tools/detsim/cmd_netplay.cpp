@@ -63,11 +63,16 @@ class Netplay {
       return "no progress: it held the match back for " + milliseconds(c.progress_timeout_us);
     return std::string(reason);
   }
-  /// Handles the session's events; false (with failure_ set) when a player disconnected.
+  /// Handles the session's events; false (with failure_ set) when the match ended here: a player
+  /// disconnected and no majority is left (--partition end), or a rejoin failed. A player that
+  /// leaves a match that goes on (a majority stays, or --partition play-on) is reported only.
   bool handle_events();
   void write_desync_report();
   void advance();
   [[nodiscard]] bool peers_at_end() const;
+  /// Whether player `id` plays in the match as this machine sees it now: neither disconnected nor
+  /// an open seat nobody took (on a joiner, any player gone in its snapshot that never came).
+  [[nodiscard]] bool in_match(const std::optional<net::PeerStats>& stats) const;
   /// The connected players whose hash checks of the match's frames have not all arrived ("" when
   /// every one has): a frame whose check never arrives is unverified, never a pass.
   [[nodiscard]] std::string checks_behind() const;
@@ -195,6 +200,7 @@ Status Netplay::start() {
 }
 
 bool Netplay::handle_events() {
+  std::vector<std::string> gone;  // players that left, while the match may go on without them
   for (const net::Event& e : session_->take_events()) {
     const std::string who = this->who(e.player);
     const bool spectator = e.player >= args_.players;
@@ -275,10 +281,13 @@ bool Netplay::handle_events() {
                        who.c_str(), static_cast<unsigned long long>(e.frame));
           break;
         }
-        failure_ = who + " disconnected at frame " + std::to_string(e.frame) + " (" +
-                   disconnect_reason(e.reason) + ")";
-        return false;
-      case net::EventType::match_ended:  // after a disconnect, which ended netplay's match above
+        // The session says whether the match goes on without it: a match_ended right after
+        // (no majority left, --partition end) ends this one with this disconnect as the reason.
+        gone.push_back(who + " disconnected at frame " + std::to_string(e.frame) + " (" +
+                       disconnect_reason(e.reason) + ")");
+        break;
+      case net::EventType::match_ended:
+        if (failure_.empty() && e.reason != "rejoin failed" && !gone.empty()) failure_ = gone[0];
         if (failure_.empty())
           failure_ =
               e.reason == "rejoin failed"
@@ -287,6 +296,11 @@ bool Netplay::handle_events() {
         return false;
     }
   }
+  for (const std::string& line : gone)
+    std::fprintf(stderr,
+                 "detsim netplay: %s; the match goes on without it (it may come back with "
+                 "--rejoin)\n",
+                 line.c_str());
   return true;
 }
 
@@ -334,11 +348,16 @@ void Netplay::advance() {
   }
 }
 
+bool Netplay::in_match(const std::optional<net::PeerStats>& stats) const {
+  if (!stats || stats->disconnected) return false;
+  return stats->synchronized || !(args_.open_seat || args_.rejoin);
+}
+
 bool Netplay::peers_at_end() const {
   for (const net::UdpPeer& p : plan_.peers) {
     const auto stats = session_->peer_stats(p.id);
-    if (args_.open_seat && stats && !stats->synchronized) continue;  // nobody took the seat
-    if (!stats || stats->remote_frame < args_.frames) return false;
+    if (!in_match(stats)) continue;  // gone, or a seat nobody took
+    if (stats->remote_frame < args_.frames) return false;
   }
   return true;
 }
@@ -350,8 +369,7 @@ std::string Netplay::checks_behind() const {
   std::string out;
   for (const net::UdpPeer& p : plan_.peers) {
     const auto stats = session_->peer_stats(p.id);
-    if (!stats || stats->disconnected || stats->checks_received_through >= last) continue;
-    if (args_.open_seat && !stats->synchronized) continue;  // an open seat nobody took
+    if (!in_match(stats) || stats->checks_received_through >= last) continue;
     if (!out.empty()) out += ", ";
     out += who(p.id) + " (checks of frames " + std::to_string(stats->checks_received_through + 1) +
            " .. " + std::to_string(last) + ")";

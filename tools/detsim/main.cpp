@@ -99,8 +99,11 @@ may also start alone with --open-seat; the others join whenever they start, with
 Exit status: 0 the match completed; 1 a desync (the frame, both hashes and the player are
 printed; --desync-report writes this machine's side for bisection) or an unverified frame (a
 peer's hash check that never arrived: "UNVERIFIED" on stderr, "unverified" in --json); 2 bad
-usage, a port in use, a handshake timeout or a peer that disconnected (the message on stderr names
-it and why: silent, or no progress). --json prints exactly one JSON object on stdout.)";
+usage, a port in use, a handshake timeout, or a peer that disconnected and left this machine
+without a majority (the message on stderr names it and why: silent, or no progress); a player
+that leaves while a majority plays on (three or more players, or --partition play-on) is reported
+on stderr and the match goes on, which it may rejoin. --json prints exactly one JSON object on
+stdout.)";
 
 #if !DETSIM_WITH_UDP
 // Without UDP the command stays, takes any arguments and says why it cannot run, so that a script
