@@ -448,6 +448,8 @@ TEST(NetRejoin, AnAlteredSnapshotIsRefusedWithAReasonAndLoadsNothing) {
   EXPECT_NE(refused.message().find("rejoin: the snapshot player 0 sent is invalid"),
             std::string::npos)
       << refused.message();
+  EXPECT_EQ(m.session(1).failure(), refused.message()) << "the same reason, without advancing";
+  EXPECT_EQ(m.session(0).failure(), "") << "the side that stayed goes on";
 }
 
 /// Adds a hello from another session of player 1 (the plain framing: anyone can send one) to

@@ -553,6 +553,10 @@ const SessionStats& Session::stats() const noexcept {
   return impl_->stats;
 }
 
+std::string_view Session::failure() const noexcept {
+  return impl_->broken;
+}
+
 const DesyncEvidence* Session::desync_evidence() const noexcept {
   return impl_->evidence ? &*impl_->evidence : nullptr;
 }

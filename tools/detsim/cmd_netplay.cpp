@@ -77,8 +77,6 @@ class Netplay {
   /// every one has): a frame whose check never arrives is unverified, never a pass.
   [[nodiscard]] std::string checks_behind() const;
   [[nodiscard]] std::string unconfirmed_players() const;
-  /// Why the session stopped (it was broken: a rejoin that failed).
-  std::string session_failure();
   /// Spectator `player` (players + k) acknowledged every frame of the match.
   [[nodiscard]] bool has_every_frame(std::uint32_t player) const {
     const auto stats = session_->peer_stats(player);
@@ -291,7 +289,7 @@ bool Netplay::handle_events() {
         if (failure_.empty())
           failure_ =
               e.reason == "rejoin failed"
-                  ? "rejoining failed: " + session_failure()
+                  ? "rejoining failed: " + std::string(session_->failure())
                   : "the match ended at frame " + std::to_string(e.frame) + ": no majority left";
         return false;
     }
@@ -375,13 +373,6 @@ std::string Netplay::checks_behind() const {
            " .. " + std::to_string(last) + ")";
   }
   return out;
-}
-
-std::string Netplay::session_failure() {
-  // A broken session returns its reason from advance_frame, and changes nothing.
-  const std::vector<std::uint8_t> none(game_->input_size());
-  const auto result = session_->advance_frame(none);
-  return result.ok() ? "(no reason given)" : result.status().message();
 }
 
 std::string Netplay::unconfirmed_players() const {

@@ -327,6 +327,10 @@ class Session {
   [[nodiscard]] std::optional<PeerStats> peer_stats(std::uint32_t player) const;
   /// This machine's side of the first desync, once one was detected.
   [[nodiscard]] const DesyncEvidence* desync_evidence() const noexcept;
+  /// Why the session stopped — the error advance_frame() returns from then on (a rejoin that
+  /// failed, a match that ended without a majority, a broken invariant) — or empty while it goes
+  /// on.
+  [[nodiscard]] std::string_view failure() const noexcept;
 
  private:
   struct Impl;
