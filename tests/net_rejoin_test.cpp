@@ -203,19 +203,25 @@ TEST(NetRejoin, UnderPauseARestartedPlayerRejoinsAfterAnyAbsence) {
   expect_rejoined_match(m, o.frames);
 }
 
-TEST(NetRejoin, ReplayingTheMatchTheRejoinedSessionDeliversEveryFrameFromTheStart) {
-  // rejoin_replays_match: the new session re-simulates frames 0 .. S from the snapshot's log
-  // before it plays, so its listener sees the whole match, exactly as the other side's did.
+/// Peer 1's process down from tick 300 to 360, back with rejoin_replays_match.
+MatchOptions replaying_restart(std::uint64_t max_ticks) {
   MatchOptions o;
   o.frames = 900;
   o.link.latency_us = 20'000;
-  o.max_ticks = 3000;
+  o.max_ticks = max_ticks;
   o.restart_peer = 1;
   o.restart_tick = 300;
   o.rejoin_tick = 360;
   o.configure = [](std::uint32_t p, net::SessionConfig& c) {
     if (p == 1) c.rejoin_replays_match = c.rejoin;
   };
+  return o;
+}
+
+TEST(NetRejoin, ReplayingTheMatchTheRejoinedSessionDeliversEveryFrameFromTheStart) {
+  // rejoin_replays_match: the new session re-simulates frames 0 .. S from the snapshot's log
+  // before it plays, so its listener sees the whole match, exactly as the other side's did.
+  MatchOptions o = replaying_restart(3000);
   Match m(o);
   ASSERT_TRUE(m.run());
   m.idle(60);
@@ -239,18 +245,9 @@ TEST(NetRejoin, ReplayingTheMatchTheRejoinedSessionDeliversEveryFrameFromTheStar
 TEST(NetRejoin, ReplayingTheMatchRefusesASnapshotItsOwnFramesDoNotGive) {
   // Peer 0's game goes wrong at frame 100 (its peer saw the desync), so its snapshot's state is
   // not what the frames in it give: the replaying session refuses it by name.
-  MatchOptions o;
-  o.frames = 900;
-  o.link.latency_us = 20'000;
-  o.max_ticks = 1500;
-  o.restart_peer = 1;
-  o.restart_tick = 300;
-  o.rejoin_tick = 360;
+  MatchOptions o = replaying_restart(1500);
   o.fault_peer = 0;
   o.fault_frame = 100;
-  o.configure = [](std::uint32_t p, net::SessionConfig& c) {
-    if (p == 1) c.rejoin_replays_match = c.rejoin;
-  };
   Match m(o);
   EXPECT_FALSE(m.run());
   EXPECT_TRUE(m.earlier_record().has(EventType::desync));
