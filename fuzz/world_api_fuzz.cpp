@@ -4,7 +4,8 @@
 // create_joint with any type, bodies, anchor, axis, limits, motor, lengths, spring and break
 // thresholds, destroy_joint, set_joint_motor, the geometry registrations, and the particle groups:
 // create_rope, create_cloth, create_soft_body with any values, apply_particle_force,
-// destroy_particle_group, raycast_particles; and the game's own state: set_game_state of any size,
+// destroy_particle_group; the queries raycast_particles, shape_cast, shape_contacts and
+// contacts_of with any shape and pose; and the game's own state: set_game_state of any size,
 // describe_game_state with good and bad fields, set_user_data).
 //
 // Properties checked beyond the sanitizers' (no crash, no undefined behaviour, no leak):
@@ -650,9 +651,32 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 26:
         status = world.destroy_particle_group(group_id(in, world));
         break;
-      case 27: {
+      case 27: {  // the queries, with any shape and pose: they answer and change nothing
+        const std::uint8_t which = in.byte() % 4U;
         const Vec3 origin = in.vec3();
-        (void)world.raycast_particles(origin, in.vec3());
+        if (which == 0) {
+          (void)world.raycast_particles(origin, in.vec3());
+          break;
+        }
+        const Shape query = shape(in);
+        const detsim::Quat q = in.quat();
+        detsim::QueryFilter filter;
+        filter.ignore = body_id(in, world);
+        if (which == 1) {
+          const Vec3 translation = in.vec3();
+          if (const auto hit = world.shape_cast(query, origin, q, translation, filter)) {
+            if (hit->fraction < Fixed::zero() || hit->fraction > Fixed::one())
+              fail("a shape cast's fraction is outside [0, 1]");
+          }
+        } else if (which == 2) {
+          for (const detsim::ShapeContact& c : world.shape_contacts(query, origin, q, filter)) {
+            if (c.point_count == 0 || c.point_count > 4 || c.depth < Fixed::zero())
+              fail("a shape contact without points or with a negative depth");
+          }
+        } else {
+          (void)world.contacts_of(filter.ignore);
+        }
+        if (world.save() != before) fail("a query changed the world");
         break;
       }
       case 28: {  // the game's own state: mostly small, sometimes empty or over the limit

@@ -41,20 +41,12 @@ using test::add;
 using test::add_ground;
 using test::make_world;
 using test::near;
+using test::near_vec;
 
 constexpr Fixed kTol = Fixed::from_raw(Fixed::one_raw >> 20);
 constexpr Fixed kQuarterPi = Fixed::from_raw(Fixed::pi().raw() / 4);  // pi's raw is a multiple of 4
 const Fixed kHalfSqrt2 = Fixed::sqrt2() >> 1;
 const Fixed kOut = Fixed::from_raw(1 << 16);  // 2^-16 m: "just outside"
-
-testing::AssertionResult near_vec(Vec3 actual, Vec3 expected, Fixed tolerance) {
-  if (near(actual.x, expected.x, tolerance) && near(actual.y, expected.y, tolerance) &&
-      near(actual.z, expected.z, tolerance))
-    return testing::AssertionSuccess();
-  return testing::AssertionFailure()
-         << testing::PrintToString(actual) << " is not within " << to_string(tolerance) << " of "
-         << testing::PrintToString(expected);
-}
 
 /// A hit at `point` with `normal` (each component within `tolerance`) and `fraction`.
 testing::AssertionResult hits(const std::optional<RayHit>& hit, Vec3 point, Vec3 normal,

@@ -23,12 +23,6 @@ using test::make_world;
 using test::placed;
 using test::state;
 
-BodyDef static_at(Shape shape, Vec3 position = {}) {
-  BodyDef d = placed(shape, position);
-  d.type = BodyType::static_body;
-  return d;
-}
-
 // A flat mesh at y = 0 of cells x cells square cells of `size` m from (-half, -half), each cell two
 // triangles (counter-clockwise from above), alternating the diagonal so that edges meet at every
 // angle a sliding box can cross.
@@ -65,7 +59,7 @@ TEST(SurfacePhysics, BoxesSlideAcrossAFlatMeshOfTwoMetreTrianglesWithoutBumping)
   WorldDef def;
   def.enable_sleep = false;
   World w = make_world(def);
-  BodyDef ground = static_at(Shape::mesh(flat_mesh(w, 16, 2_fx)));
+  BodyDef ground = test::static_placed(Shape::mesh(flat_mesh(w, 16, 2_fx)));
   ground.friction = 0.2_fx;
   add(w, ground);
   struct Launch {
@@ -133,7 +127,7 @@ TEST(SurfacePhysics, ASolidSphereRollsDownAHeightfieldSlopeAtFiveSeventhsGSinThe
       hf.heights.push_back(Fixed::from_int(-3 * static_cast<int>(c)) / 10_fx);
   auto g = w.create_heightfield(hf);
   ASSERT_TRUE(g.ok()) << g.message();
-  BodyDef ground = static_at(Shape::heightfield(*g));
+  BodyDef ground = test::static_placed(Shape::heightfield(*g));
   ground.friction = 0.8_fx;
   add(w, ground);
   // On the slope at x = 3, z = 6 (the middle row): the centre r along the normal from the surface.
@@ -172,7 +166,7 @@ TEST(SurfacePhysics, AHullRestsOnAMeshAcrossItsEdgesWithoutCreeping) {
   // triangles and their shared edges and vertex): once settled it stays within 0.5 mm for 5 s and
   // falls asleep, as on a plane.
   World w = make_world();
-  add(w, static_at(Shape::mesh(flat_mesh(w, 4, 2_fx))));
+  add(w, test::static_placed(Shape::mesh(flat_mesh(w, 4, 2_fx))));
   auto g = w.create_convex_hull(test::test_rock());
   ASSERT_TRUE(g.ok()) << g.message();
   const BodyId id = add(w, placed(Shape::convex(*g), {0_fx, 1_fx, 0_fx}));
@@ -206,13 +200,13 @@ TEST(SurfacePhysics, NothingTunnelsThroughAOneTriangleFloorAt1000MetresPerSecond
         hf.cell_size = 100_fx;
         hf.heights = {0_fx, 0_fx, 0_fx, 0_fx};
         floor = w.create_heightfield(hf).value();
-        add(w, static_at(Shape::heightfield(floor), {-50_fx, 0_fx, -50_fx}));
+        add(w, test::static_placed(Shape::heightfield(floor), {-50_fx, 0_fx, -50_fx}));
       } else {
         const std::vector<Vec3> v{
             {-100_fx, 0_fx, -100_fx}, {0_fx, 0_fx, 100_fx}, {100_fx, 0_fx, -100_fx}};
         const std::vector<std::uint32_t> tri{0, 1, 2};
         floor = w.create_mesh(v, tri).value();
-        add(w, static_at(Shape::mesh(floor)));
+        add(w, test::static_placed(Shape::mesh(floor)));
       }
       const std::vector<Vec3> corners{{-0.1_fx, -0.1_fx, -0.1_fx},
                                       {0.1_fx, -0.1_fx, -0.1_fx},
@@ -253,7 +247,7 @@ TEST(SurfacePhysics, ASnapshotDoesNotGrowWithTheMeshUnderThePile) {
   const auto snapshot_bytes = [](bool on_mesh) {
     World w = make_world();
     if (on_mesh) {
-      add(w, static_at(Shape::mesh(flat_mesh(w, 224, 0.25_fx))));
+      add(w, test::static_placed(Shape::mesh(flat_mesh(w, 224, 0.25_fx))));
     } else {
       test::add_ground(w);
     }

@@ -65,15 +65,6 @@ GeometryId heightfield(World& w, const HeightfieldDef& d) {
   return id.ok() ? *id : GeometryId{};
 }
 
-BodyDef static_body(const Shape& shape, Vec3 position = {}, Quat orientation = {}) {
-  BodyDef d;
-  d.type = BodyType::static_body;
-  d.shape = shape;
-  d.position = position;
-  d.orientation = orientation;
-  return d;
-}
-
 // A pose that is neither axis-aligned nor at the origin.
 const Vec3 kAt{3_fx, 1_fx, -2_fx};
 Quat posed() {
@@ -213,7 +204,7 @@ TEST(Surface, TheContentHashNamesTheDataNotTheWorld) {
 TEST(Surface, RaysOnAPosedMeshHitItsPlaneFromEitherSide) {
   World w = make_world();
   const GeometryId g = mesh(w, kSquare, kSquareIndices);
-  const BodyId body = add(w, static_body(Shape::mesh(g), kAt, posed()));
+  const BodyId body = add(w, test::static_placed(Shape::mesh(g), kAt, posed()));
   auto own = sim_detail::build_mesh(kSquare, kSquareIndices);
   ASSERT_TRUE(own.ok());
   const std::array<Vec3, 4> targets = {Vec3{0.3_fx, 0_fx, 0.2_fx}, Vec3{-1.7_fx, 0_fx, 1.1_fx},
@@ -258,7 +249,7 @@ TEST(Surface, RaysOnAPosedMeshHitItsPlaneFromEitherSide) {
 TEST(Surface, RaysOnAPosedTiltedHeightfieldHitItsPlane) {
   World w = make_world();
   const GeometryId g = heightfield(w, tilted_heightfield());
-  const BodyId body = add(w, static_body(Shape::heightfield(g), kAt, posed()));
+  const BodyId body = add(w, test::static_placed(Shape::heightfield(g), kAt, posed()));
   auto own = sim_detail::build_heightfield(tilted_heightfield());
   ASSERT_TRUE(own.ok());
   const Vec3 unit_normal = normalize(kTiltNormal);
@@ -295,10 +286,10 @@ TEST(Surface, RaycastAllOrdersSurfacesWithOtherBodies) {
   World w = make_world();
   const GeometryId m = mesh(w, kSquare, kSquareIndices);
   const GeometryId h = heightfield(w, tilted_heightfield());
-  const BodyId low = add(w, static_body(Shape::mesh(m), {0_fx, 0_fx, 0_fx}));
+  const BodyId low = add(w, test::static_placed(Shape::mesh(m), {0_fx, 0_fx, 0_fx}));
   // The heightfield above it, shifted so that x = z = 0 of the world is its sample (2, 2): there
   // its height is 2/4 - 2/2 + 1 = 0.5, so the surface is at y = 3.5 over the origin.
-  const BodyId high = add(w, static_body(Shape::heightfield(h), {-2_fx, 3_fx, -2_fx}));
+  const BodyId high = add(w, test::static_placed(Shape::heightfield(h), {-2_fx, 3_fx, -2_fx}));
   BodyDef ball;
   ball.shape = Shape::sphere(0.5_fx);
   ball.position = {0_fx, 10_fx, 0_fx};
@@ -326,7 +317,7 @@ TEST(Surface, RaycastAllOrdersSurfacesWithOtherBodies) {
 TEST(Surface, ARayStartingOnTheSurfaceHitsItAtZeroAndAPointNever) {
   World w = make_world();
   const GeometryId m = mesh(w, kSquare, kSquareIndices);
-  const BodyId body = add(w, static_body(Shape::mesh(m), {0_fx, 1_fx, 0_fx}));
+  const BodyId body = add(w, test::static_placed(Shape::mesh(m), {0_fx, 1_fx, 0_fx}));
   const Vec3 on{0.3_fx, 1_fx, 0.2_fx};
   const auto down = w.raycast_closest(on, {0_fx, -1_fx, 0_fx});
   ASSERT_TRUE(down.has_value());
@@ -351,8 +342,8 @@ TEST(Surface, OverlapQueriesSkipSurfacesFarAwayAndStillFindOtherBodies) {
   World w = make_world();
   const GeometryId m = mesh(w, kSquare, kSquareIndices);
   const GeometryId h = heightfield(w, tilted_heightfield());
-  const BodyId ground = add(w, static_body(Shape::mesh(m)));
-  const BodyId hill = add(w, static_body(Shape::heightfield(h), {10_fx, 0_fx, 0_fx}));
+  const BodyId ground = add(w, test::static_placed(Shape::mesh(m)));
+  const BodyId hill = add(w, test::static_placed(Shape::heightfield(h), {10_fx, 0_fx, 0_fx}));
   BodyDef ball;
   ball.shape = Shape::sphere(0.5_fx);
   ball.position = {0_fx, 0.25_fx, 0_fx};
@@ -381,7 +372,7 @@ TEST(Surface, ASurfaceNeedsAStaticBodyAndStaysStatic) {
   for (const auto& [shape, name] : {std::pair{Shape::mesh(m), std::string("triangle mesh")},
                                     std::pair{Shape::heightfield(h), std::string("heightfield")}}) {
     for (const BodyType type : {BodyType::dynamic, BodyType::kinematic}) {
-      BodyDef d = static_body(shape);
+      BodyDef d = test::static_placed(shape);
       d.type = type;
       const auto r = w.create_body(d);
       ASSERT_FALSE(r.ok());
@@ -389,7 +380,7 @@ TEST(Surface, ASurfaceNeedsAStaticBodyAndStaysStatic) {
           << r.message();
     }
     const std::size_t before = w.body_count();
-    const BodyId id = add(w, static_body(shape));
+    const BodyId id = add(w, test::static_placed(shape));
     EXPECT_EQ(w.body_count(), before + 1);
     const Status s = w.set_type(id, BodyType::dynamic);
     ASSERT_FALSE(s.ok());
@@ -398,8 +389,8 @@ TEST(Surface, ASurfaceNeedsAStaticBodyAndStaysStatic) {
     EXPECT_EQ(test::state(w, id).type, BodyType::static_body);
     EXPECT_FALSE(w.set_type(id, BodyType::kinematic).ok());
     // A shape of the wrong geometry type is refused, naming it.
-    const auto wrong = w.create_body(
-        static_body(shape.type == ShapeType::mesh ? Shape::mesh(h) : Shape::heightfield(m)));
+    const auto wrong = w.create_body(test::static_placed(
+        shape.type == ShapeType::mesh ? Shape::mesh(h) : Shape::heightfield(m)));
     ASSERT_FALSE(wrong.ok());
     EXPECT_NE(wrong.message().find("shape's geometry ID"), std::string::npos) << wrong.message();
   }
@@ -409,8 +400,8 @@ TEST(Surface, SaveAndRestoreNameTheMeshByItsHash) {
   World saved = make_world();
   const GeometryId m = mesh(saved, kSquare, kSquareIndices);
   const GeometryId h = heightfield(saved, tilted_heightfield());
-  add(saved, static_body(Shape::mesh(m), kAt, posed()));
-  add(saved, static_body(Shape::heightfield(h), {-10_fx, 0_fx, 0_fx}));
+  add(saved, test::static_placed(Shape::mesh(m), kAt, posed()));
+  add(saved, test::static_placed(Shape::heightfield(h), {-10_fx, 0_fx, 0_fx}));
   BodyDef ball;
   ball.shape = Shape::sphere(0.5_fx);
   ball.position = {20_fx, 3_fx, 0_fx};
@@ -461,7 +452,7 @@ TEST(Surface, SaveAndRestoreNameTheMeshByItsHash) {
 TEST(Surface, TheOutlineHoldsTheTrianglesPlaced) {
   World w = make_world();
   const GeometryId m = mesh(w, kSquare, kSquareIndices);
-  const BodyId body = add(w, static_body(Shape::mesh(m), kAt, posed()));
+  const BodyId body = add(w, test::static_placed(Shape::mesh(m), kAt, posed()));
   const auto out = w.body_outline(body);
   ASSERT_TRUE(out.ok()) << out.message();
   EXPECT_EQ(out->surface_triangles, 2U);
@@ -476,7 +467,7 @@ TEST(Surface, TheOutlineHoldsTheTrianglesPlaced) {
   big.columns = 102;
   big.cell_size = 0.5_fx;
   big.heights.assign(102 * 102, Fixed::zero());
-  const BodyId ground = add(w, static_body(Shape::heightfield(heightfield(w, big))));
+  const BodyId ground = add(w, test::static_placed(Shape::heightfield(heightfield(w, big))));
   const auto capped = w.body_outline(ground);
   ASSERT_TRUE(capped.ok());
   EXPECT_EQ(capped->surface_triangles, 2U * 101U * 101U);

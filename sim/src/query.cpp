@@ -23,6 +23,7 @@
 
 #include "collide.hpp"
 #include "collide_util.hpp"
+#include "query_util.hpp"
 #include "shapes.hpp"
 #include "world_state.hpp"
 
@@ -31,24 +32,12 @@ namespace detsim {
 namespace {
 
 using sim_detail::bounding_radius;
+using sim_detail::cull_slack;
 using sim_detail::Manifold;
+using sim_detail::passes;
 using sim_detail::Pose;
+using sim_detail::pose_of;
 using sim_detail::narrow::to_local;
-
-bool passes(const BodyState& b, const QueryFilter& f) noexcept {
-  return (b.layer & f.mask) != 0 && (f.layer & b.mask) != 0 && (!b.sensor || f.include_sensors);
-}
-
-Pose pose_of(const BodyState& b) noexcept {
-  return {b.position, to_mat3(b.orientation)};
-}
-
-/// A cull must never reject what the exact test would accept. The exact tests see the same
-/// quantities after a few more roundings of at most a few ulps of the shape's size plus 2^-32 of
-/// the distance travelled; 2^-10 m plus 2^-24 of the distance is far above both and still tight.
-Fixed cull_slack(Fixed distance) noexcept {
-  return Fixed::from_raw(Fixed::one_raw >> 10) + (abs(distance) >> 24);
-}
 
 struct Ray {
   Vec3 origin;

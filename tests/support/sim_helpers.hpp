@@ -51,6 +51,14 @@ inline BodyDef placed(Shape shape, Vec3 position, Quat orientation = {}) {
   return d;
 }
 
+/// A static body of `shape` placed at `position` turned by `orientation`, every other field
+/// default.
+inline BodyDef static_placed(Shape shape, Vec3 position = {}, Quat orientation = {}) {
+  BodyDef d = placed(shape, position, orientation);
+  d.type = BodyType::static_body;
+  return d;
+}
+
 /// The 12-point rock of the hull tests: points of Rng(9) on an ellipsoid of semi-axes 0.6, 0.4,
 /// 0.5 m.
 inline std::vector<Vec3> test_rock() {
@@ -69,6 +77,16 @@ inline testing::AssertionResult near(Fixed actual, Fixed expected, Fixed toleran
   if (abs(actual - expected) <= tolerance) return testing::AssertionSuccess();
   return testing::AssertionFailure() << "actual " << to_string(actual) << ", expected "
                                      << to_string(expected) << " +- " << to_string(tolerance);
+}
+
+/// Each component of `actual` within `tolerance` of `expected`'s, printing both on failure.
+inline testing::AssertionResult near_vec(Vec3 actual, Vec3 expected, Fixed tolerance) {
+  if (near(actual.x, expected.x, tolerance) && near(actual.y, expected.y, tolerance) &&
+      near(actual.z, expected.z, tolerance))
+    return testing::AssertionSuccess();
+  return testing::AssertionFailure()
+         << testing::PrintToString(actual) << " is not within " << to_string(tolerance) << " of "
+         << testing::PrintToString(expected);
 }
 
 }  // namespace detsim::test

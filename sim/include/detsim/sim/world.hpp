@@ -129,6 +129,7 @@ struct QueryFilter {
   std::uint32_t layer = 0xFFFFFFFFU;
   std::uint32_t mask = 0xFFFFFFFFU;
   bool include_sensors = false;
+  BodyId ignore{};  ///< a body to leave out (a character's or a vehicle's own), or none
 };
 
 /// Where a ray met a body.
@@ -139,6 +140,34 @@ struct RayHit {
   Fixed fraction{};  ///< of the ray's translation, 0 .. 1
 
   friend constexpr bool operator==(const RayHit&, const RayHit&) noexcept = default;
+};
+
+/// Where a moving shape first met a body (World::shape_cast).
+struct ShapeHit {
+  BodyId body{};
+  /// Of the cast's translation, 0 .. 1: the shape placed at position + fraction * translation is
+  /// apart from the body by at most the world's linear_slop (and, unless it started so, never
+  /// overlaps it).
+  Fixed fraction{};
+  Vec3 point{};   ///< world space, on the body's surface where the shape met it
+  Vec3 normal{};  ///< unit, out of the body towards the shape (against the motion)
+
+  friend constexpr bool operator==(const ShapeHit&, const ShapeHit&) noexcept = default;
+};
+
+/// A body in touch with a shape (World::shape_contacts, World::contacts_of): one per touching
+/// sub-shape pair, so a body of parts or triangles (a compound, a mesh, a heightfield) may give
+/// several, each with its own normal (a stair's tread and riser).
+struct ShapeContact {
+  BodyId body{};
+  std::uint32_t sub_shape = 0;  ///< the body's part or triangle patch (0 for a whole shape)
+  /// Unit, out of the body towards the shape: moving the shape by depth * normal separates them.
+  Vec3 normal{};
+  Fixed depth{};  ///< how far they overlap along the normal, >= 0 (0: the surfaces touch)
+  std::uint8_t point_count = 0;  ///< 1 .. 4
+  std::array<Vec3, 4> points{};  ///< world space, midway between the surfaces; first point_count
+
+  friend constexpr bool operator==(const ShapeContact&, const ShapeContact&) noexcept = default;
 };
 
 /// Where a ray met a particle (World::raycast_particles).
@@ -380,6 +409,28 @@ class World {
   /// create_body would refuse overlaps nothing: the result is empty.
   [[nodiscard]] std::vector<BodyId> overlap(const Shape& shape, Vec3 position, Quat orientation,
                                             const QueryFilter& filter = {}) const;
+
+  /// The first body that `shape`, placed at `position` with `orientation`, meets when moved along
+  /// `translation` without turning (the lowest fraction; ties go to the lower ID), or nothing.
+  /// What a character or a wheel asks before it moves. Bodies the shape already touches or
+  /// overlaps at the start are hit at fraction 0 only where the motion goes deeper into them; a
+  /// shape resting on a floor and cast along it meets the walls ahead, not the floor it slides on.
+  /// The cast shape is a sphere, box, capsule, cylinder or convex hull (a compound is not cast),
+  /// valid by overlap()'s rules; anything else, or a zero translation, meets nothing. It meets
+  /// every shape. Against convex bodies it never passes one (docs/SIM.md, "Queries").
+  [[nodiscard]] std::optional<ShapeHit> shape_cast(const Shape& shape, Vec3 position,
+                                                   Quat orientation, Vec3 translation,
+                                                   const QueryFilter& filter = {}) const;
+  /// Every body in touch with `shape` placed at `position` with `orientation` (surfaces touching
+  /// or overlapping), with the normal, depth and points of each touch, ascending by (body,
+  /// sub_shape). The same shape and orientation rules as overlap(): anything else touches nothing.
+  [[nodiscard]] std::vector<ShapeContact> shape_contacts(const Shape& shape, Vec3 position,
+                                                         Quat orientation,
+                                                         const QueryFilter& filter = {}) const;
+  /// What touches body `id` now: shape_contacts of its shape at its pose, against the bodies its
+  /// layer and mask collide with (sensors and itself left out). The normals point out of each
+  /// other body towards this one. An error for an unknown ID.
+  [[nodiscard]] Expected<std::vector<ShapeContact>> contacts_of(BodyId id) const;
 
   // ---- The game's own state (<detsim/sim/game_state.hpp>) ----
 
