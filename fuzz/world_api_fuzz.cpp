@@ -1,9 +1,9 @@
 // libFuzzer target for the World's API: the input is a hostile WorldDef and a sequence of calls
-// (create_body with any shape, size, mass, density, velocity and orientation, destroy_body,
-// set_type, set_transform, set_*_velocity, the forces and impulses, wake, step, save, restore,
-// create_joint with any type, bodies, anchor, axis, limits, motor, lengths, spring and break
-// thresholds, destroy_joint, set_joint_motor, the geometry registrations, and the particle groups:
-// create_rope, create_cloth, create_soft_body with any values, apply_particle_force,
+// (create_body with any shape, size, mass, density, velocity, orientation and axis locks,
+// destroy_body, set_type, set_transform, set_*_velocity, the forces and impulses, wake, step, save,
+// restore, create_joint with any type, bodies, anchor, axis, limits, motor, lengths, spring and
+// break thresholds, destroy_joint, set_joint_motor, the geometry registrations, and the particle
+// groups: create_rope, create_cloth, create_soft_body with any values, apply_particle_force,
 // destroy_particle_group; the queries raycast_particles, shape_cast, shape_contacts and
 // contacts_of with any shape and pose; and the game's own state: set_game_state of any size,
 // describe_game_state with good and bad fields, set_user_data).
@@ -284,6 +284,8 @@ BodyDef body_def(Input& in) {
     const std::uint8_t flags = in.byte();
     def.sensor = (flags & 1U) != 0;
     def.ccd = (flags & 2U) != 0;
+    def.lock_translation = {(flags & 4U) != 0, (flags & 8U) != 0, (flags & 16U) != 0};
+    def.lock_rotation = {(flags & 32U) != 0, (flags & 64U) != 0, (flags & 128U) != 0};
     def.user_data = in.u64();
   }
   return def;

@@ -9,6 +9,7 @@
 // - what is shared or zero is not written: the structural facts a smaller encoding rests on.
 //
 // Worlds are built through the public API only.
+#include <array>
 #include <cstdint>
 #include <initializer_list>
 #include <limits>
@@ -312,12 +313,28 @@ TEST_F(CanonicalRestore, UnknownFlagBits) {
     expect_refused_at(encode(d), {sphere.at, sphere.flags_at},
                       "body flag bit " + std::to_string(bit));
   }
+}
+
+// Every bit of a property set's flags has a meaning: sensor, CCD, then the six axis locks in
+// order (translation x, y, z, rotation x, y, z). Each lock bit restores as that lock alone.
+TEST_F(CanonicalRestore, PropertyFlagBitsAreTheLocks) {
+  const DecodedBody& sphere = decoded_.bodies[1];
   const DecodedSet& set = decoded_.sets[static_cast<std::size_t>(sphere.set)];
-  const std::size_t set_flags_at = set.end - 1;
-  for (const int bit : {0x04, 0x08, 0x80}) {
+  ASSERT_EQ(set.flags & ~(kSensor | kCcd), 0);
+  for (int k = 0; k < 6; ++k) {
     Decoded d = decoded_;
-    d.sets[static_cast<std::size_t>(sphere.set)].flags = static_cast<std::uint8_t>(set.flags | bit);
-    expect_refused_at(encode(d), {set.at, set_flags_at}, "set flag bit " + std::to_string(bit));
+    d.sets[static_cast<std::size_t>(sphere.set)].flags =
+        static_cast<std::uint8_t>(set.flags | (kLockTranslationX << k));
+    expect_accepted(encode(d), "lock bit " + std::to_string(k));
+    World w;
+    ASSERT_TRUE(w.restore(encode(d)).ok());
+    const auto b = w.body(w.body_ids()[1]);
+    ASSERT_TRUE(b.ok()) << b.message();
+    const std::array<bool, 6> locks{b->lock_translation_x, b->lock_translation_y,
+                                    b->lock_translation_z, b->lock_rotation_x,
+                                    b->lock_rotation_y,    b->lock_rotation_z};
+    for (int m = 0; m < 6; ++m)
+      EXPECT_EQ(locks[static_cast<std::size_t>(m)], m == k) << "bit " << k << ", lock " << m;
   }
 }
 

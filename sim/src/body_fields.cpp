@@ -64,6 +64,14 @@ constexpr std::array kFields{
     field("mask", property, &BodyState::mask),
     field("sensor", property, &BodyState::sensor),
     field("ccd", property, &BodyState::ccd),
+    // Bits 2..7 of the property flags (added without a new version: a body without locks
+    // encodes as before, and an older reader refuses the bits, naming the ones it knows).
+    field("lock_translation_x", property, &BodyState::lock_translation_x),
+    field("lock_translation_y", property, &BodyState::lock_translation_y),
+    field("lock_translation_z", property, &BodyState::lock_translation_z),
+    field("lock_rotation_x", property, &BodyState::lock_rotation_x),
+    field("lock_rotation_y", property, &BodyState::lock_rotation_y),
+    field("lock_rotation_z", property, &BodyState::lock_rotation_z),
     field("user_data", motion, &BodyState::user_data, true),
     field("awake", motion, &BodyState::awake),
     field("sleep_time", motion, &BodyState::sleep_time),

@@ -63,8 +63,22 @@ void prepare_body(WorldState& s, std::size_t i) {
     d.inverse_inertia_world = rotate_inertia(
         principal, Mat3::diagonal(inverse_or_zero(b.inertia.x), inverse_or_zero(b.inertia.y),
                                   inverse_or_zero(b.inertia.z)));
+    d.translation_locks = b.translation_locks();
+    d.rotation_locks = b.rotation_locks();
+    if (d.rotation_locks.any()) {
+      // P I^-1 P: the locked rows and columns zeroed.
+      Mat3& m = d.inverse_inertia_world;
+      for (std::size_t r = 0; r < 3; ++r)
+        m.rows[r] = without_locked(m.rows[r], d.rotation_locks);
+      const AxisLocks& l = d.rotation_locks;
+      if (l.x) m.rows[0] = Vec3::zero();
+      if (l.y) m.rows[1] = Vec3::zero();
+      if (l.z) m.rows[2] = Vec3::zero();
+    }
   } else {
     d.inverse_inertia_world = Mat3::zero();
+    d.translation_locks = {};
+    d.rotation_locks = {};
   }
   const ShapeKind& shape = shape_kind(b.shape.type);
   const Geometry* g = s.geometry(b.shape);

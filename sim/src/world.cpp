@@ -116,6 +116,12 @@ Expected<BodyId> World::create_body(const BodyDef& def) {
   b.mask = def.mask;
   b.sensor = def.sensor;
   b.ccd = def.ccd;
+  b.lock_translation_x = def.lock_translation.x;
+  b.lock_translation_y = def.lock_translation.y;
+  b.lock_translation_z = def.lock_translation.z;
+  b.lock_rotation_x = def.lock_rotation.x;
+  b.lock_rotation_y = def.lock_rotation.y;
+  b.lock_rotation_z = def.lock_rotation.z;
   b.user_data = def.user_data;
   b.awake = def.type != BodyType::static_body;
   s_->bodies.push_back(b);  // IDs only grow: appending keeps the order

@@ -81,7 +81,13 @@ struct Derived {
   /// centre is its origin (every primitive) it is the position, bit for bit.
   Vec3 center;
   Fixed inverse_mass;
-  Mat3 inverse_inertia_world;  ///< R I^-1 R^T; zero unless dynamic
+  /// R I^-1 R^T; zero unless dynamic. A locked rotation axis k zeroes row and column k (P I^-1 P
+  /// with P the projection on the free axes), so no impulse turns the body about it.
+  Mat3 inverse_inertia_world;
+  /// BodyState's lock_translation_* of a dynamic body (none otherwise): its rows' linear
+  /// responses and shares of effective mass leave the locked world axes out (solver/rows.hpp).
+  AxisLocks translation_locks;
+  AxisLocks rotation_locks;
   Vec3 aabb_min;
   Vec3 aabb_max;
   bool infinite = false;  ///< a plane: bounded by nothing
@@ -153,6 +159,12 @@ struct WorldState {
 struct WorldAccess {
   [[nodiscard]] static const WorldState& of(const World& w) noexcept { return *w.s_; }
 };
+
+/// v without its components along the locked axes.
+[[nodiscard]] inline Vec3 without_locked(Vec3 v, AxisLocks locks) noexcept {
+  return {locks.x ? Fixed::zero() : v.x, locks.y ? Fixed::zero() : v.y,
+          locks.z ? Fixed::zero() : v.z};
+}
 
 /// Definition checks shared by World::create, create_body and restore. Empty string: valid.
 [[nodiscard]] std::string check_world_def(const WorldDef& def);

@@ -15,14 +15,15 @@
 // var of the zigzag raw value. A set: type u8, shape (type u8, then its vfixed sizes, or a convex
 // hull's, mesh's or heightfield's geometry ID var), mass, inertia, centre of mass (vec3), inertia
 // axes (quat), friction, restitution, linear and angular damping (vfixed), layer u32, mask u32,
-// flags u8 (sensor, CCD). A body: ID step var, set index var, flags u8 (awake, user data, force,
-// torque follow), position, orientation, velocities, sleep time (vfixed), then the flagged values.
-// A contact: a step var, b - a var, point byte (count in bits 0-2, reported in bit 3), then per
-// point: feature on a, feature on b (var: index * 4 + kind), three impulses (vfixed). A joint: ID
-// step var, type u8 (0-5), body a var, body b var, flags u8 (limit enabled, motor enabled, collide
-// connected, broken, user data follows), anchor, axis (vec3), eleven definition numbers (vfixed),
-// local anchors a and b, local axes a and b (vec3), relative orientation (quat), length (vfixed),
-// linear and angular impulse (vec3), axial, motor and limit impulse (vfixed), then the user data.
+// flags u8 (sensor, CCD, then the locks: translation x, y, z, rotation x, y, z). A body: ID step
+// var, set index var, flags u8 (awake, user data, force, torque follow), position, orientation,
+// velocities, sleep time (vfixed), then the flagged values. A contact: a step var, b - a var, point
+// byte (count in bits 0-2, reported in bit 3), then per point: feature on a, feature on b (var:
+// index * 4 + kind), three impulses (vfixed). A joint: ID step var, type u8 (0-5), body a var, body
+// b var, flags u8 (limit enabled, motor enabled, collide connected, broken, user data follows),
+// anchor, axis (vec3), eleven definition numbers (vfixed), local anchors a and b, local axes a and
+// b (vec3), relative orientation (quat), length (vfixed), linear and angular impulse (vec3), axial,
+// motor and limit impulse (vfixed), then the user data.
 //
 // decode() is strict about what the layout itself says (canonical vars, enum values, flag bits,
 // zero values flagged present, set order and use, ID and pair order, point bytes, features) and
@@ -76,6 +77,7 @@ inline constexpr std::uint8_t kHasTorque = 8;
 // Property-set flags.
 inline constexpr std::uint8_t kSensor = 1;
 inline constexpr std::uint8_t kCcd = 2;
+inline constexpr std::uint8_t kLockTranslationX = 4;  // then y 8, z 16, rotation x 32, y 64, z 128
 // A contact's point byte.
 inline constexpr std::uint8_t kPointCountBits = 7;
 inline constexpr std::uint8_t kReported = 8;
@@ -182,7 +184,7 @@ struct DecodedSet {
   Fixed angular_damping{};
   std::uint32_t layer = 1;
   std::uint32_t mask = 0xFFFFFFFFU;
-  std::uint8_t flags = 0;  // kSensor, kCcd
+  std::uint8_t flags = 0;  // kSensor, kCcd, the locks from kLockTranslationX
   // Filled by decode(), ignored by encode():
   std::size_t at = 0;
   std::size_t mass_at = 0;
@@ -492,7 +494,7 @@ inline DecodedSet read_set(StateReader& r) {
   s.mask = r.u32("mask");
   const std::size_t flags_at = r.at();
   s.flags = r.u8("set flags");
-  if ((s.flags & ~(kSensor | kCcd)) != 0) r.fail(flags_at, "set flags: an unknown bit");
+  (void)flags_at;  // every bit has a meaning: sensor, CCD and the six locks
   s.end = r.at();
   return s;
 }

@@ -297,7 +297,7 @@ void ParticleStepper::apply_pushes() {
   for (std::uint32_t i : pushed_) {
     const Derived& d = s_.derived[i];
     Velocity& v = bodies_.velocities[i];
-    v.linear += pushes_[i].linear * d.inverse_mass;
+    v.linear += without_locked(pushes_[i].linear, d.translation_locks) * d.inverse_mass;
     v.angular += d.inverse_inertia_world * pushes_[i].angular;
     pushes_[i] = {};
   }

@@ -95,6 +95,10 @@ void SolverBodies::integrate_velocities() {
     if (!awake_dynamic(b)) continue;
     const Derived& d = s.derived[i];
     Velocity& v = velocities[i];
+    // Locked axes (BodyDef::lock_translation, lock_rotation): a velocity the game set along them
+    // is dropped here, and gravity and the force below; the solver's rows keep them at zero.
+    if (d.translation_locks.any()) v.linear = without_locked(v.linear, d.translation_locks);
+    if (d.rotation_locks.any()) v.angular = without_locked(v.angular, d.rotation_locks);
     // Without a force, the kick is gravity's (g + 0 m = g exactly), the same for every body; a
     // zero torque adds exactly zero (M 0 h = 0).
     const Vec3 start = v.linear;
@@ -104,6 +108,7 @@ void SolverBodies::integrate_velocities() {
       v.linear += (def.gravity + b.force * d.inverse_mass) * h;
     }
     if (b.torque != Vec3{}) v.angular += (d.inverse_inertia_world * b.torque) * h;
+    if (d.translation_locks.any()) v.linear = without_locked(v.linear, d.translation_locks);
     // Implicit damping, unconditionally stable: v /= 1 + h c.
     if (b.linear_damping > Fixed::zero()) v.linear /= Fixed::one() + h * b.linear_damping;
     if (b.angular_damping > Fixed::zero()) v.angular /= Fixed::one() + h * b.angular_damping;

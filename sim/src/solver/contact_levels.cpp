@@ -110,7 +110,8 @@ void ContactSolver::hold() {
       const std::size_t upper = a_upper ? k.bodies.a : k.bodies.b;
       const Fixed angular = a_upper ? dot(sp.normal.response_a, sp.normal.angular_a)
                                     : dot(sp.normal.response_b, sp.normal.angular_b);
-      const Fixed mass = inverse_or_zero(s_.derived[upper].inverse_mass + angular);
+      const Fixed mass =
+          inverse_or_zero(linear_share(s_.derived[upper], k.normal.linear_b) + angular);
       const Fixed impulse = -mass * (vn + allowed);
       k.pushed = true;
       BodyPair one_side = k.bodies;

@@ -63,7 +63,8 @@ namespace {
   r.response_b = r.response_b * share;
   const Fixed angular =
       DotSum{}.add(r.response_a, r.angular_a).add(r.response_b, r.angular_b).result();
-  r.mass = inverse_or_zero(a.inverse_mass + b.inverse_mass + angular);
+  const Vec3 n = k.normal.linear_b;
+  r.mass = inverse_or_zero(linear_share(a, n) + linear_share(b, n) + angular);
   return r;
 }
 

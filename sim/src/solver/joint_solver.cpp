@@ -59,6 +59,8 @@
 // sub-step, no further.
 #include "joint_solver.hpp"
 
+#include <array>
+
 #include <detsim/fixed/math.hpp>
 
 namespace detsim::sim_detail {
@@ -114,13 +116,25 @@ Row block_row(const Derived& a, const Derived& b, Vec3 ra, Vec3 rb, Vec3 d) {
 
 const Direction no_direction{};
 
+// A block whose bodies cannot move along one of its rows (a locked axis: BodyDef::lock_translation
+// or lock_rotation) has a zero diagonal entry there, and since the block is positive semi-definite
+// its whole row and column are zero: no impulse along it can do anything. A unit diagonal entry
+// there leaves the other rows' inverse as it was and makes the block invertible (its own impulse
+// then moves nothing). A block without such a row is returned as it is, bit for bit.
+Mat3 immobile_rows_unit(Mat3 K) {
+  if (K.rows[0].x == Fixed::zero()) K.rows[0].x = Fixed::one();
+  if (K.rows[1].y == Fixed::zero()) K.rows[1].y = Fixed::one();
+  if (K.rows[2].z == Fixed::zero()) K.rows[2].z = Fixed::one();
+  return K;
+}
+
 // The inverse of the symmetric 2x2 block [[k11, k12], [k12, k22]], as the upper left of a 3x3
 // with a unit third row and column: each entry the exact cofactor over the exact determinant
 // (try_inverse), however small the block is.
 Mat3 inverse_2x2(Fixed k11, Fixed k12, Fixed k22) {
   const Mat3 K{{Vec3{k11, k12, Fixed::zero()}, Vec3{k12, k22, Fixed::zero()},
                 Vec3{Fixed::zero(), Fixed::zero(), Fixed::one()}}};
-  return inverse(K);
+  return inverse(immobile_rows_unit(K));
 }
 
 }  // namespace
@@ -240,7 +254,7 @@ void JointSolver::prepare_weld(JointConstraint& k) {
     }
     K.rows[i] = {entries[0], entries[1], entries[2]};
   }
-  k.weld_mass = inverse(K);
+  k.weld_mass = inverse(immobile_rows_unit(K));
 }
 
 // The anchors, the rows and the position error at the bodies' present poses. `held`: a tree
@@ -306,7 +320,7 @@ void JointSolver::update_geometry(JointConstraint& k, bool held) {
     const Mat3 K{{Vec3{entries[0][0], entries[0][1], Fixed::zero()},
                   Vec3{entries[1][0], entries[1][1], Fixed::zero()},
                   Vec3{Fixed::zero(), Fixed::zero(), Fixed::one()}}};
-    k.angular_mass = inverse(K);
+    k.angular_mass = inverse(immobile_rows_unit(K));
     const Vec3 misalignment = cross(k.axis_a, k.axis_b);
     k.angular_error_1 = dot(misalignment, k.across[0]);
     k.angular_error_2 = dot(misalignment, k.across[1]);
@@ -357,8 +371,10 @@ void JointSolver::update_geometry(JointConstraint& k, bool held) {
     for (std::size_t i = 0; i < 3; ++i)
       k.rows[i] = block_row(da, db, k.anchor_a, k.anchor_b, axis(i));
     // K_ij = (m_a^-1 + m_b^-1) d_i . d_j + angular_i . response_j on each side; the directions
-    // are the world axes, so the linear part is diagonal.
-    const Fixed linear = da.inverse_mass + db.inverse_mass;
+    // are the world axes, so the linear part is diagonal (a locked axis's share zero).
+    const std::array<Fixed, 3> linear_shares{linear_share(da, axis(0)) + linear_share(db, axis(0)),
+                                             linear_share(da, axis(1)) + linear_share(db, axis(1)),
+                                             linear_share(da, axis(2)) + linear_share(db, axis(2))};
     Mat3 K;
     for (std::size_t i = 0; i < 3; ++i) {
       Fixed entries[3];
@@ -367,15 +383,15 @@ void JointSolver::update_geometry(JointConstraint& k, bool held) {
         const Row& rc = k.rows[c];
         entries[c] =
             DotSum{}.add(ri.angular_a, rc.response_a).add(ri.angular_b, rc.response_b).result();
-        if (c == i) entries[c] += linear;
+        if (c == i) entries[c] += linear_shares[i];
       }
       K.rows[i] = {entries[0], entries[1], entries[2]};
     }
-    k.point_k = K;
+    k.point_k = immobile_rows_unit(K);
     const bool swings = k.type == JointType::swing_twist && j.def.limit_enabled;
     // K is positive definite: one body is dynamic. A tree's joint without twist or swing rows
     // never reads its inverse.
-    if (!held || twists || swings) k.point_mass = inverse(K);
+    if (!held || twists || swings) k.point_mass = inverse(k.point_k);
     // An angular row's coupling to the point rows, b_i = J_point_i M^-1 J_row^T (the row has no
     // linear part), as K^-1 b, and the row's effective mass with the point rows held,
     // 1 / (c - b . K^-1 b).

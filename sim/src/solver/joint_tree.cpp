@@ -46,8 +46,7 @@ constexpr std::uint32_t none = ~std::uint32_t{0};
 // rows' linear parts on P are -e_i on body a, e_i on body b; their angular parts and responses
 // are the rows'.
 Mat3 coupling(const JointConstraint& j, bool j_a, const JointConstraint& k, bool k_a,
-              Fixed inverse_mass) {
-  const Fixed linear = j_a == k_a ? inverse_mass : -inverse_mass;
+              const Derived& body) {
   Mat3 m;
   for (std::size_t i = 0; i < 3; ++i) {
     const Vec3 angular = j_a ? j.rows[i].angular_a : j.rows[i].angular_b;
@@ -55,7 +54,13 @@ Mat3 coupling(const JointConstraint& j, bool j_a, const JointConstraint& k, bool
     for (std::size_t c = 0; c < 3; ++c) {
       const Vec3 response = k_a ? k.rows[c].response_a : k.rows[c].response_b;
       entries[c] = DotSum{}.add(angular, response).result();
-      if (c == i) entries[c] += linear;
+      if (c == i) {
+        // The world axis e_i's linear share: m^-1, or 0 along a locked axis (rows.hpp).
+        Vec3 e;
+        (i == 0 ? e.x : i == 1 ? e.y : e.z) = Fixed::one();
+        const Fixed share = linear_share(body, e);
+        entries[c] += j_a == k_a ? share : -share;
+      }
     }
     m.rows[i] = {entries[0], entries[1], entries[2]};
   }
@@ -204,10 +209,10 @@ void JointTrees::update_couplings(const std::vector<JointConstraint>& constraint
                                   const WorldState& s) {
   for (const Node& node : nodes_) {
     const JointConstraint& k = constraints[node.constraint];
-    const Fixed inverse_mass = s.derived[node.body].inverse_mass;
+    const Derived& body = s.derived[node.body];
     for (std::uint32_t l = node.links_begin; l < node.links_end; ++l) {
       const JointConstraint& o = constraints[nodes_[links_[l].node].constraint];
-      links_[l].coupling = coupling(k, node.body_is_a, o, o.bodies.a == node.body, inverse_mass);
+      links_[l].coupling = coupling(k, node.body_is_a, o, o.bodies.a == node.body, body);
     }
   }
   soft_factor_.valid = false;

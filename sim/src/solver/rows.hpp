@@ -94,9 +94,24 @@ inline Softness make_soft(Fixed hertz, Fixed zeta, Fixed h) {
   return {omega / a1, a2 * a3, a3};
 }
 
+/// A body's linear response to a unit impulse along d, M^-1 d: d m^-1, with the components
+/// along its locked translation axes (BodyDef::lock_translation) zero.
+inline Vec3 linear_response(const Derived& b, Vec3 d) {
+  if (!b.translation_locks.any()) return d * b.inverse_mass;
+  return without_locked(d, b.translation_locks) * b.inverse_mass;
+}
+
+/// A body's linear share of the effective mass of a row along unit d, d . M^-1 d: m^-1, or with
+/// locked translation axes m^-1 times the square of d's free part.
+inline Fixed linear_share(const Derived& b, Vec3 d) {
+  if (!b.translation_locks.any()) return b.inverse_mass;
+  const Vec3 free = without_locked(d, b.translation_locks);
+  return dot(free, d) * b.inverse_mass;
+}
+
 /// The linear parts of the rows of direction d.
 inline Direction make_direction(const Derived& a, const Derived& b, Vec3 d) {
-  return {-d, d, -d * a.inverse_mass, d * b.inverse_mass};
+  return {-d, d, -linear_response(a, d), linear_response(b, d)};
 }
 
 /// The row of direction d at anchors r_a and r_b, with its effective mass
@@ -109,7 +124,7 @@ inline Row make_row(const Derived& a, const Derived& b, Vec3 ra, Vec3 rb, Vec3 d
   r.response_b = b.inverse_inertia_world * r.angular_b;
   const Fixed angular =
       DotSum{}.add(r.response_a, r.angular_a).add(r.response_b, r.angular_b).result();
-  r.mass = inverse_or_zero(a.inverse_mass + b.inverse_mass + angular);
+  r.mass = inverse_or_zero(linear_share(a, d) + linear_share(b, d) + angular);
   return r;
 }
 

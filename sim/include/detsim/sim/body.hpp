@@ -29,6 +29,21 @@ enum class BodyType : std::uint8_t {
 };
 
 /// Everything needed to create a body. Plain data with defaults; recordable.
+/// World axes along which a dynamic body may not move (BodyDef::lock_translation) or about which
+/// it may not turn (BodyDef::lock_rotation). The solver treats a locked axis as infinite mass or
+/// inertia along it, exactly: no impulse, force, gravity or push moves the body that way, and a
+/// velocity component along it (one set with the body, or later) is dropped at the next step. A
+/// planar game (2D in 3D) locks z translation and x and y rotation; an upright character locks
+/// rotation about x and z. Saved and hashed (the body's lock_* fields).
+struct AxisLocks {
+  bool x = false;
+  bool y = false;
+  bool z = false;
+
+  [[nodiscard]] constexpr bool any() const noexcept { return x || y || z; }
+  friend constexpr bool operator==(AxisLocks, AxisLocks) noexcept = default;
+};
+
 struct BodyDef {
   BodyType type = BodyType::dynamic;
   Shape shape = Shape::sphere(Fixed::half());
@@ -49,8 +64,10 @@ struct BodyDef {
   /// Collision filtering: a and b collide when (a.layer & b.mask) and (b.layer & a.mask).
   std::uint32_t layer = 1;
   std::uint32_t mask = 0xFFFFFFFFU;
-  bool sensor = false;  ///< reports overlaps as events, makes no contact response
-  bool ccd = false;     ///< continuous collision against everything, whatever its speed
+  bool sensor = false;           ///< reports overlaps as events, makes no contact response
+  bool ccd = false;              ///< continuous collision against everything, whatever its speed
+  AxisLocks lock_translation{};  ///< world axes the body does not move along
+  AxisLocks lock_rotation{};     ///< world axes the body does not turn about
   std::uint64_t user_data = 0;
 
   friend constexpr bool operator==(const BodyDef&, const BodyDef&) noexcept = default;

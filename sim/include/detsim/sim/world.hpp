@@ -59,6 +59,13 @@ struct BodyState {
   std::uint32_t mask = 0xFFFFFFFFU;
   bool sensor = false;
   bool ccd = false;
+  /// BodyDef::lock_translation and lock_rotation, one flag per world axis.
+  bool lock_translation_x = false;
+  bool lock_translation_y = false;
+  bool lock_translation_z = false;
+  bool lock_rotation_x = false;
+  bool lock_rotation_y = false;
+  bool lock_rotation_z = false;
   std::uint64_t user_data = 0;
   bool awake = true;
   Fixed sleep_time{};  ///< seconds the body has been slow enough to sleep
@@ -68,6 +75,12 @@ struct BodyState {
   /// The centre of mass in world space: position + orientation * center_of_mass. linear_velocity
   /// is this point's velocity.
   [[nodiscard]] Vec3 world_center() const noexcept;
+  [[nodiscard]] constexpr AxisLocks translation_locks() const noexcept {
+    return {lock_translation_x, lock_translation_y, lock_translation_z};
+  }
+  [[nodiscard]] constexpr AxisLocks rotation_locks() const noexcept {
+    return {lock_rotation_x, lock_rotation_y, lock_rotation_z};
+  }
 
   friend constexpr bool operator==(const BodyState&, const BodyState&) noexcept = default;
 };
