@@ -41,9 +41,7 @@
 #include <detsim/fixed/vec3.hpp>
 
 #include "collide.hpp"
-#include "geometry/convex.hpp"
-#include "geometry/convex_internal.hpp"
-#include "geometry/geometry.hpp"
+#include "gap.hpp"
 #include "query_util.hpp"
 #include "shapes.hpp"
 #include "world_state.hpp"
@@ -54,8 +52,11 @@ namespace {
 
 using sim_detail::bounding_radius;
 using sim_detail::collide_all;
+using sim_detail::convex_gap;
+using sim_detail::convex_view;
 using sim_detail::ConvexView;
 using sim_detail::cull_slack;
+using sim_detail::Gap;
 using sim_detail::Geometry;
 using sim_detail::passes;
 using sim_detail::Pose;
@@ -66,21 +67,6 @@ using sim_detail::SubManifold;
 using sim_detail::WorldState;
 
 constexpr int max_cast_iterations = 32;
-
-/// The convex view of a shape, if it has one (sphere, box, capsule, cylinder, hull).
-std::optional<ConvexView> convex_view(const Shape& shape, const Geometry* g) {
-  switch (shape.type) {
-    case ShapeType::sphere:
-    case ShapeType::box:
-    case ShapeType::capsule:
-    case ShapeType::cylinder:
-      return ConvexView::of(shape);
-    case ShapeType::convex:
-      return ConvexView::of_hull(g->hull());
-    default:
-      return std::nullopt;
-  }
-}
 
 /// The query shape, checked: the rules of a moving body's shape (so never a plane) and of
 /// create_body's orientations. nullopt when it breaks them (the query then finds nothing).
@@ -149,39 +135,6 @@ void touches_of(const WorldState& s, const Query& query, const BodyState& b,
   }
 }
 
-/// A pair of the cast shape and a body (or one of its sub-shapes) as measured at one t: a lower
-/// bound of their distance, the direction it is measured along (unit, from the cast shape into
-/// the body) and the point of the body's surface nearest the cast shape.
-struct Gap {
-  Fixed separation;
-  Vec3 normal;
-  Vec3 point;
-};
-
-/// Two convex shapes: GJK's closest points give the direction n, and the gap between the shapes'
-/// projections on n is the lower bound (exactly linear in t along a fixed n, so the tangent step
-/// is exact; GJK's own |v| bounds the distance from above, not below). Cores that meet have no
-/// closest points: the narrowphase's normal and depth then.
-Gap convex_gap(const ConvexView& va, const Pose& pa, const ConvexView& vb, const Pose& pb,
-               const PosedShape& a, const PosedShape& b) {
-  using namespace sim_detail::convex;
-  const Vec3 origin = pa.position;
-  const Body ba = make_body(va, pa, origin);
-  const Body bb = make_body(vb, pb, origin);
-  const Closest c = gjk_closest(ba, bb);
-  if (c.overlap || c.on_b == c.on_a) {
-    const sim_detail::Manifold m = sim_detail::collide(a, b, Fixed::zero());
-    if (m.count == 0) return {Fixed::zero(), Vec3::zero(), origin};  // touching: no direction
-    const Nearest n = nearest_point(m);
-    const sim_detail::ContactPoint& p = m.points[n.index];
-    return {n.separation, m.normal, p.point + m.normal * (p.separation >> 1)};
-  }
-  const Vec3 n = normalize(c.on_b - c.on_a);
-  const Fixed gap =
-      dot(n, support_at(bb, -n).point - support_at(ba, n).point) - ba.radius - bb.radius;
-  return {gap, n, origin + c.on_b - n * bb.radius};
-}
-
 /// The earliest fraction at which the cast of `query` along `translation` (length `travel`)
 /// meets body b, below `before`, or nothing.
 std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query, Vec3 translation,
@@ -218,8 +171,8 @@ std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query, Ve
     Fixed advance = covers_rest ? Fixed::one() : (margin - half_target) / travel;
     gaps.clear();
     if (body_view) {
-      gaps.push_back(convex_gap(*query.view, at, *body_view, pose,
-                                {query.shape, query.geometry, at}, {b.shape, g, pose}));
+      gaps.push_back(convex_gap({query.shape, query.geometry, at}, *query.view, {b.shape, g, pose},
+                                *body_view));
       advance = Fixed::one();  // the gap bounds the whole pair
     } else {
       collide_all({query.shape, query.geometry, at}, {b.shape, g, pose}, margin, manifolds);
