@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
 """Writes every C++ block of the given Markdown files out as translation units that compile
-against the installed package: tests/install/run_consumer.cmake builds them, so code the docs
-show is code that compiles.
+against the installed package, and every C block as a C11 program that links against it (the
+C API): tests/install/run_consumer.cmake builds them, so code the docs show is code that
+compiles.
 
 Usage: scripts/doc_snippets.py OUT_DIR FILE.md...
 
 Rules (what a reader assumes anyway):
-- A ```cpp or ```c++ block is a snippet. Other languages (```sh, ```cmake, ```text) are not.
+- A ```cpp or ```c++ block is a snippet. A ```c block is a whole C program (it must define
+  `int main(`), written as it is to a .c file of its own. Other languages (```sh, ```cmake,
+  ```text) are not snippets.
 - A block that defines `int main(` is a whole file of its own.
 - The other blocks of one Markdown file continue each other, in order, as the body of one
   function, so a later block may use what an earlier one declared, as the reader reads them.
@@ -32,8 +35,9 @@ FENCE = re.compile(r"^```\s*(\S*)")
 CONTEXT_OPEN = "<!-- snippet context"
 
 
-def parse(path):
-    """[(first line number of the code, code lines, context lines)] of the C++ blocks."""
+def parse(path, languages=("cpp", "c++")):
+    """[(first line number of the code, code lines, context lines)] of the blocks in
+    `languages` (the C++ blocks by default)."""
     lines = path.read_text(encoding="utf-8").splitlines()
     blocks = []
     i = 0
@@ -49,7 +53,7 @@ def parse(path):
             i += 1
         if i == len(lines):
             sys.exit(f"{path}:{start + 1}: a ``` block that is never closed")
-        if language in ("cpp", "c++"):
+        if language in languages:
             blocks.append((start + 2, lines[start + 1:i], context_before(lines, start)))
         i += 1
     return blocks
@@ -102,9 +106,10 @@ def main():
         sys.exit("usage: scripts/doc_snippets.py OUT_DIR FILE.md...")
     out_dir = pathlib.Path(sys.argv[1])
     out_dir.mkdir(parents=True, exist_ok=True)
-    for old in out_dir.glob("*.cpp"):
+    for old in [*out_dir.glob("*.cpp"), *out_dir.glob("*.c")]:
         old.unlink()
     written = 0
+    c_programs = 0
     pages = [pathlib.Path(arg).resolve() for arg in sys.argv[2:]]
     root = pathlib.Path(os.path.commonpath([p.parent for p in pages]))
     for path in pages:
@@ -120,7 +125,14 @@ def main():
         if continuing:
             (out_dir / f"{stem}.cpp").write_text(
                 unit(source, continuing, True, f"doc_snippets_{stem}"))
-    print(f"doc_snippets: {written} C++ blocks from {len(sys.argv) - 2} files")
+        for index, (first, code, _) in enumerate(parse(path, ("c",))):
+            if not any("int main(" in line for line in code):
+                sys.exit(f"{path}:{first}: a C block must be a whole program (int main)")
+            text = "\n".join([f'#line {first} "{source}"'] + code) + "\n"
+            (out_dir / f"{stem}_c{index}.c").write_text(text)
+            c_programs += 1
+    print(f"doc_snippets: {written} C++ blocks and {c_programs} C programs from "
+          f"{len(sys.argv) - 2} files")
 
 
 if __name__ == "__main__":

@@ -29,7 +29,8 @@ step "gcc Release"
 # -O1: on 2 cores compiling is most of this script's time (tests/CMakeLists.txt says why -O1). The
 # libraries build as unity batches (every test file is its own executable already), which parses
 # their headers once per batch instead of once per file.
-cmake -S . -B build/gcc-release -G Ninja -DCMAKE_CXX_COMPILER=g++ -DCMAKE_BUILD_TYPE=Release \
+cmake -S . -B build/gcc-release -G Ninja -DCMAKE_CXX_COMPILER=g++ -DCMAKE_C_COMPILER=gcc \
+  -DCMAKE_BUILD_TYPE=Release \
   "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -DNDEBUG" -DDETSIM_TEST_OPTIMIZE=-O1 -DDETSIM_WERROR=ON \
   -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build build/gcc-release -j "$jobs"
@@ -40,8 +41,9 @@ step "clang ASan+UBSan"
 # far cheaper to build than full debug information. DETSIM_CHECKS: every DETSIM_ASSERT and
 # World::validate() after every step of every test (they only read: the golden tests still pass).
 san="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
-cmake -S . -B build/clang-sanitize -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
+cmake -S . -B build/clang-sanitize -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
+  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" -DCMAKE_C_FLAGS="$san" \
   -DCMAKE_CXX_FLAGS="$san" -DCMAKE_EXE_LINKER_FLAGS="$san" -DDETSIM_WERROR=ON -DDETSIM_CHECKS=ON \
   -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build build/clang-sanitize -j "$jobs"

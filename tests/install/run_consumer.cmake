@@ -35,3 +35,10 @@ if(NOT last_output MATCHES "\"scenario\":\"consumer_drop\",\"frames\":120,")
   message(FATAL_ERROR "unexpected consumer_tool output: ${last_output}")
 endif()
 message(STATUS "consumer_tool ran: ${last_output}")
+# The C API example of docs/C_API.md, built from C against the installed package: the ball rests
+# a radius above the plane.
+run(${WORK_DIR}/consumer/docs_C_API_c0)
+if(NOT last_output MATCHES "^y = 0\\.50[0-9] m, state hash [0-9a-f]+")
+  message(FATAL_ERROR "unexpected output of the C API example: ${last_output}")
+endif()
+message(STATUS "the C API example ran: ${last_output}")

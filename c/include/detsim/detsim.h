@@ -1,0 +1,172 @@
+/* detsim's C API: worlds, bodies and shapes, stepping, save and restore, state hashes and queries,
+ * for engines and languages that bind to C (C#, Rust, Godot, Unity, Python's ctypes). docs/C_API.md
+ * has the rules and an example.
+ *
+ * - Numbers are Q32.32 fixed point, passed as their raw 64-bit value (detsim_fixed: 1.0 is
+ *   DETSIM_FIXED_ONE). Make them exactly with detsim_fixed_from_int or detsim_fixed_parse (decimal
+ *   text, correctly rounded); detsim_fixed_to_double is for display only: a simulation fed from
+ *   doubles is deterministic only if the doubles are.
+ * - Every call that can fail returns a detsim_result; DETSIM_OK is 0. On failure it changes
+ *   nothing, and detsim_last_error() says why ("body definition: radius must be > 0 ...").
+ * - No C++ exception crosses this boundary, and no C++ type appears here.
+ * - A world is used by one thread at a time; distinct worlds are independent.
+ */
+#ifndef DETSIM_DETSIM_H
+#define DETSIM_DETSIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- Numbers ---- */
+
+typedef int64_t detsim_fixed; /* Q32.32: the value times 2^32 */
+#define DETSIM_FIXED_ONE ((detsim_fixed)1 << 32)
+
+typedef struct detsim_vec3 {
+  detsim_fixed x, y, z;
+} detsim_vec3;
+
+typedef struct detsim_quat { /* a unit quaternion; the identity is {DETSIM_FIXED_ONE, 0, 0, 0} */
+  detsim_fixed w, x, y, z;
+} detsim_quat;
+
+typedef enum detsim_result {
+  DETSIM_OK = 0,
+  DETSIM_INVALID_ARGUMENT = 1, /* a null pointer, an unknown ID, a value the world refuses */
+  DETSIM_BUFFER_TOO_SMALL = 2, /* the size needed was written; call again with a larger buffer */
+  DETSIM_OUT_OF_MEMORY = 3,
+  DETSIM_INTERNAL_ERROR = 4 /* a bug: please report it with detsim_last_error() */
+} detsim_result;
+
+/* The message of this thread's last failed call, "" when the last call succeeded. Valid until the
+ * thread's next call into detsim. */
+const char* detsim_last_error(void);
+/* The library's version, "MAJOR.MINOR.PATCH". */
+const char* detsim_version(void);
+
+detsim_fixed detsim_fixed_from_int(int32_t value);
+/* Decimal text ("0.25", "-9.81", "1e-3") to the nearest Q32.32 value (ties to even). */
+detsim_result detsim_fixed_parse(const char* text, detsim_fixed* out);
+double detsim_fixed_to_double(detsim_fixed value);
+
+/* ---- Worlds ---- */
+
+typedef struct detsim_world detsim_world;
+
+/* The most used settings of a world; detsim_world_def_init fills every field with the defaults
+ * (60 Hz, 4 sub-steps, gravity -9.81 m/s^2 along y, seed 0). */
+typedef struct detsim_world_def {
+  detsim_vec3 gravity; /* m/s^2 */
+  detsim_fixed dt;     /* s per step */
+  uint32_t substeps;
+  uint32_t iterations;
+  uint64_t seed; /* the world's random number generator */
+} detsim_world_def;
+
+void detsim_world_def_init(detsim_world_def* def);
+/* def may be NULL (the defaults). The world is written to *out; destroy it with
+ * detsim_world_destroy. */
+detsim_result detsim_world_create(const detsim_world_def* def, detsim_world** out);
+void detsim_world_destroy(detsim_world* world); /* NULL is fine */
+detsim_result detsim_world_step(detsim_world* world);
+uint64_t detsim_world_frame(const detsim_world* world); /* 0 for NULL */
+/* The state in the canonical encoding (docs/STATE.md), identical on every machine. With
+ * capacity too small (or buffer NULL) nothing is written but *size, and the result is
+ * DETSIM_BUFFER_TOO_SMALL (DETSIM_OK when buffer is NULL and capacity 0: a size query). */
+detsim_result detsim_world_save(const detsim_world* world, uint8_t* buffer, size_t capacity,
+                                size_t* size);
+/* Replaces the whole state; bytes that do not restore change nothing (the reason is in
+ * detsim_last_error, naming the byte and the field). */
+detsim_result detsim_world_restore(detsim_world* world, const uint8_t* bytes, size_t size);
+/* The per-frame state hash (XXH3-64 of the canonical state): what peers compare. */
+detsim_result detsim_world_hash(const detsim_world* world, uint64_t* out);
+
+/* ---- Bodies and shapes ---- */
+
+typedef enum detsim_shape_type {
+  DETSIM_SHAPE_SPHERE = 1,  /* radius */
+  DETSIM_SHAPE_BOX = 2,     /* half_extents */
+  DETSIM_SHAPE_CAPSULE = 3, /* radius, half_height: along the local y axis */
+  DETSIM_SHAPE_PLANE = 4,   /* the half-space below local y = 0; static bodies only */
+  DETSIM_SHAPE_CYLINDER = 5 /* radius, half_height: along the local y axis */
+} detsim_shape_type;
+
+typedef struct detsim_shape {
+  uint32_t type; /* a detsim_shape_type */
+  detsim_fixed radius;
+  detsim_fixed half_height;
+  detsim_vec3 half_extents;
+} detsim_shape;
+
+typedef enum detsim_body_type {
+  DETSIM_BODY_STATIC = 0,
+  DETSIM_BODY_KINEMATIC = 1,
+  DETSIM_BODY_DYNAMIC = 2
+} detsim_body_type;
+
+/* detsim_body_def_init fills the defaults: dynamic, a 0.5 m sphere at the origin, density 1000,
+ * friction 0.6, collides with everything. */
+typedef struct detsim_body_def {
+  uint32_t type; /* a detsim_body_type */
+  detsim_shape shape;
+  detsim_vec3 position;
+  detsim_quat orientation;
+  detsim_vec3 linear_velocity;
+  detsim_vec3 angular_velocity;
+  detsim_fixed mass; /* kg; 0: density times volume */
+  detsim_fixed density;
+  detsim_fixed friction;
+  detsim_fixed restitution;
+  uint32_t layer;
+  uint32_t mask;
+  uint64_t user_data;
+} detsim_body_def;
+
+typedef struct detsim_body_state {
+  uint32_t id;
+  uint32_t type;
+  detsim_vec3 position;
+  detsim_quat orientation;
+  detsim_vec3 linear_velocity;
+  detsim_vec3 angular_velocity;
+  detsim_fixed mass;
+  int awake;
+  uint64_t user_data;
+} detsim_body_state;
+
+void detsim_body_def_init(detsim_body_def* def);
+/* A refused definition creates nothing and consumes no ID. */
+detsim_result detsim_body_create(detsim_world* world, const detsim_body_def* def, uint32_t* id);
+detsim_result detsim_body_destroy(detsim_world* world, uint32_t id);
+detsim_result detsim_body_get(const detsim_world* world, uint32_t id, detsim_body_state* out);
+detsim_result detsim_body_apply_force(detsim_world* world, uint32_t id, detsim_vec3 force);
+detsim_result detsim_body_apply_impulse(detsim_world* world, uint32_t id, detsim_vec3 impulse);
+detsim_result detsim_body_set_linear_velocity(detsim_world* world, uint32_t id,
+                                              detsim_vec3 velocity);
+
+/* ---- Queries ---- */
+
+typedef struct detsim_hit {
+  uint32_t body;
+  detsim_vec3 point;
+  detsim_vec3 normal;
+  detsim_fixed fraction;
+} detsim_hit;
+
+/* The first body a ray meets: *found is 1 and *hit filled, or *found is 0. */
+detsim_result detsim_world_raycast(const detsim_world* world, detsim_vec3 origin,
+                                   detsim_vec3 translation, detsim_hit* hit, int* found);
+/* The first body a shape meets moving along translation without turning (World::shape_cast). */
+detsim_result detsim_world_shape_cast(const detsim_world* world, const detsim_shape* shape,
+                                      detsim_vec3 position, detsim_quat orientation,
+                                      detsim_vec3 translation, detsim_hit* hit, int* found);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DETSIM_DETSIM_H */
