@@ -108,7 +108,8 @@ TEST(AxisLocks, ABodyLockedVerticallyHoldsWhatLandsOnIt) {
   for (int i = 0; i < 240; ++i)
     w.step();
   const BodyState s = state(w, held);
-  EXPECT_EQ(s.position, Vec3(0_fx, 1_fx, 0_fx));
+  const Vec3 placed_at{0_fx, 1_fx, 0_fx};
+  EXPECT_EQ(s.position, placed_at);
   EXPECT_EQ(s.orientation, Quat{});
   // At rest on the top face (y = 1.1) within the contact's soft range.
   const BodyState b = state(w, dropped);

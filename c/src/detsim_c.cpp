@@ -4,18 +4,73 @@
 // failure is kept per thread for detsim_last_error.
 #include <detsim/detsim.h>
 
+#include <array>
 #include <cstring>
 #include <exception>
+#include <memory>
 #include <new>
 #include <string>
 #include <vector>
 
 #include <detsim/core/version.hpp>
 #include <detsim/fixed/decimal.hpp>
+#include <detsim/net/game.hpp>
+#include <detsim/net/session.hpp>
+#include <detsim/net/sim_network.hpp>
 #include <detsim/sim/world.hpp>
 
 struct detsim_world {
   detsim::World world;
+};
+
+struct detsim_network {
+  detsim::net::SimNetwork network;
+};
+
+namespace detsim_c {
+
+// The C callbacks as a net::Game. The session keeps the bytes save() writes; the game's own
+// buffer is copied out and handed back to it at once.
+class CallbackGame final : public detsim::net::Game {
+ public:
+  explicit CallbackGame(const detsim_game& game) : game_(game) {}
+
+  std::uint64_t save(std::vector<std::uint8_t>& state) override {
+    std::uint8_t* buffer = nullptr;
+    std::size_t size = 0;
+    const std::uint64_t hash = game_.save(game_.context, &buffer, &size);
+    state.assign(buffer, buffer + (buffer == nullptr ? 0 : size));
+    if (buffer != nullptr && game_.free_buffer != nullptr) game_.free_buffer(game_.context, buffer);
+    return hash;
+  }
+  void load(std::span<const std::uint8_t> state) override {
+    game_.load(game_.context, state.data(), state.size());
+  }
+  void advance(const detsim::net::FrameInputs& inputs, bool resimulating) override {
+    status_.resize(inputs.status.size());
+    for (std::size_t i = 0; i < inputs.status.size(); ++i)
+      status_[i] = static_cast<std::uint8_t>(inputs.status[i]);
+    game_.advance(game_.context, inputs.frame, inputs.bytes.data(),
+                  static_cast<std::uint32_t>(inputs.players()),
+                  static_cast<std::uint32_t>(inputs.input_size), status_.data(),
+                  resimulating ? 1 : 0);
+  }
+
+ private:
+  detsim_game game_;
+  std::vector<std::uint8_t> status_;
+};
+
+}  // namespace detsim_c
+
+struct detsim_session {
+  std::unique_ptr<detsim_c::CallbackGame> game;
+  std::unique_ptr<detsim::net::Session> session;
+  /// The last kept_hashes confirmed frames' hashes, by frame % kept_hashes.
+  static constexpr std::size_t kept_hashes = 1024;
+  std::array<std::uint64_t, kept_hashes> frames{};
+  std::array<std::uint64_t, kept_hashes> hashes{};
+  std::array<bool, kept_hashes> kept{};  ///< the slot holds a frame
 };
 
 namespace {
@@ -343,6 +398,148 @@ detsim_result detsim_world_shape_cast(const detsim_world* world, const detsim_sh
     const auto h = world->world.shape_cast(s, vec(position), quat(orientation), vec(translation));
     *found = h ? 1 : 0;
     if (h) *hit = to_hit(h->body, h->point, h->normal, h->fraction);
+    return ok();
+  });
+}
+
+void detsim_session_config_init(detsim_session_config* config) {
+  if (config == nullptr) return;
+  const detsim::net::SessionConfig c;
+  config->mode = static_cast<std::uint32_t>(c.mode);
+  config->players = c.players;
+  config->local_player = c.local_player;
+  config->input_size = c.input_size;
+  config->input_delay = c.input_delay;
+  config->max_prediction = c.max_prediction;
+  config->fingerprint = c.fingerprint;
+}
+
+detsim_result detsim_network_create(uint32_t nodes, uint64_t seed, const detsim_link* links,
+                                    detsim_network** out) {
+  return guarded("detsim_network_create", [&] {
+    if (out == nullptr) return null_argument("detsim_network_create", "out");
+    detsim::net::LinkConditions all;
+    if (links != nullptr) {
+      all.latency_us = links->latency_us;
+      all.jitter_us = links->jitter_us;
+      all.loss_ppm = links->loss_ppm;
+      all.duplicate_ppm = links->duplicate_ppm;
+      all.reorder_ppm = links->reorder_ppm;
+    }
+    auto network = detsim::net::SimNetwork::create(nodes, seed, all);
+    if (!network.ok()) return fail(DETSIM_INVALID_ARGUMENT, network.message());
+    *out = new detsim_network{std::move(network.value())};
+    return ok();
+  });
+}
+
+void detsim_network_destroy(detsim_network* network) {
+  delete network;
+}
+
+detsim_result detsim_network_advance_to(detsim_network* network, uint64_t now_us) {
+  return guarded("detsim_network_advance_to", [&] {
+    if (network == nullptr) return null_argument("detsim_network_advance_to", "network");
+    network->network.advance_to(now_us);
+    return ok();
+  });
+}
+
+detsim_result detsim_session_create(const detsim_session_config* config, const detsim_game* game,
+                                    detsim_network* network, detsim_session** out) {
+  return guarded("detsim_session_create", [&] {
+    if (config == nullptr) return null_argument("detsim_session_create", "config");
+    if (game == nullptr) return null_argument("detsim_session_create", "game");
+    if (network == nullptr) return null_argument("detsim_session_create", "network");
+    if (out == nullptr) return null_argument("detsim_session_create", "out");
+    if (game->save == nullptr || game->load == nullptr || game->advance == nullptr)
+      return fail(DETSIM_INVALID_ARGUMENT,
+                  "detsim_session_create: the game's save, load and advance must all be set");
+    if (config->mode > DETSIM_MODE_LOCKSTEP) {
+      return fail(DETSIM_INVALID_ARGUMENT, "session config: mode " + std::to_string(config->mode) +
+                                               " is not 0 (rollback) or 1 (lockstep)");
+    }
+    if (config->players > network->network.nodes() ||
+        config->local_player >= network->network.nodes()) {
+      return fail(DETSIM_INVALID_ARGUMENT,
+                  "session config: " + std::to_string(config->players) +
+                      " players need as many network nodes, the network has " +
+                      std::to_string(network->network.nodes()));
+    }
+    detsim::net::SessionConfig c;
+    c.mode = static_cast<detsim::net::SessionMode>(config->mode);
+    c.players = config->players;
+    c.local_player = config->local_player;
+    c.input_size = config->input_size;
+    c.input_delay = config->input_delay;
+    c.max_prediction = config->max_prediction;
+    c.fingerprint = config->fingerprint;
+    for (std::uint32_t p = 0; p < config->players; ++p) {
+      if (p != config->local_player) c.remotes.push_back({p, p});
+    }
+    auto wrapper = std::make_unique<detsim_session>();
+    wrapper->game = std::make_unique<detsim_c::CallbackGame>(*game);
+    auto session = detsim::net::Session::create(c, *wrapper->game,
+                                                network->network.endpoint(config->local_player));
+    if (!session.ok()) return fail(DETSIM_INVALID_ARGUMENT, session.message());
+    wrapper->session = std::make_unique<detsim::net::Session>(std::move(session.value()));
+    detsim_session* self = wrapper.get();
+    self->session->set_confirmed_listener([self](const detsim::net::ConfirmedFrame& f) {
+      const std::size_t slot = f.frame % detsim_session::kept_hashes;
+      self->frames[slot] = f.frame;
+      self->hashes[slot] = f.hash;
+      self->kept[slot] = true;
+    });
+    *out = wrapper.release();
+    return ok();
+  });
+}
+
+void detsim_session_destroy(detsim_session* session) {
+  delete session;
+}
+
+detsim_result detsim_session_poll(detsim_session* session, uint64_t now_us) {
+  return guarded("detsim_session_poll", [&] {
+    if (session == nullptr) return null_argument("detsim_session_poll", "session");
+    session->session->poll(now_us);
+    return ok();
+  });
+}
+
+detsim_result detsim_session_advance_frame(detsim_session* session, const uint8_t* input,
+                                           size_t size, uint32_t* what) {
+  return guarded("detsim_session_advance_frame", [&] {
+    if (session == nullptr) return null_argument("detsim_session_advance_frame", "session");
+    if (input == nullptr && size > 0) return null_argument("detsim_session_advance_frame", "input");
+    if (what == nullptr) return null_argument("detsim_session_advance_frame", "what");
+    const auto advanced = session->session->advance_frame({input, size});
+    if (!advanced.ok()) return fail(DETSIM_INVALID_ARGUMENT, advanced.message());
+    *what = static_cast<std::uint32_t>(*advanced);
+    return ok();
+  });
+}
+
+uint64_t detsim_session_current_frame(const detsim_session* session) {
+  return session == nullptr ? 0 : session->session->current_frame();
+}
+
+uint64_t detsim_session_confirmed_frame(const detsim_session* session) {
+  return session == nullptr ? 0 : session->session->confirmed_frame();
+}
+
+detsim_result detsim_session_confirmed_hash(const detsim_session* session, uint64_t frame,
+                                            uint64_t* hash) {
+  return guarded("detsim_session_confirmed_hash", [&] {
+    if (session == nullptr) return null_argument("detsim_session_confirmed_hash", "session");
+    if (hash == nullptr) return null_argument("detsim_session_confirmed_hash", "hash");
+    const std::size_t slot = frame % detsim_session::kept_hashes;
+    if (!session->kept[slot] || session->frames[slot] != frame) {
+      return fail(DETSIM_INVALID_ARGUMENT, "detsim_session_confirmed_hash: frame " +
+                                               std::to_string(frame) +
+                                               " is not among the last 1024 confirmed frames");
+    }
+    *hash = session->hashes[slot];
     return ok();
   });
 }

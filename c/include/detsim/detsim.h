@@ -1,6 +1,7 @@
-/* detsim's C API: worlds, bodies and shapes, stepping, save and restore, state hashes and queries,
- * for engines and languages that bind to C (C#, Rust, Godot, Unity, Python's ctypes). docs/C_API.md
- * has the rules and an example.
+/* detsim's C API: worlds, bodies and shapes, stepping, save and restore, state hashes, queries
+ * and rollback or lockstep sessions driving a game through callbacks, for engines and languages
+ * that bind to C (C#, Rust, Godot, Unity, Python's ctypes). docs/C_API.md has the rules and an
+ * example.
  *
  * - Numbers are Q32.32 fixed point, passed as their raw 64-bit value (detsim_fixed: 1.0 is
  *   DETSIM_FIXED_ONE). Make them exactly with detsim_fixed_from_int or detsim_fixed_parse (decimal
@@ -164,6 +165,97 @@ detsim_result detsim_world_raycast(const detsim_world* world, detsim_vec3 origin
 detsim_result detsim_world_shape_cast(const detsim_world* world, const detsim_shape* shape,
                                       detsim_vec3 position, detsim_quat orientation,
                                       detsim_vec3 translation, detsim_hit* hit, int* found);
+
+/* ---- Sessions: rollback and lockstep (docs/NET.md) over a seeded simulated network ---- */
+
+/* The game a session drives, GGPO's shape: the session decides when the game saves, loads and
+ * advances. Every callback is called from inside detsim_session_poll or
+ * detsim_session_advance_frame, on the calling thread, with `context`. */
+typedef struct detsim_game {
+  void* context;
+  /* Writes the current state to a buffer the game allocates (*buffer, *size) and returns the
+   * state's hash: two machines in the same state must return the same hash. */
+  uint64_t (*save)(void* context, uint8_t** buffer, size_t* size);
+  /* Frees a buffer save returned, once the session no longer needs it. */
+  void (*free_buffer)(void* context, uint8_t* buffer);
+  /* Returns the game to a state save wrote. */
+  void (*load)(void* context, const uint8_t* buffer, size_t size);
+  /* Simulates frame `frame` with players * input_size bytes of inputs (player order) and one
+   * detsim_input_status per player; resimulating is 1 after a rollback (skip sounds and effects
+   * already played). */
+  void (*advance)(void* context, uint64_t frame, const uint8_t* inputs, uint32_t players,
+                  uint32_t input_size, const uint8_t* status, int resimulating);
+} detsim_game;
+
+typedef enum detsim_input_status {
+  DETSIM_INPUT_CONFIRMED = 0,
+  DETSIM_INPUT_PREDICTED = 1,
+  DETSIM_INPUT_DISCONNECTED = 2
+} detsim_input_status;
+
+/* One direction of a simulated link: integers only (a perfect link is all zero). */
+typedef struct detsim_link {
+  uint32_t latency_us;
+  uint32_t jitter_us;
+  uint32_t loss_ppm;
+  uint32_t duplicate_ppm;
+  uint32_t reorder_ppm;
+} detsim_link;
+
+typedef struct detsim_network detsim_network;
+/* A network of `nodes` nodes, every link with *links (NULL: perfect), the clock at 0. The same
+ * seed and calls give the same deliveries on every machine. */
+detsim_result detsim_network_create(uint32_t nodes, uint64_t seed, const detsim_link* links,
+                                    detsim_network** out);
+/* Destroy a network after the sessions that use it. NULL is fine. */
+void detsim_network_destroy(detsim_network* network);
+/* Moves the virtual clock to now_us (never backwards): delivers what is due. */
+detsim_result detsim_network_advance_to(detsim_network* network, uint64_t now_us);
+
+typedef enum detsim_session_mode {
+  DETSIM_MODE_ROLLBACK = 0,
+  DETSIM_MODE_LOCKSTEP = 1
+} detsim_session_mode;
+
+/* detsim_session_config_init fills the defaults: rollback, 2 players, local player 0, 4-byte
+ * inputs, input delay 2, prediction up to 8 frames. */
+typedef struct detsim_session_config {
+  uint32_t mode; /* a detsim_session_mode */
+  uint32_t players;
+  uint32_t local_player;
+  uint32_t input_size;
+  uint32_t input_delay;
+  uint32_t max_prediction;
+  uint64_t fingerprint; /* what peers must agree on (game, version, settings) */
+} detsim_session_config;
+
+typedef enum detsim_advance {
+  DETSIM_ADVANCED = 0,          /* simulated one new frame (after any rollback) */
+  DETSIM_SYNCHRONIZING = 1,     /* a peer's handshake is not done: nothing simulated */
+  DETSIM_PREDICTION_LIMIT = 2,  /* rollback: too far ahead of the confirmed inputs */
+  DETSIM_WAITING_FOR_INPUTS = 3 /* lockstep: an input of the next frame has not arrived */
+} detsim_advance;
+
+typedef struct detsim_session detsim_session;
+void detsim_session_config_init(detsim_session_config* config);
+/* A session for config->local_player at node local_player of `network`; player p is at node p.
+ * The game's state is saved as frame 0. The network must outlive the session. */
+detsim_result detsim_session_create(const detsim_session_config* config, const detsim_game* game,
+                                    detsim_network* network, detsim_session** out);
+void detsim_session_destroy(detsim_session* session); /* NULL is fine */
+/* Receives, sends what is due, applies corrections (the game loads and re-simulates). */
+detsim_result detsim_session_poll(detsim_session* session, uint64_t now_us);
+/* Queues input_size bytes of local input and simulates the next frame if it may; *what says
+ * what happened (a detsim_advance). */
+detsim_result detsim_session_advance_frame(detsim_session* session, const uint8_t* input,
+                                           size_t size, uint32_t* what);
+uint64_t detsim_session_current_frame(const detsim_session* session);
+/* The newest frame whose inputs every player confirmed; its states will not change. */
+uint64_t detsim_session_confirmed_frame(const detsim_session* session);
+/* The hash of the state after confirmed frame `frame`, once the session has simulated past it and
+ * handed it on (the last 1024 such frames are kept). */
+detsim_result detsim_session_confirmed_hash(const detsim_session* session, uint64_t frame,
+                                            uint64_t* hash);
 
 #ifdef __cplusplus
 }
