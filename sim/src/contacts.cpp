@@ -274,6 +274,24 @@ void wake_touched_islands(WorldState& s) {
   narrowphase(s, true);
 }
 
+void wake_islands(WorldState& s, const std::vector<std::size_t>& bodies) {
+  bool asleep = false;
+  for (const std::size_t i : bodies)
+    asleep = asleep || (s.bodies[i].type == BodyType::dynamic && !s.bodies[i].awake);
+  if (!asleep) return;  // the common case: no island to find
+  UnionFind uf = islands(s);
+  std::vector<bool> wake(s.bodies.size(), false);
+  for (const std::size_t i : bodies)
+    wake[uf.root(static_cast<std::uint32_t>(i))] = true;
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    BodyState& b = s.bodies[i];
+    if (b.type == BodyType::dynamic && wake[uf.root(static_cast<std::uint32_t>(i))]) {
+      b.awake = true;
+      b.sleep_time = Fixed::zero();
+    }
+  }
+}
+
 void report_end(WorldState& s, const Contact& c) {
   if (!c.reported) return;
   const BodyState& a = s.bodies[index_of(s, c.a)];

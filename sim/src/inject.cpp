@@ -12,6 +12,7 @@
 #include <detsim/fixed/quat.hpp>
 
 #include "body_fields.hpp"
+#include "character_fields.hpp"
 #include "joint_fields.hpp"
 #include "shapes.hpp"
 #include "state_io.hpp"
@@ -20,16 +21,17 @@
 namespace detsim {
 namespace {
 
-/// The joint's fields from its table (joint_fields.hpp), with the delta each takes.
-std::string joint_fields_help() {
-  using sim_detail::JointFieldKind;
+/// A record's fields from its table (record_fields.hpp), with the delta each takes.
+template <class T>
+std::string record_fields_help(std::span<const sim_detail::RecordField<T>> fields) {
+  using sim_detail::RecordFieldKind;
   std::string out;
-  for (const sim_detail::JointField& f : sim_detail::joint_fields()) {
+  for (const sim_detail::RecordField<T>& f : fields) {
     std::string form = f.name;
-    if (f.kind == JointFieldKind::vec3) form += ".x|y|z";
-    if (f.kind == JointFieldKind::quat) form += ".w|x|y|z";
-    if (f.kind == JointFieldKind::flag) form += " (1 toggles)";
-    if (f.kind == JointFieldKind::u64) form += " (an integer)";
+    if (f.kind == RecordFieldKind::vec3) form += ".x|y|z";
+    if (f.kind == RecordFieldKind::quat) form += ".w|x|y|z";
+    if (f.kind == RecordFieldKind::flag) form += " (1 toggles)";
+    if (f.kind == RecordFieldKind::u64 || f.kind == RecordFieldKind::u32) form += " (an integer)";
     out += (out.empty() ? "" : ", ") + form;
   }
   return out;
@@ -72,7 +74,9 @@ const std::string& fields_help() {
            "contact[OTHER].point[I].normal_impulse|tangent_impulse_1|tangent_impulse_2 (DELTA a "
            "decimal; contact[OTHER/S/T] for the contact of BODY's sub-shape S with OTHER's "
            "sub-shape T); joint[J].FIELD (BODY 0; FIELD a field of the joint as diff names it: " +
-           joint_fields_help() +
+           record_fields_help(sim_detail::joint_fields()) +
+           "); character[C].FIELD (BODY 0; FIELD a field of the character as diff names it: " +
+           record_fields_help(sim_detail::character_fields()) +
            "); particle_group[G].particle[I].position.x|y|z, "
            "particle_group[G].particle[I].velocity.x|y|z, particle_group[G].force.x|y|z, "
            "particle_group[G].sleep_time, particle_group[G].tether_impulse (BODY 0; DELTA a "
@@ -90,14 +94,14 @@ enum class DeltaKind { fixed, toggle, integer, presence, number };
 /// What a field name refers to, once parsed.
 struct Target {
   DeltaKind kind = DeltaKind::fixed;
-  enum class Part { body, rng, contact, joint, particles, game } part = Part::body;
+  enum class Part { body, rng, contact, joint, character, particles, game } part = Part::body;
   std::string base;             ///< "position", "sleep_time", "normal_impulse", ...
   int component = -1;           ///< x y z = 0 1 2, w = 3; the RNG word; -1: none
   std::uint32_t other = 0;      ///< contact: the other body
   std::uint32_t sub_body = 0;   ///< contact: BODY's sub-shape (compound part, surface triangle)
   std::uint32_t sub_other = 0;  ///< contact: OTHER's sub-shape
   std::size_t point = 0;        ///< contact: the point
-  std::uint32_t joint = 0;      ///< joint: its ID
+  std::uint32_t joint = 0;      ///< joint, character: its ID
   std::uint32_t group = 0;      ///< particles: the group's ID
   std::optional<std::uint32_t> particle;  ///< particles: the particle (none: a group field)
 };
@@ -179,35 +183,32 @@ Expected<Target> parse_field(std::string_view field) {
     t.base = std::string(name);
     return t;
   }
-  if (field.starts_with("joint[")) {
+  // joint[J].FIELD and character[C].FIELD: a field of the record's table (record_fields.hpp).
+  const auto record = [&]<class T>(
+                          std::string_view prefix, Target::Part part,
+                          std::span<const sim_detail::RecordField<T>> fields) -> Expected<Target> {
     std::string_view rest;
-    auto joint = indexed(field, "joint", rest);
-    if (!joint || *joint == 0 || *joint > 0xFFFFFFFFU || !rest.starts_with(".")) return unknown();
-    rest.remove_prefix(1);
-    std::string_view base = rest;
+    auto id = indexed(field, prefix, rest);
+    if (!id || *id == 0 || *id > 0xFFFFFFFFU || !rest.starts_with(".")) return unknown();
     int component = -1;
-    const std::size_t dot = rest.rfind('.');
-    if (dot != std::string_view::npos && dot + 2 == rest.size()) {
-      const char c = rest.back();
-      base = rest.substr(0, dot);
-      component = c == 'w' ? 3 : c >= 'x' && c <= 'z' ? c - 'x' : -2;
-    }
-    const sim_detail::JointField* f = sim_detail::find_joint_field(base);
+    const sim_detail::RecordField<T>* f =
+        sim_detail::parse_record_field(fields, rest.substr(1), component);
     if (f == nullptr) return unknown();
-    using sim_detail::JointFieldKind;
-    const bool whole = f->kind != JointFieldKind::vec3 && f->kind != JointFieldKind::quat;
-    if (whole ? component != -1
-              : component < 0 || (f->kind == JointFieldKind::vec3 && component == 3))
-      return unknown();
-    t.part = Target::Part::joint;
-    t.joint = static_cast<std::uint32_t>(*joint);
+    using sim_detail::RecordFieldKind;
+    t.part = part;
+    t.joint = static_cast<std::uint32_t>(*id);
     t.base = f->name;
     t.component = component;
-    t.kind = f->kind == JointFieldKind::flag  ? DeltaKind::toggle
-             : f->kind == JointFieldKind::u64 ? DeltaKind::integer
-                                              : DeltaKind::fixed;
+    t.kind = f->kind == RecordFieldKind::flag ? DeltaKind::toggle
+             : f->kind == RecordFieldKind::u64 || f->kind == RecordFieldKind::u32
+                 ? DeltaKind::integer
+                 : DeltaKind::fixed;
     return t;
-  }
+  };
+  if (field.starts_with("joint["))
+    return record("joint", Target::Part::joint, sim_detail::joint_fields());
+  if (field.starts_with("character["))
+    return record("character", Target::Part::character, sim_detail::character_fields());
   if (field.starts_with("particle_group[")) {
     // particle_group[G].particle[I].position|velocity.C, or a group field: force.C, sleep_time,
     // tether_impulse, awake.
@@ -389,31 +390,32 @@ Status change_body(BodyState& b, const Target& t, std::string_view delta) {
   return Status::success();
 }
 
-// Changes a copy of the joint's field, then checks it as restore() would.
-Status change_joint(const sim_detail::WorldState& s, JointState& j, const Target& t,
-                    std::string_view delta) {
-  const sim_detail::JointField& f = *sim_detail::find_joint_field(t.base);
+// Changes a copy of a record's field (a joint's, a character's); the caller checks it as
+// restore() would before writing it back.
+template <class T>
+void change_record(std::span<const sim_detail::RecordField<T>> fields, T& x, const Target& t,
+                   std::string_view delta) {
+  const sim_detail::RecordField<T>& f = *sim_detail::find_record_field(fields, t.base);
   switch (f.kind) {
-    case sim_detail::JointFieldKind::fixed:
-      f.fixed(j) += Fixed::parse(delta).value;
+    case sim_detail::RecordFieldKind::fixed:
+      f.fixed(x) += Fixed::parse(delta).value;
       break;
-    case sim_detail::JointFieldKind::vec3:
-      field_ref(f.vec3(j), t.component) += Fixed::parse(delta).value;
+    case sim_detail::RecordFieldKind::vec3:
+      field_ref(f.vec3(x), t.component) += Fixed::parse(delta).value;
       break;
-    case sim_detail::JointFieldKind::quat:
-      field_ref(f.quat(j), t.component) += Fixed::parse(delta).value;
+    case sim_detail::RecordFieldKind::quat:
+      field_ref(f.quat(x), t.component) += Fixed::parse(delta).value;
       break;
-    case sim_detail::JointFieldKind::u64:
-      f.u64(j) += static_cast<std::uint64_t>(*parse_i64(delta));  // modulo 2^64
+    case sim_detail::RecordFieldKind::u32:
+      f.u32(x) += static_cast<std::uint32_t>(*parse_i64(delta));  // modulo 2^32
       break;
-    case sim_detail::JointFieldKind::flag:
-      f.flag(j) = !f.flag(j);
+    case sim_detail::RecordFieldKind::u64:
+      f.u64(x) += static_cast<std::uint64_t>(*parse_i64(delta));  // modulo 2^64
+      break;
+    case sim_detail::RecordFieldKind::flag:
+      f.flag(x) = !f.flag(x);
       break;
   }
-  if (auto e = sim_detail::check_joint_record(s, j); !e.empty())
-    return Status::error("joint " + std::to_string(j.id.value) +
-                         ": the change would leave an invalid state: " + e);
-  return Status::success();
 }
 
 // Changes one field of a particle group (a particle's or the group's own), checks the group as
@@ -516,6 +518,9 @@ Expected<Injection> parse_injection(std::string_view spec) {
     return Status::error(where + "BODY must be 0 for an RNG field");
   if (target->part == Target::Part::joint && *body != 0)
     return Status::error(where + "BODY must be 0 for a joint field (the joint is named in it)");
+  if (target->part == Target::Part::character && *body != 0)
+    return Status::error(where +
+                         "BODY must be 0 for a character field (the character is named in it)");
   if (target->part == Target::Part::game && *body != 0)
     return Status::error(where + "BODY must be 0 for a field of the game state");
   if (target->part == Target::Part::particles && *body != 0)
@@ -561,9 +566,23 @@ Status apply_injection(World& world, const Injection& injection) {
     const std::ptrdiff_t j = s.find_joint(t.joint);
     if (j < 0) return Status::error(where + "no joint with ID " + std::to_string(t.joint));
     JointState changed = s.joints[static_cast<std::size_t>(j)];
-    if (Status st = change_joint(s, changed, t, injection.delta); !st)
-      return Status::error(where + st.message());
+    change_record(sim_detail::joint_fields(), changed, t, injection.delta);
+    if (auto e = sim_detail::check_joint_record(s, changed); !e.empty())
+      return Status::error(where + "joint " + std::to_string(t.joint) +
+                           ": the change would leave an invalid state: " + e);
     s.joints[static_cast<std::size_t>(j)] = changed;
+    return Status::success();
+  }
+
+  if (t.part == Target::Part::character) {
+    const std::ptrdiff_t k = s.find_character(t.joint);
+    if (k < 0) return Status::error(where + "no character with ID " + std::to_string(t.joint));
+    CharacterState changed = s.characters[static_cast<std::size_t>(k)];
+    change_record(sim_detail::character_fields(), changed, t, injection.delta);
+    if (auto e = sim_detail::check_character_record(s, changed); !e.empty())
+      return Status::error(where + "character " + std::to_string(t.joint) +
+                           ": the change would leave an invalid state: " + e);
+    s.characters[static_cast<std::size_t>(k)] = changed;
     return Status::success();
   }
 
@@ -634,6 +653,7 @@ Status apply_injection(World& world, const Injection& injection) {
     std::erase_if(s.contacts,
                   [id](const sim_detail::Contact& c) { return c.a == id || c.b == id; });
     s.bodies.erase(s.bodies.begin() + index);
+    sim_detail::forget_ground(s, BodyId{id});  // no character may stand on a body that is gone
     return Status::success();
   }
 

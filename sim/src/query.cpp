@@ -90,6 +90,11 @@ bool touches(const Manifold& m) noexcept {
 
 }  // namespace
 
+std::optional<RayHit> sim_detail::ray_body(const WorldState& s, const BodyState& b, Vec3 origin,
+                                           Vec3 translation) {
+  return cast_body(s, b, make_ray(origin, translation));
+}
+
 std::optional<RayHit> World::raycast_closest(Vec3 origin, Vec3 translation,
                                              const QueryFilter& filter) const {
   // The same per-body test as raycast_all, so the result is always raycast_all's first hit: a

@@ -24,13 +24,16 @@
 //   the narrowphase's precision.
 // A pair not shrinking now is not met: the shape resting on a floor and cast along it passes the
 // floor by and meets the wall ahead, and a shape that starts inside a body and moves out is not
-// stopped by it. Every advance is the smallest bound over the pairs, and (surfaces, compounds) for
-// pairs beyond `margin`, (margin - target / 2) / |translation|. The cast stops when some shrinking
-// pair is within `target` (the world's linear_slop): the shape is then apart from the body by
-// between about target / 2 and target. A fixed number of iterations bounds the work; a cast that
-// runs out stops where it was, short of the body (it never ends inside anything). Bodies are
-// visited in ascending ID order and a later body replaces the best hit only with a strictly lower
-// fraction, so the result is the same bits on every machine.
+// stopped by it. A pair already in touch is met only when the motion goes into it by more than
+// 2^-14 of its length (about 0.0035 degrees): a motion along a surface it touches slides along it
+// whatever the last bits of GJK's direction say, and may end at most that much deeper. Every
+// advance is the smallest bound over the pairs, and (surfaces, compounds) for pairs beyond
+// `margin`, (margin - target / 2) / |translation|. The cast stops when some shrinking pair is
+// within `target` (the world's linear_slop): the shape is then apart from the body by between about
+// target / 2 and target. A fixed number of iterations bounds the work; a cast that runs out stops
+// where it was, short of the body (it never ends inside anything). Bodies are visited in ascending
+// ID order and a later body replaces the best hit only with a strictly lower fraction, so the
+// result is the same bits on every machine.
 #include <algorithm>
 #include <optional>
 #include <string>
@@ -189,6 +192,10 @@ std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query, Ve
       const Fixed approach = dot(gap.normal, translation);  // per unit t
       if (approach <= Fixed::zero()) continue;  // not shrinking now, so never (convexity)
       if (gap.separation <= target) {
+        // In touch but grazing (deeper by at most 2^-14 of the motion): sliding along, not into
+        // it. GJK's direction is good to a few 10^-6, so a motion along a face it touches (a
+        // character's capsule moving down beside a wall) must not read as into it.
+        if (approach <= (travel >> 14)) continue;
         if (hit == nullptr || gap.separation < hit->separation) hit = &gap;
         continue;
       }
@@ -216,34 +223,48 @@ std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query, Ve
 
 }  // namespace
 
-std::optional<ShapeHit> World::shape_cast(const Shape& shape, Vec3 position, Quat orientation,
-                                          Vec3 translation, const QueryFilter& filter) const {
-  const std::optional<Query> query = checked_query(*s_, shape, position, orientation);
+namespace sim_detail {
+
+std::optional<ShapeHit> cast_shape(const WorldState& s, const Shape& shape, Vec3 position,
+                                   Quat orientation, Vec3 translation, const QueryFilter& filter) {
+  const std::optional<Query> query = checked_query(s, shape, position, orientation);
   const Fixed travel = length(translation);
   if (!query || !query->view || travel == Fixed::zero()) return std::nullopt;
   thread_local std::vector<SubManifold> manifolds;  // reused between queries
   thread_local std::vector<Gap> gaps;
   std::optional<ShapeHit> best;
-  for (const BodyState& b : s_->bodies) {
+  for (const BodyState& b : s.bodies) {
     if (!passes(b, filter)) continue;
     const Fixed before = best ? best->fraction : Fixed::one() + Fixed::from_raw(1);
-    if (auto hit = cast_against(*s_, *query, translation, travel, b, before, manifolds, gaps)) {
+    if (auto hit = cast_against(s, *query, translation, travel, b, before, manifolds, gaps)) {
       best = hit;
     }
   }
   return best;
 }
 
-std::vector<ShapeContact> World::shape_contacts(const Shape& shape, Vec3 position, Quat orientation,
-                                                const QueryFilter& filter) const {
+std::vector<ShapeContact> contacts_with(const WorldState& s, const Shape& shape, Vec3 position,
+                                        Quat orientation, const QueryFilter& filter) {
   std::vector<ShapeContact> out;
-  const std::optional<Query> query = checked_query(*s_, shape, position, orientation);
+  const std::optional<Query> query = checked_query(s, shape, position, orientation);
   if (!query) return out;
   thread_local std::vector<SubManifold> manifolds;
-  for (const BodyState& b : s_->bodies) {
-    if (passes(b, filter)) touches_of(*s_, *query, b, manifolds, out);
+  for (const BodyState& b : s.bodies) {
+    if (passes(b, filter)) touches_of(s, *query, b, manifolds, out);
   }
   return out;
+}
+
+}  // namespace sim_detail
+
+std::optional<ShapeHit> World::shape_cast(const Shape& shape, Vec3 position, Quat orientation,
+                                          Vec3 translation, const QueryFilter& filter) const {
+  return sim_detail::cast_shape(*s_, shape, position, orientation, translation, filter);
+}
+
+std::vector<ShapeContact> World::shape_contacts(const Shape& shape, Vec3 position, Quat orientation,
+                                                const QueryFilter& filter) const {
+  return sim_detail::contacts_with(*s_, shape, position, orientation, filter);
 }
 
 Expected<std::vector<ShapeContact>> World::contacts_of(BodyId id) const {

@@ -2,6 +2,9 @@
 // and contacts). Internal to detsim::sim.
 #pragma once
 
+#include <optional>
+#include <vector>
+
 #include <detsim/fixed/math.hpp>
 #include <detsim/fixed/quat.hpp>
 #include <detsim/sim/world.hpp>
@@ -27,5 +30,19 @@ namespace detsim::sim_detail {
 [[nodiscard]] inline Fixed cull_slack(Fixed distance) noexcept {
   return Fixed::from_raw(Fixed::one_raw >> 10) + (abs(distance) >> 24);
 }
+
+struct WorldState;
+
+/// World::shape_cast and World::shape_contacts on a world's state (query_shapes.cpp): what the
+/// step's own movers (characters) ask, between stages, of the bodies' present poses.
+[[nodiscard]] std::optional<ShapeHit> cast_shape(const WorldState& s, const Shape& shape,
+                                                 Vec3 position, Quat orientation, Vec3 translation,
+                                                 const QueryFilter& filter);
+/// World::raycast_closest against body b alone (query.cpp).
+[[nodiscard]] std::optional<RayHit> ray_body(const WorldState& s, const BodyState& b, Vec3 origin,
+                                             Vec3 translation);
+[[nodiscard]] std::vector<ShapeContact> contacts_with(const WorldState& s, const Shape& shape,
+                                                      Vec3 position, Quat orientation,
+                                                      const QueryFilter& filter);
 
 }  // namespace detsim::sim_detail

@@ -1,8 +1,9 @@
 // Field-level state comparison (state_diff.hpp). Both states are restored into scratch worlds
 // (so both are fully validated); each section whose hash differs is compared by its differ
 // (kDiffers): bodies field by field through the field table (body_fields.hpp), contacts pair by
-// pair (World::contacts()), point by point, joints field by field through their table
-// (joint_fields.hpp). A section without a differ is named by its hashes.
+// pair (World::contacts()), point by point, joints and characters field by field through their
+// tables (joint_fields.hpp, character_fields.hpp). A section without a differ is named by its
+// hashes.
 #include <detsim/sim/state_diff.hpp>
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include <detsim/sim/state_sections.hpp>
 
 #include "body_fields.hpp"
+#include "character_fields.hpp"
 #include "geometry/geometry.hpp"
 #include "joint_fields.hpp"
 #include "world_state.hpp"
@@ -200,9 +202,40 @@ std::string joint_name(JointId id) {
   return "joint[" + std::to_string(id.value) + "]";
 }
 
-// A joint's identity (type, bodies), then every field of the table (joint_fields.hpp) in its
-// order. Joints belong to no one body: their lines have body 0 and name the joint in the field.
-void diff_joint(Collector& c, JointState a, JointState b) {
+// Every field of a record's table (record_fields.hpp), in its order, named "PREFIX.FIELD".
+// Records belong to no one body: their lines have body 0 and name the record in the field.
+template <class T>
+void diff_record_fields(Collector& c, const std::string& prefix,
+                        std::span<const sim_detail::RecordField<T>> fields, T a, T b,
+                        const char* section) {
+  using sim_detail::RecordFieldKind;
+  for (const sim_detail::RecordField<T>& f : fields) {
+    const std::string field = prefix + f.name;
+    switch (f.kind) {
+      case RecordFieldKind::fixed:
+        c.field(0, field, f.fixed(a), f.fixed(b), section);
+        break;
+      case RecordFieldKind::vec3:
+        c.vec(0, field, f.vec3(a), f.vec3(b), section);
+        break;
+      case RecordFieldKind::quat:
+        c.quat(0, field, f.quat(a), f.quat(b), section);
+        break;
+      case RecordFieldKind::u32:
+        c.field(0, field, std::uint64_t{f.u32(a)}, std::uint64_t{f.u32(b)}, section);
+        break;
+      case RecordFieldKind::u64:
+        c.field(0, field, f.u64(a), f.u64(b), section);
+        break;
+      case RecordFieldKind::flag:
+        c.field(0, field, f.flag(a), f.flag(b), section);
+        break;
+    }
+  }
+}
+
+// A joint's identity (type, bodies), then every field of its table (joint_fields.hpp).
+void diff_joint(Collector& c, const JointState& a, const JointState& b) {
   const std::string name = joint_name(a.id) + ".";
   const char* section = "joints";
   c.field(0, name + "type", a.def.type, b.def.type, section);
@@ -210,26 +243,7 @@ void diff_joint(Collector& c, JointState a, JointState b) {
           section);
   c.field(0, name + "body_b", std::uint64_t{a.def.body_b.value}, std::uint64_t{b.def.body_b.value},
           section);
-  for (const sim_detail::JointField& f : sim_detail::joint_fields()) {
-    const std::string field = name + f.name;
-    switch (f.kind) {
-      case sim_detail::JointFieldKind::fixed:
-        c.field(0, field, f.fixed(a), f.fixed(b), section);
-        break;
-      case sim_detail::JointFieldKind::vec3:
-        c.vec(0, field, f.vec3(a), f.vec3(b), section);
-        break;
-      case sim_detail::JointFieldKind::quat:
-        c.quat(0, field, f.quat(a), f.quat(b), section);
-        break;
-      case sim_detail::JointFieldKind::u64:
-        c.field(0, field, f.u64(a), f.u64(b), section);
-        break;
-      case sim_detail::JointFieldKind::flag:
-        c.field(0, field, f.flag(a), f.flag(b), section);
-        break;
-    }
-  }
+  diff_record_fields(c, name, sim_detail::joint_fields(), a, b, section);
 }
 
 // ---- Sections: each a differ that lists its fields; any other section is named by its hash ----
@@ -351,6 +365,33 @@ void diff_joints(Collector& c, const Sides& w) {
       ++j;
     } else {
       diff_joint(c, w.a->joint(ia[i]).value(), w.b->joint(ib[j]).value());
+      ++i;
+      ++j;
+    }
+  }
+}
+
+std::string character_name(CharacterId id) {
+  return "character[" + std::to_string(id.value) + "]";
+}
+
+// A merge of both ascending character ID lists; a character on one side only is "present".
+void diff_characters(Collector& c, const Sides& w) {
+  const std::vector<CharacterId> ia = w.a->character_ids();
+  const std::vector<CharacterId> ib = w.b->character_ids();
+  std::size_t i = 0;
+  std::size_t j = 0;
+  while (i < ia.size() || j < ib.size()) {
+    if (j == ib.size() || (i < ia.size() && ia[i] < ib[j])) {
+      c.add("characters", 0, character_name(ia[i]) + ".present", "present", "absent");
+      ++i;
+    } else if (i == ia.size() || ib[j] < ia[i]) {
+      c.add("characters", 0, character_name(ib[j]) + ".present", "absent", "present");
+      ++j;
+    } else {
+      diff_record_fields(c, character_name(ia[i]) + ".", sim_detail::character_fields(),
+                         w.a->character(ia[i]).value(), w.b->character(ib[j]).value(),
+                         "characters");
       ++i;
       ++j;
     }
@@ -513,14 +554,9 @@ void diff_game(Collector& c, const Sides& w) {
 
 /// A new section of the World's state adds its differ here.
 constexpr SectionDiffer kDiffers[] = {
-    {"globals", diff_globals},
-    {"geometry", diff_geometry, false},
-    {"rng", diff_rng},
-    {"bodies", diff_bodies},
-    {"contacts", diff_contact_cache},
-    {"joints", diff_joints},
-    {"particles", diff_particles},
-    {"game", diff_game},
+    {"globals", diff_globals},     {"geometry", diff_geometry, false}, {"rng", diff_rng},
+    {"bodies", diff_bodies},       {"contacts", diff_contact_cache},   {"joints", diff_joints},
+    {"particles", diff_particles}, {"characters", diff_characters},    {"game", diff_game},
 };
 
 /// The hashes of a state's sections from its bytes (a state that may not restore here), and its

@@ -1,5 +1,6 @@
 // The canonical state encoding (docs/STATE.md): the container of sections, the World's sections
-// (globals, rng, bodies in state_bodies.cpp, contacts, joints in state_joints.cpp), save, restore
+// (globals, rng, bodies in state_bodies.cpp, contacts, joints in state_joints.cpp, characters in
+// state_characters.cpp), save, restore
 // and the hashes.
 //
 // A World's state is one list of sections, each with its name, version and length; the World's
@@ -317,6 +318,7 @@ constexpr WorldSection kSections[] = {
     {"contacts", 2, write_contacts, read_contacts},
     {"joints", 1, write_joints, read_joints},
     {"particles", 1, write_particles, read_particles},
+    {"characters", 1, write_characters, read_characters, has_characters, clear_characters},
     {"game", 1, write_game, read_game, has_game, clear_game},
 };
 constexpr std::size_t kSectionCount = std::size(kSections);

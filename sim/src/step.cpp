@@ -25,6 +25,8 @@ void World::step() {
     b.force = {};
     b.torque = {};
   }
+  sim_detail::move_characters(s);  //    characters walk, slide and ride on the new poses (their
+                                   //    pushes are forces for the next step)
   ++s.frame;
   sim_detail::check_after_step(s);  // 10. invariants, in builds with DETSIM_CHECKS
 }

@@ -154,6 +154,7 @@ Status World::destroy_body(BodyId id) {
                 [id](const sim_detail::Contact& c) { return c.a == id.value || c.b == id.value; });
   sim_detail::destroy_joints_of(*s_, id);
   sim_detail::detach_particles_of(*s_, id);
+  sim_detail::forget_ground(*s_, id);
   s_->bodies.erase(s_->bodies.begin() + i);
   return Status::success();
 }

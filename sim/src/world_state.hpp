@@ -119,6 +119,8 @@ struct WorldState {
   std::uint32_t next_joint_id = 1;
   std::vector<ParticleGroup> particle_groups;  ///< ascending ID
   std::uint32_t next_particle_group_id = 1;
+  std::vector<CharacterState> characters;  ///< ascending ID
+  std::uint32_t next_character_id = 1;
   /// The game's own state (World::set_game_state): the "game" section when not empty.
   std::vector<std::uint8_t> game;
   /// Its fields' names for diff (World::describe_game_state): a description, not saved.
@@ -149,6 +151,8 @@ struct WorldState {
   [[nodiscard]] std::ptrdiff_t find_joint(std::uint32_t id) const noexcept;
   /// Index of particle group `id` in `particle_groups`, or -1.
   [[nodiscard]] std::ptrdiff_t find_group(std::uint32_t id) const noexcept;
+  /// Index of character `id` in `characters`, or -1.
+  [[nodiscard]] std::ptrdiff_t find_character(std::uint32_t id) const noexcept;
   /// Particles in every group.
   [[nodiscard]] std::size_t particle_total() const noexcept;
 };
@@ -233,6 +237,17 @@ void destroy_joints_of(WorldState& s, BodyId id);
 /// Detaches every particle attached to body `id` (the particle goes free; its group wakes)
 /// (particles/api.cpp).
 void detach_particles_of(WorldState& s, BodyId id);
+
+/// Wakes the islands of the bodies at these indices (a character pushed them after the solver):
+/// every dynamic body of each, so that islands stay asleep or awake as a whole (contacts.cpp).
+void wake_islands(WorldState& s, const std::vector<std::size_t>& bodies);
+
+/// Moves every character (character.cpp): after the bodies, against their new poses.
+void move_characters(WorldState& s);
+/// Characters standing on body `id` (being destroyed) stand on nothing until their next step.
+void forget_ground(WorldState& s, BodyId id);
+/// What a saved character must satisfy (character.cpp): "" when it does.
+[[nodiscard]] std::string check_character_record(const WorldState& s, const CharacterState& c);
 
 /// Appends the end event of a contact that is reported as touching (a pair that stops existing).
 void report_end(WorldState& s, const Contact& c);

@@ -4,6 +4,7 @@
 #include <detsim/core.hpp>  // Status, Rng and the byte codec, which sim's API speaks
 
 #include <detsim/sim/body.hpp>
+#include <detsim/sim/character.hpp>
 #include <detsim/sim/driver.hpp>
 #include <detsim/sim/inject.hpp>
 #include <detsim/sim/joint.hpp>

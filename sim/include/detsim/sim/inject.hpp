@@ -24,6 +24,9 @@
 //                         is contact[OTHER/0/0]. Diff prints contacts in this form.
 //   joint[J].FIELD        BODY 0; FIELD a field of joint J as diff names it (anchor.x,
 //                         linear_impulse.y, motor_speed, broken, ...): DELTA as for its kind
+//   character[C].FIELD    BODY 0; FIELD a field of character C as diff names it (position.y,
+//                         velocity.x, grounded, ground_body, desired_velocity.z, ...): DELTA as
+//                         for its kind
 //   particle_group[G].particle[I].position.x|y|z  particle_group[G].particle[I].velocity.x|y|z
 //   particle_group[G].force.x|y|z  particle_group[G].sleep_time  particle_group[G].tether_impulse
 //                         BODY 0; particle I (0, 1, ...) of particle group G, or the group's own
@@ -34,7 +37,8 @@
 //                         it): DELTA an integer added at the field's width, a decimal for Fixed
 //   game.byte[N]          BODY 0; byte N of the game state; DELTA: an integer, added mod 256
 // Results that restore() would refuse (an orientation no longer a unit quaternion, a negative
-// sleep time, a static body awake, an all-zero RNG state, a joint's axis no longer a unit vector,
+// sleep time, a static body awake, an all-zero RNG state, a joint's axis no longer a unit vector, a
+// character grounded on no body,
 // a particle beyond +-2^30 m or m/s) are refused, and the world is unchanged.
 #pragma once
 

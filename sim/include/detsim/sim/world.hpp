@@ -18,6 +18,7 @@
 #include <detsim/core/status.hpp>
 #include <detsim/fixed/vec3.hpp>
 #include <detsim/sim/body.hpp>
+#include <detsim/sim/character.hpp>
 #include <detsim/sim/game_state.hpp>
 #include <detsim/sim/geometry.hpp>
 #include <detsim/sim/joint.hpp>
@@ -98,7 +99,8 @@ struct StateHashes {
   std::uint64_t total = 0;  ///< the frame's state hash: covers every section
   /// In the state's order. A World's: "globals" (frame, ID counter, definition), "rng",
   /// "geometry" (registered geometry by content hash), "bodies" (every body), "contacts" (the
-  /// contact cache with its warm-start impulses), "joints", "particles" (docs/STATE.md).
+  /// contact cache with its warm-start impulses), "joints", "particles", and when the world has
+  /// had characters, "characters" (docs/STATE.md).
   std::vector<SectionHash> sections;
 
   /// The hash of the section called `name`, or 0 when there is none.
@@ -367,6 +369,24 @@ class World {
   /// a push): accumulated like apply_force, cleared by the step. Wakes the group. Refused beyond
   /// +-2^30 N per component (summed), changing nothing.
   Status apply_particle_force(ParticleGroupId id, Vec3 force);
+
+  // ---- Characters: capsules that walk, climb, slide and ride (<detsim/sim/character.hpp>) ----
+
+  /// Creates a character (docs/SIM.md, "Characters"); its ID is the next in character sequence.
+  /// Refused, with a message naming the field and changing nothing: a radius outside 2^-10 ..
+  /// 100 m, a half_height outside 0 .. 100 m, a max_slope outside (0, pi/2), a step_height below
+  /// 0 or not below the character's height, a mass outside (0, 2^31 - 1) kg, a position beyond
+  /// +-2^30 m. It may start overlapping bodies: its first step moves it out.
+  Expected<CharacterId> create_character(const CharacterDef& def);
+  /// Removes a character. Unknown IDs are an error.
+  Status destroy_character(CharacterId id);
+  /// Sets what the next step applies (CharacterInput). Refused, changing nothing: an unknown ID,
+  /// a desired_velocity component or a jump beyond the world's max_linear_speed, a negative jump.
+  Status set_character_input(CharacterId id, const CharacterInput& input);
+  /// A copy of a character's state, or an error for an unknown ID.
+  [[nodiscard]] Expected<CharacterState> character(CharacterId id) const;
+  /// Every character's ID, ascending.
+  [[nodiscard]] std::vector<CharacterId> character_ids() const;
 
   // ---- Game inputs: accumulated until the next step. Each wakes the body. ----
   // A call whose sums, accelerations or resulting velocities would leave the limits of docs/SIM.md
