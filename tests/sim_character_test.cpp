@@ -199,6 +199,30 @@ TEST(Character, SlidesDownASlopeFiveDegreesAboveItsMaxSlopeAtGSinTheta) {
   EXPECT_NEAR(gain, 9.81 * std::sin(s.angle), 0.02 * 9.81 * std::sin(s.angle));
 }
 
+TEST(Character, AtTheFootOfASteepSlopeItStandsOnTheFloorAndWalksAway) {
+  // A wedge: the floor, and a 60-degree slope rising from x = 0. A character pushed against the
+  // slope's foot touches both; it stands on the floor (walkable) and walks away when told to.
+  World w = make_world();
+  add_ground(w);
+  // A box turned -30 degrees about z: its -x face, of normal (-cos 30, sin 30), is the slope; the
+  // box's centre 1 / cos 30 beyond x = 0 puts the face's foot there.
+  add(w, static_placed(Shape::box({1_fx, 4_fx, 2_fx}), {fx(1 / std::cos(kPi / 6)), 0_fx, 0_fx},
+                       from_axis_angle(kZ, radians(-30))));
+  const CharacterId c = add_character(w, at({-1_fx, 1_fx, 0_fx}));
+  walk(w, c, {2_fx, 0_fx, 0_fx});  // into the slope's foot
+  for (int i = 0; i < 60; ++i)
+    w.step();
+  const CharacterState pressed = character(w, c);
+  EXPECT_TRUE(pressed.grounded);
+  EXPECT_FALSE(pressed.sliding());
+  EXPECT_NEAR(to_d(pressed.position.y), kStand, 0.002) << "on the floor, not up the slope";
+  walk(w, c, {-2_fx, 0_fx, 0_fx});
+  for (int i = 0; i < 30; ++i)
+    w.step();
+  EXPECT_NEAR(to_d(character(w, c).position.x), to_d(pressed.position.x) - 1.0, 0.02)
+      << "it walks away at its input's speed";
+}
+
 TEST(Character, StaysGroundedWalkingDownThirtyDegreesAtFiveMetresASecond) {
   World w = make_world();
   // A floor whose top is y = 0 for x < 0, then a 30-degree slope down towards +x from its edge.

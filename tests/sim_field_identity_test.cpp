@@ -28,7 +28,8 @@ const char* const kGoldenPath = DETSIM_SOURCE_DIR "/golden/fields.txt";
 
 // The layout hashed per frame: the frame number (u64), then per body in ascending ID order its ID
 // (u32) and the raw Q32.32 values (i64) of position x y z, orientation w x y z, linear velocity
-// x y z and angular velocity x y z, all little-endian.
+// x y z and angular velocity x y z, then per character in ascending ID order its ID (u32), its
+// position x y z and velocity x y z (a world without characters adds nothing), all little-endian.
 class FieldBytes {
  public:
   void u32(std::uint32_t v) { put(v, 4); }
@@ -63,6 +64,12 @@ std::uint64_t field_hash(const World& world, FieldBytes& bytes) {
     bytes.fixed(b.orientation.z);
     bytes.vec3(b.linear_velocity);
     bytes.vec3(b.angular_velocity);
+  }
+  for (const CharacterId id : world.character_ids()) {
+    const CharacterState c = *world.character(id);
+    bytes.u32(id.value);
+    bytes.vec3(c.position);
+    bytes.vec3(c.velocity);
   }
   return bytes.hash();
 }

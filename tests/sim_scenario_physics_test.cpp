@@ -2,8 +2,9 @@
 // passes the wall (with and without the CCD flag, at any phase of the step), the slope sorts boxes
 // by friction, the dominoes all fall, the game logic of spray and arena does what it says, and the
 // joint scenes (pendulum, chain, ragdolls, bridge, wrecking_ball, motors) do what their formulas
-// say. Each expectation is derived from the scene's geometry (read from the World at frame 0) and
-// the physics, never read back from a run.
+// say, and the characters keep to the floor, the yard and the slopes they may walk. Each
+// expectation is derived from the scene's geometry (read from the World at frame 0) and the
+// physics, never read back from a run.
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
@@ -713,5 +714,81 @@ TEST(MotorsScenario, CarsRunAtWheelRadiusTimesMotorSpeedAndDriveStraight) {
                 to_string(now.position.z - cars[c].position.z).c_str());
   }
 }
+
+// The characters scene's parts, found in the World at frame 0 by their geometry: the walls (the
+// static boxes 2 m tall), the steep ramp (the static body turned furthest from upright) and the
+// top of the stairs (the upright static boxes whose tops are highest below the walls': the last
+// step and the landing).
+struct Yard {
+  Fixed inner = Fixed::max();  ///< the walls' inner faces are at +- inner
+  BodyId steep;
+  std::vector<BodyId> top;
+};
+
+Yard yard_of(const World& w) {
+  Yard y;
+  Fixed least_w = Fixed::one();
+  Fixed highest = Fixed::zero();
+  for (const BodyId id : w.body_ids()) {
+    const BodyState b = state(w, id);
+    if (b.type != BodyType::static_body || b.shape.type != ShapeType::box) continue;
+    const Vec3 half = b.shape.half_extents;
+    const Fixed top = b.position.y + half.y;
+    if (half.y == 1_fx) {
+      y.inner = std::min(y.inner, std::max(abs(b.position.x) - half.x, abs(b.position.z) - half.z));
+      continue;
+    }
+    if (b.orientation.w < least_w) {
+      least_w = b.orientation.w;
+      y.steep = id;
+    }
+    if (b.orientation == Quat::identity() && top >= highest) {
+      if (top > highest) y.top.clear();
+      highest = top;
+      y.top.push_back(id);
+    }
+  }
+  return y;
+}
+
+TEST(CharactersScenario, CharactersKeepToTheFloorAndTheYardStayOffTheSteepSlopeAndClimbTheStairs) {
+  // Eight characters walking and jumping where the RNG sends them for 20 s: none ever sinks into
+  // the floor or passes a wall, none ever stands on the slope steeper than its max_slope (60
+  // degrees against 45), each stands most of the time, and the stairs (0.2 m risers under a 0.3 m
+  // step height) are climbed to the landing.
+  Scenario s = make("characters");
+  const World& w = s.world();
+  const Yard yard = yard_of(w);
+  ASSERT_LT(yard.inner, 100_fx);
+  ASSERT_FALSE(yard.steep.is_null());
+  ASSERT_EQ(yard.top.size(), 2U);
+  const std::vector<CharacterId> ids = w.character_ids();
+  ASSERT_EQ(ids.size(), 8U);
+  const CharacterDef def = w.character(ids[0])->def;
+  const Fixed stand = def.radius + def.half_height;  // the centre's height on the floor
+  const Fixed cos_max = cos(def.max_slope);
+  std::vector<int> grounded(ids.size(), 0);
+  bool landed = false;
+  constexpr int frames = 1200;
+  for (int f = 0; f < frames; ++f) {
+    s.step();
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      const CharacterState c = w.character(ids[k]).value();
+      ASSERT_GE(c.position.y, stand - 0.001_fx) << "character " << k + 1 << " frame " << f;
+      ASSERT_LE(abs(c.position.x), yard.inner - def.radius + 0.001_fx) << "frame " << f;
+      ASSERT_LE(abs(c.position.z), yard.inner - def.radius + 0.001_fx) << "frame " << f;
+      if (!c.grounded) continue;
+      ++grounded[k];
+      ASSERT_GE(c.ground_normal.y, cos_max) << "character " << k + 1 << " frame " << f;
+      ASSERT_NE(c.ground_body, yard.steep) << "character " << k + 1 << " frame " << f;
+      landed =
+          landed || std::find(yard.top.begin(), yard.top.end(), c.ground_body) != yard.top.end();
+    }
+  }
+  for (std::size_t k = 0; k < ids.size(); ++k)
+    EXPECT_GT(grounded[k], frames / 2) << "character " << k + 1;
+  EXPECT_TRUE(landed) << "someone climbed the stairs to their top";
+}
+
 }  // namespace
 }  // namespace detsim

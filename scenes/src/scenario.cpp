@@ -63,6 +63,13 @@ constexpr std::array entries{
            1200, 0, 0, 0, 30, 1000, false, "links"},
           scenes_detail::build_chain,
           nullptr},
+    Entry{{"characters",
+           "N character controllers (default 8) walking, jumping, climbing stairs, kept off a "
+           "steep slope, riding a sliding and a turning platform and pushing crates in a walled "
+           "yard; inputs drawn from the RNG each second",
+           600, 0, 0, 0, 8, 100, true, "characters"},
+          scenes_detail::build_characters,
+          scenes_detail::control_characters},
     Entry{{"dam_break",
            "a block of water N particles wide, 2N high and 2N deep (default 10: 4000 particles) "
            "released at one end of a tank with an obstacle",

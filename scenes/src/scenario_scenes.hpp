@@ -44,11 +44,15 @@ void build_wrecking_rope(World& w, const ScenarioParams& p);
 void build_jelly(World& w, const ScenarioParams& p);
 void build_dam_break(World& w, const ScenarioParams& p);
 
+// The scene of character controllers (scenario_characters.cpp).
+void build_characters(World& w, const ScenarioParams& p);
+
 // Per-frame logic, run before each step. Reads only the World and the inputs.
 void control_spray(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_arena(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_bridge(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_flag(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
+void control_characters(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 
 // Tags in BodyDef::user_data by which game logic finds its bodies again (the World is the whole
 // scenario state, so nothing else may remember them). A player's tag is player_tag + index.
@@ -200,5 +204,28 @@ inline constexpr std::uint32_t segments = 24;
 inline constexpr Fixed ball_radius = 0.4_fx;
 inline constexpr Fixed ball_mass = 200_fx;
 }  // namespace wrecking_rope
+
+namespace characters {
+inline constexpr Fixed yard = 12_fx;  ///< the walls' inner faces are at +-yard in x and z
+inline constexpr std::int32_t stair_count = 6;
+inline constexpr Fixed stair_rise = 0.2_fx;  ///< below the characters' step height (0.3 m)
+inline constexpr Fixed stair_run = 0.4_fx;
+inline constexpr Fixed stairs_z = -7_fx;
+inline constexpr Fixed ramp_z = -2_fx;
+inline constexpr Fixed steep_z = 2_fx;
+inline constexpr Fixed walkable_slope = 0.436332313_fx;  ///< 25 degrees
+inline constexpr Fixed steep_slope = 1.047197551_fx;     ///< 60 degrees: above max_slope (45)
+inline constexpr Fixed platform_half_thickness = 0.2_fx;
+inline constexpr Vec3 slide_at{-7_fx, 0.6_fx, 7_fx};
+inline constexpr Fixed slide_speed = 2_fx;
+inline constexpr std::uint64_t slide_period = 120;  ///< frames each way
+inline constexpr Vec3 spin_at{6_fx, 0.4_fx, 7_fx};
+inline constexpr Fixed spin_rate = 0.8_fx;  ///< rad/s
+inline constexpr Fixed crates_z = -4_fx;
+inline constexpr Fixed crate_half = 0.4_fx;
+inline constexpr Fixed crate_mass = 20_fx;
+inline constexpr Fixed max_walk_speed = 3_fx;
+inline constexpr Fixed jump_speed = 4.5_fx;
+}  // namespace characters
 
 }  // namespace detsim::scenes_detail

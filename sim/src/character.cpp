@@ -230,8 +230,15 @@ class CharacterMover {
   [[nodiscard]] Ground ground(Vec3 p, Fixed reach) const {
     Ground g;
     const Vec3 down{Fixed::zero(), -reach, Fixed::zero()};
-    const std::optional<ShapeHit> hit = cast(p, down);
+    std::optional<ShapeHit> hit = cast(p, down);
     if (!hit) return g;
+    // In a wedge (a floor at the foot of a wall or a steep slope) the steep surface may be met
+    // first: the ground beyond it, when walkable, is what the character stands on.
+    if (!walkable(surface_normal(*hit, p + down * hit->fraction))) {
+      if (auto beyond = cast(p, down, hit->body);
+          beyond && walkable(surface_normal(*beyond, p + down * beyond->fraction)))
+        hit = beyond;
+    }
     const Vec3 at = p + down * hit->fraction;
     g.found = true;
     g.normal = surface_normal(*hit, at);

@@ -25,6 +25,7 @@ inline constexpr GoldenRun runs[] = {
     {"bridge", {.seed = 1, .players = 0, .count = 20}, 1000},
     {"bullet_wall", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"chain", {.seed = 1, .players = 0, .count = 30}, 1200},
+    {"characters", {.seed = 1, .players = 0, .count = 8}, 1000},
     {"dam_break", {.seed = 1, .players = 0, .count = 3}, 1000},
     {"dominoes", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"drape", {.seed = 1, .players = 0, .count = 12}, 1000},
