@@ -114,6 +114,45 @@ TEST(CliBisect, AJointsFieldIsNamedLikeABodysField) {
   EXPECT_TRUE(has(r.err, "no joint with ID 999")) << r.err;
 }
 
+/// A character's field (the characters scenario) through the commands: bisection names the
+/// character and the field in the "characters" subsystem; a change the next step overwrites (the
+/// velocity of a character that stands) is found, and said to have healed by the next keyframe.
+TEST(CliBisect, ACharactersFieldIsNamedAndAHealedDivergenceIsSaid) {
+  TempFile faulty("faulty.dsr");
+  TempFile healthy_report("healthy.dsd");
+  TempFile faulty_report("faulty.dsd");
+  const std::string inject = "150:0:character[3].position.x:0.01";
+  auto r = detsim_cli("run --scenario characters --frames 300 --record " + faulty.path() +
+                      " --inject " + inject);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = detsim_cli("verify " + faulty.path() + " --report " + healthy_report.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "first_mismatch"), "150") << r.out;
+  r = detsim_cli("verify " + faulty.path() + " --inject " + inject + " --report " +
+                 faulty_report.path() + " --at 150");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = detsim_cli("bisect " + healthy_report.path() + " " + faulty_report.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_TRUE(has(r.out, R"("subsystems":["characters"])")) << r.out;
+  EXPECT_TRUE(has(r.out, R"("field":"character[3].position.x",)")) << r.out;
+  EXPECT_TRUE(has(r.out, R"(}],"diffs_omitted":0)")) << "exactly one difference: " << r.out;
+
+  // A standing character's velocity is recomputed from its input by the next step.
+  TempFile healthy("healthy.dsr");
+  TempFile healing("healing.dsr");
+  r = detsim_cli("run --scenario characters --frames 400 --keyframe-interval 100 --record " +
+                 healthy.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = detsim_cli("run --scenario characters --frames 400 --keyframe-interval 100 --record " +
+                 healing.path() + " --inject 250:0:character[2].velocity.y:0.5");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = detsim_cli("bisect " + healthy.path() + " " + healing.path() + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(json_value(r.out, "first_divergent_frame"), "250") << r.out;
+  EXPECT_EQ(json_value(r.out, "healed_frame"), "300") << r.out;
+  EXPECT_EQ(json_value(r.out, "diff_frame"), "null") << r.out;
+}
+
 /// A particle's field (a cloth particle's height in the drape scenario) through the commands:
 /// bisection names the group, the particle and the field, in the "particles" subsystem.
 TEST(CliBisect, AParticlesFieldIsNamedLikeABodysField) {

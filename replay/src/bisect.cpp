@@ -464,6 +464,12 @@ Expected<BisectResult> bisect(const std::string& path_a, const std::string& path
     if (!sb) continue;
     auto diff = diff_states(geometry, *sa, *sb, options.max_diffs);
     if (!diff) return diff.status();
+    if (diff.value().a.total == diff.value().b.total) {
+      // The divergence did not last (a field the next step overwrites, such as the velocity of a
+      // character that stands): nothing to list here, so a later known frame is no help either.
+      r.healed_frame = f;
+      break;
+    }
     r.diff_frame = f;
     r.diff_source_a = source_a;
     r.diff_source_b = source_b;

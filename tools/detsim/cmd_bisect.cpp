@@ -87,6 +87,7 @@ void print_json(const replay::BisectResult& r, const std::string& html, double s
       .raw("subsystems", Json::array(quoted(r.subsystems)))
       .str("local_agrees_with", r.local_agrees_with)
       .frame("diff_frame", r.diff_frame)
+      .frame("healed_frame", r.healed_frame)
       .str("diff_source_a", r.diff_source_a)
       .str("diff_source_b", r.diff_source_b)
       .raw("diffs", Json::array(diffs))
@@ -162,6 +163,11 @@ void print_text(const replay::BisectResult& r, const std::string& html, double s
           print_field(f);
         if (r.diffs_omitted != 0)
           std::printf("  ... and %zu more differences (--max shows more)\n", r.diffs_omitted);
+      } else if (r.healed_frame) {
+        std::printf(
+            "the states are equal again at frame %llu (the divergence healed: a field the "
+            "next steps overwrote): no field-level diff there\n",
+            static_cast<unsigned long long>(*r.healed_frame));
       } else {
         std::printf("no frame from %llu on has both sides' states: no field-level diff\n", first);
       }

@@ -97,6 +97,10 @@ struct BisectResult {
 
   /// The frame of the field-level diff (first_divergent_frame when exact states were known).
   std::optional<std::uint64_t> diff_frame;
+  /// The first known frame after the divergence where both sides' states are equal again (the
+  /// divergence healed: a field the next step overwrites), when that came before any frame that
+  /// differs; then there is no diff_frame.
+  std::optional<std::uint64_t> healed_frame;
   std::string diff_source_a;  ///< where A's state came from: "desync report", "keyframe", ...
   std::string diff_source_b;
   std::vector<FieldDiff> diffs;
