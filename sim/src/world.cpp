@@ -155,6 +155,7 @@ Status World::destroy_body(BodyId id) {
   sim_detail::destroy_joints_of(*s_, id);
   sim_detail::detach_particles_of(*s_, id);
   sim_detail::forget_ground(*s_, id);
+  sim_detail::forget_vehicles_of(*s_, id);
   s_->bodies.erase(s_->bodies.begin() + i);
   return Status::success();
 }

@@ -119,6 +119,8 @@ struct WorldState {
   std::uint32_t next_joint_id = 1;
   std::vector<ParticleGroup> particle_groups;  ///< ascending ID
   std::uint32_t next_particle_group_id = 1;
+  std::vector<VehicleState> vehicles;  ///< ascending ID
+  std::uint32_t next_vehicle_id = 1;
   std::vector<CharacterState> characters;  ///< ascending ID
   std::uint32_t next_character_id = 1;
   /// The game's own state (World::set_game_state): the "game" section when not empty.
@@ -151,6 +153,8 @@ struct WorldState {
   [[nodiscard]] std::ptrdiff_t find_joint(std::uint32_t id) const noexcept;
   /// Index of particle group `id` in `particle_groups`, or -1.
   [[nodiscard]] std::ptrdiff_t find_group(std::uint32_t id) const noexcept;
+  /// Index of vehicle `id` in `vehicles`, or -1.
+  [[nodiscard]] std::ptrdiff_t find_vehicle(std::uint32_t id) const noexcept;
   /// Index of character `id` in `characters`, or -1.
   [[nodiscard]] std::ptrdiff_t find_character(std::uint32_t id) const noexcept;
   /// Particles in every group.
@@ -244,6 +248,9 @@ void wake_islands(WorldState& s, const std::vector<std::size_t>& bodies);
 
 /// Moves every character (character.cpp): after the bodies, against their new poses.
 void move_characters(WorldState& s);
+/// Removes the vehicles whose chassis is body `id` (being destroyed) and forgets it as a wheel's
+/// ground (vehicles.cpp).
+void forget_vehicles_of(WorldState& s, BodyId id);
 /// Characters standing on body `id` (being destroyed) stand on nothing until their next step.
 void forget_ground(WorldState& s, BodyId id);
 /// What a saved character must satisfy (character.cpp): "" when it does.

@@ -13,5 +13,6 @@
 #include <detsim/sim/shape_outline.hpp>
 #include <detsim/sim/state_diff.hpp>
 #include <detsim/sim/state_sections.hpp>
+#include <detsim/sim/vehicle.hpp>
 #include <detsim/sim/world.hpp>
 #include <detsim/sim/world_def.hpp>

@@ -23,7 +23,8 @@
 // the bits it gave before joints existed; the order is part of the results, and fixed now that it
 // is chosen). Particle groups (particles/xpbd.cpp) are stepped after the bodies' positions move in
 // each sub-step, in small steps of their own, and pass what they push on bodies to the bodies'
-// velocities before the kinds see the new positions. Wheel contacts will follow as a kind. Wide
+// velocities before the kinds see the new positions. Vehicles' wheels (wheel_solver.cpp) are the
+// fourth kind. Wide
 // (SIMD) rows do not change this file: a kind's stage function will loop over batches of
 // constraints (4 or 8 side by side, from a deterministic graph colouring, each lane giving the
 // scalar path's bits) instead of one constraint at a time; the stage order and the kind order stay
@@ -38,12 +39,13 @@
 #include "contact_solver.hpp"
 #include "joint_solver.hpp"
 #include "tether_solver.hpp"
+#include "wheel_solver.hpp"
 
 namespace detsim::sim_detail {
 
 namespace {
 
-using Kinds = std::array<ConstraintKind*, 3>;
+using Kinds = std::array<ConstraintKind*, 4>;
 
 // One stage of every kind, in kind order.
 void each_kind(const Kinds& kinds, void (ConstraintKind::*stage)()) {
@@ -64,8 +66,10 @@ void solve(WorldState& s) {
   ContactSolver contacts(s, bodies);
   JointSolver joints(s, bodies);
   TetherSolver tethers(s, bodies);
+  WheelSolver wheels(s, bodies);
   ParticleStepper particles(s, bodies);
-  const Kinds kinds{&contacts, &joints, &tethers};  // the kind order: part of the results
+  // The kind order: part of the results.
+  const Kinds kinds{&contacts, &joints, &tethers, &wheels};
   const std::uint32_t iterations = s.def.iterations;
 
   each_kind(kinds, &ConstraintKind::prepare);

@@ -26,6 +26,7 @@
 #include <detsim/sim/particles.hpp>
 #include <detsim/sim/shape_outline.hpp>
 #include <detsim/sim/state_sections.hpp>
+#include <detsim/sim/vehicle.hpp>
 #include <detsim/sim/world_def.hpp>
 
 namespace detsim {
@@ -387,6 +388,25 @@ class World {
   [[nodiscard]] Expected<CharacterState> character(CharacterId id) const;
   /// Every character's ID, ascending.
   [[nodiscard]] std::vector<CharacterId> character_ids() const;
+
+  // ---- Vehicles: a chassis on wheels, engine, gearbox and tires (<detsim/sim/vehicle.hpp>) ----
+
+  /// Makes the dynamic body def.chassis a vehicle (docs/SIM.md, "Vehicles"); its ID is the next
+  /// in vehicle sequence. Refused, with a message naming the field and changing nothing: a chassis
+  /// that does not exist, is not dynamic or is already a vehicle's; a count of wheels (1 .. 16),
+  /// torque curve points (1 .. 16, ascending rpm), gears (1 .. 8) or axles (0 .. 8) out of range;
+  /// a value out of its documented range. Wakes the chassis.
+  Expected<VehicleId> create_vehicle(const VehicleDef& def);
+  /// Removes a vehicle (its chassis stays, a plain body). Unknown IDs are an error.
+  Status destroy_vehicle(VehicleId id);
+  /// Sets what the next steps apply (VehicleInput: kept until changed); a change wakes the
+  /// chassis. Refused, changing nothing: an unknown ID, a throttle or brake outside 0 .. 1, a
+  /// steering outside -1 .. 1.
+  Status set_vehicle_input(VehicleId id, const VehicleInput& input);
+  /// A copy of a vehicle's state, or an error for an unknown ID.
+  [[nodiscard]] Expected<VehicleState> vehicle(VehicleId id) const;
+  /// Every vehicle's ID, ascending.
+  [[nodiscard]] std::vector<VehicleId> vehicle_ids() const;
 
   // ---- Game inputs: accumulated until the next step. Each wakes the body. ----
   // A call whose sums, accelerations or resulting velocities would leave the limits of docs/SIM.md
