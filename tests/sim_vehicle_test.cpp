@@ -189,6 +189,68 @@ TEST(Vehicle, AtAHundredMetresASecondItDoesNotPassATenCentimetreWall) {
   }
 }
 
+/// A car driven by a script of inputs: throttle, steering both ways, braking, the handbrake.
+void drive(Car& car, int from, int to) {
+  for (int f = from; f < to; ++f) {
+    VehicleInput in;
+    const int phase = (f / 40) % 5;
+    in.throttle = phase < 3 ? 0.8_fx : 0_fx;
+    in.steering = phase == 1 ? 0.7_fx : (phase == 2 ? -0.5_fx : 0_fx);
+    in.brake = phase == 3 ? 0.6_fx : 0_fx;
+    in.handbrake = phase == 4;
+    car.input(in);
+    car.w.step();
+  }
+}
+
+TEST(Vehicle, RestoredMidManoeuvreItDrivesOnLikeTheUninterruptedRun) {
+  Car a;
+  drive(a, 0, 130);
+  const std::vector<std::uint8_t> saved = a.w.save();
+  std::vector<StateHashes> expected;
+  for (int f = 130; f < 260; ++f) {
+    drive(a, f, f + 1);
+    expected.push_back(a.w.hashes());
+  }
+  Car b;
+  ASSERT_TRUE(b.w.restore(saved).ok());
+  for (int f = 130; f < 260; ++f) {
+    drive(b, f, f + 1);
+    ASSERT_EQ(b.w.hashes(), expected[static_cast<std::size_t>(f - 130)]) << "frame " << f;
+  }
+  EXPECT_EQ(a.vehicle(), b.vehicle());
+  EXPECT_GT(to_d(a.vehicle().forward_speed), 1.0) << "the script drove it";
+}
+
+TEST(Vehicle, TheVehiclesSectionIsWrittenOnlyByAWorldThatHasHadOneAndDiffNamesAWheel) {
+  World plain = make_world();
+  add_ground(plain);
+  EXPECT_EQ(plain.hashes().section("vehicles"), 0U);
+  Car car;
+  drive(car, 0, 50);
+  EXPECT_NE(car.w.hashes().section("vehicles"), 0U);
+  const std::vector<std::uint8_t> before = car.w.save();
+  auto injection = parse_injection("50:0:vehicle[1].wheel[2].angular_velocity:0.5");
+  ASSERT_TRUE(injection.ok()) << injection.message();
+  ASSERT_TRUE(apply_injection(car.w, *injection).ok());
+  const StateDiff d = diff_states(car.w, before, car.w.save()).value();
+  ASSERT_EQ(d.fields.size(), 1U);
+  EXPECT_EQ(d.fields[0].subsystem, "vehicles");
+  EXPECT_EQ(d.fields[0].field, "vehicle[1].wheel[2].angular_velocity");
+  // What restore would refuse is refused, and changes nothing.
+  const std::vector<std::uint8_t> now = car.w.save();
+  EXPECT_FALSE(apply_injection(car.w, *parse_injection("50:0:vehicle[1].gear:9")).ok());
+  EXPECT_FALSE(apply_injection(car.w, *parse_injection("50:0:vehicle[1].wheel[7].radius:1")).ok());
+  EXPECT_FALSE(apply_injection(car.w, *parse_injection("50:0:vehicle[1].throttle:2")).ok());
+  EXPECT_FALSE(parse_injection("50:0:vehicle[1].wheel[0].wobble:1").ok());
+  EXPECT_EQ(car.w.save(), now);
+  // A restore keeps every field: a saved state reads back to the same bytes.
+  World copy = car.w;
+  ASSERT_TRUE(copy.restore(now).ok());
+  EXPECT_EQ(copy.save(), now);
+  EXPECT_EQ(copy.vehicle(car.id).value(), car.vehicle());
+}
+
 TEST(Vehicle, BadDefinitionsAndInputsAreRefusedNamingTheField) {
   World w = make_world();
   add_ground(w);

@@ -16,6 +16,7 @@
 #include "joint_fields.hpp"
 #include "shapes.hpp"
 #include "state_io.hpp"
+#include "vehicle_fields.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
@@ -75,6 +76,11 @@ const std::string& fields_help() {
            "decimal; contact[OTHER/S/T] for the contact of BODY's sub-shape S with OTHER's "
            "sub-shape T); joint[J].FIELD (BODY 0; FIELD a field of the joint as diff names it: " +
            record_fields_help(sim_detail::joint_fields()) +
+           "); vehicle[V].FIELD and vehicle[V].wheel[K].FIELD (BODY 0; FIELD a field of the "
+           "vehicle as diff names it: " +
+           record_fields_help(sim_detail::vehicle_fields()) +
+           "; of a wheel: " + record_fields_help(sim_detail::wheel_state_fields()) + ", " +
+           record_fields_help(sim_detail::wheel_def_fields()) +
            "); character[C].FIELD (BODY 0; FIELD a field of the character as diff names it: " +
            record_fields_help(sim_detail::character_fields()) +
            "); particle_group[G].particle[I].position.x|y|z, "
@@ -94,7 +100,18 @@ enum class DeltaKind { fixed, toggle, integer, presence, number };
 /// What a field name refers to, once parsed.
 struct Target {
   DeltaKind kind = DeltaKind::fixed;
-  enum class Part { body, rng, contact, joint, character, particles, game } part = Part::body;
+  enum class Part {
+    body,
+    rng,
+    contact,
+    joint,
+    character,
+    vehicle,
+    particles,
+    game
+  } part = Part::body;
+  /// vehicle: the table of `base`: the vehicle's own (0), a wheel's state (1) or definition (2)
+  int table = 0;
   std::string base;             ///< "position", "sleep_time", "normal_impulse", ...
   int component = -1;           ///< x y z = 0 1 2, w = 3; the RNG word; -1: none
   std::uint32_t other = 0;      ///< contact: the other body
@@ -183,12 +200,13 @@ Expected<Target> parse_field(std::string_view field) {
     t.base = std::string(name);
     return t;
   }
-  // joint[J].FIELD and character[C].FIELD: a field of the record's table (record_fields.hpp).
-  const auto record = [&]<class T>(
-                          std::string_view prefix, Target::Part part,
-                          std::span<const sim_detail::RecordField<T>> fields) -> Expected<Target> {
+  // joint[J].FIELD, character[C].FIELD, vehicle[V].FIELD: a field of the record's table
+  // (record_fields.hpp), `text` being PREFIX[ID].FIELD.
+  const auto record = [&]<class T>(std::string_view prefix, Target::Part part,
+                                   std::span<const sim_detail::RecordField<T>> fields,
+                                   std::string_view text) -> Expected<Target> {
     std::string_view rest;
-    auto id = indexed(field, prefix, rest);
+    auto id = indexed(text, prefix, rest);
     if (!id || *id == 0 || *id > 0xFFFFFFFFU || !rest.starts_with(".")) return unknown();
     int component = -1;
     const sim_detail::RecordField<T>* f =
@@ -206,9 +224,41 @@ Expected<Target> parse_field(std::string_view field) {
     return t;
   };
   if (field.starts_with("joint["))
-    return record("joint", Target::Part::joint, sim_detail::joint_fields());
+    return record("joint", Target::Part::joint, sim_detail::joint_fields(), field);
   if (field.starts_with("character["))
-    return record("character", Target::Part::character, sim_detail::character_fields());
+    return record("character", Target::Part::character, sim_detail::character_fields(), field);
+  if (field.starts_with("vehicle[")) {
+    // vehicle[V].FIELD, or vehicle[V].wheel[K].FIELD of the wheel's state or definition.
+    std::string_view rest;
+    auto id = indexed(field, "vehicle", rest);
+    if (!id || *id == 0 || *id > 0xFFFFFFFFU || !rest.starts_with(".")) return unknown();
+    rest.remove_prefix(1);
+    if (rest.starts_with("wheel[")) {
+      std::string_view name;
+      auto wheel = indexed(rest, "wheel", name);
+      if (!wheel || *wheel > 0xFFFFU || !name.starts_with(".")) return unknown();
+      const std::string prefix =
+          "vehicle[" + std::to_string(*id) + "].wheel[" + std::to_string(*wheel) + "]";
+      const std::string inner = "wheel_state[1]" + std::string(name);
+      auto t_state =
+          record("wheel_state", Target::Part::vehicle, sim_detail::wheel_state_fields(), inner);
+      if (t_state.ok()) {
+        t.table = 1;
+      } else if (auto t_def = record("wheel_state", Target::Part::vehicle,
+                                     sim_detail::wheel_def_fields(), inner);
+                 t_def.ok()) {
+        t.table = 2;
+      } else {
+        return unknown();
+      }
+      t.joint = static_cast<std::uint32_t>(*id);
+      t.particle = static_cast<std::uint32_t>(*wheel);
+      return t;
+    }
+    auto out = record("vehicle", Target::Part::vehicle, sim_detail::vehicle_fields(), field);
+    if (out.ok()) t.table = 0;
+    return out;
+  }
   if (field.starts_with("particle_group[")) {
     // particle_group[G].particle[I].position|velocity.C, or a group field: force.C, sleep_time,
     // tether_impulse, awake.
@@ -518,6 +568,8 @@ Expected<Injection> parse_injection(std::string_view spec) {
     return Status::error(where + "BODY must be 0 for an RNG field");
   if (target->part == Target::Part::joint && *body != 0)
     return Status::error(where + "BODY must be 0 for a joint field (the joint is named in it)");
+  if (target->part == Target::Part::vehicle && *body != 0)
+    return Status::error(where + "BODY must be 0 for a vehicle field (the vehicle is named in it)");
   if (target->part == Target::Part::character && *body != 0)
     return Status::error(where +
                          "BODY must be 0 for a character field (the character is named in it)");
@@ -571,6 +623,28 @@ Status apply_injection(World& world, const Injection& injection) {
       return Status::error(where + "joint " + std::to_string(t.joint) +
                            ": the change would leave an invalid state: " + e);
     s.joints[static_cast<std::size_t>(j)] = changed;
+    return Status::success();
+  }
+
+  if (t.part == Target::Part::vehicle) {
+    const std::ptrdiff_t k = s.find_vehicle(t.joint);
+    if (k < 0) return Status::error(where + "no vehicle with ID " + std::to_string(t.joint));
+    VehicleState changed = s.vehicles[static_cast<std::size_t>(k)];
+    if (t.table != 0 && *t.particle >= changed.wheels.size())
+      return Status::error(where + "vehicle " + std::to_string(t.joint) + " has " +
+                           std::to_string(changed.wheels.size()) + " wheels, not wheel " +
+                           std::to_string(*t.particle));
+    if (t.table == 0) change_record(sim_detail::vehicle_fields(), changed, t, injection.delta);
+    if (t.table == 1)
+      change_record(sim_detail::wheel_state_fields(), changed.wheels[*t.particle], t,
+                    injection.delta);
+    if (t.table == 2)
+      change_record(sim_detail::wheel_def_fields(), changed.def.wheels[*t.particle], t,
+                    injection.delta);
+    if (auto e = sim_detail::check_vehicle_record(s, changed); !e.empty())
+      return Status::error(where + "vehicle " + std::to_string(t.joint) +
+                           ": the change would leave an invalid state: " + e);
+    s.vehicles[static_cast<std::size_t>(k)] = changed;
     return Status::success();
   }
 

@@ -19,6 +19,7 @@
 #include "character_fields.hpp"
 #include "geometry/geometry.hpp"
 #include "joint_fields.hpp"
+#include "vehicle_fields.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
@@ -371,6 +372,72 @@ void diff_joints(Collector& c, const Sides& w) {
   }
 }
 
+std::string vehicle_name(VehicleId id) {
+  return "vehicle[" + std::to_string(id.value) + "]";
+}
+
+// A vehicle's own fields, then its lists: the torque curve, the gear ratios, each wheel's
+// definition and state ("vehicle[1].wheel[2].angular_velocity"), each axle. A list of another
+// length is named by its count.
+void diff_vehicle(Collector& c, const VehicleState& a, const VehicleState& b) {
+  const char* section = "vehicles";
+  const std::string name = vehicle_name(a.id) + ".";
+  diff_record_fields(c, name, sim_detail::vehicle_fields(), a, b, section);
+  const auto count = [&](const std::string& list, std::size_t na, std::size_t nb) {
+    c.field(0, name + list + ".count", std::uint64_t{na}, std::uint64_t{nb}, section);
+    return na == nb;
+  };
+  const std::vector<TorquePoint>& ta = a.def.engine.torque_curve;
+  const std::vector<TorquePoint>& tb = b.def.engine.torque_curve;
+  if (count("engine.torque_curve", ta.size(), tb.size())) {
+    for (std::size_t i = 0; i < ta.size(); ++i) {
+      const std::string at = name + "engine.torque_curve[" + std::to_string(i) + "].";
+      c.field(0, at + "rpm", ta[i].rpm, tb[i].rpm, section);
+      c.field(0, at + "torque", ta[i].torque, tb[i].torque, section);
+    }
+  }
+  if (count("gear_ratios", a.def.gear_ratios.size(), b.def.gear_ratios.size())) {
+    for (std::size_t i = 0; i < a.def.gear_ratios.size(); ++i)
+      c.field(0, name + "gear_ratios[" + std::to_string(i) + "]", a.def.gear_ratios[i],
+              b.def.gear_ratios[i], section);
+  }
+  if (count("wheels", a.wheels.size(), b.wheels.size())) {
+    for (std::size_t i = 0; i < a.wheels.size(); ++i) {
+      const std::string at = name + "wheel[" + std::to_string(i) + "].";
+      diff_record_fields(c, at, sim_detail::wheel_def_fields(), a.def.wheels[i], b.def.wheels[i],
+                         section);
+      diff_record_fields(c, at, sim_detail::wheel_state_fields(), a.wheels[i], b.wheels[i],
+                         section);
+    }
+  }
+  if (count("axles", a.def.axles.size(), b.def.axles.size())) {
+    for (std::size_t i = 0; i < a.def.axles.size(); ++i)
+      diff_record_fields(c, name + "axle[" + std::to_string(i) + "].", sim_detail::axle_fields(),
+                         a.def.axles[i], b.def.axles[i], section);
+  }
+}
+
+// A merge of both ascending vehicle ID lists; a vehicle on one side only is "present".
+void diff_vehicles(Collector& c, const Sides& w) {
+  const std::vector<VehicleId> ia = w.a->vehicle_ids();
+  const std::vector<VehicleId> ib = w.b->vehicle_ids();
+  std::size_t i = 0;
+  std::size_t j = 0;
+  while (i < ia.size() || j < ib.size()) {
+    if (j == ib.size() || (i < ia.size() && ia[i] < ib[j])) {
+      c.add("vehicles", 0, vehicle_name(ia[i]) + ".present", "present", "absent");
+      ++i;
+    } else if (i == ia.size() || ib[j] < ia[i]) {
+      c.add("vehicles", 0, vehicle_name(ib[j]) + ".present", "absent", "present");
+      ++j;
+    } else {
+      diff_vehicle(c, w.a->vehicle(ia[i]).value(), w.b->vehicle(ib[j]).value());
+      ++i;
+      ++j;
+    }
+  }
+}
+
 std::string character_name(CharacterId id) {
   return "character[" + std::to_string(id.value) + "]";
 }
@@ -554,9 +621,16 @@ void diff_game(Collector& c, const Sides& w) {
 
 /// A new section of the World's state adds its differ here.
 constexpr SectionDiffer kDiffers[] = {
-    {"globals", diff_globals},     {"geometry", diff_geometry, false}, {"rng", diff_rng},
-    {"bodies", diff_bodies},       {"contacts", diff_contact_cache},   {"joints", diff_joints},
-    {"particles", diff_particles}, {"characters", diff_characters},    {"game", diff_game},
+    {"globals", diff_globals},           //
+    {"geometry", diff_geometry, false},  //
+    {"rng", diff_rng},                   //
+    {"bodies", diff_bodies},             //
+    {"contacts", diff_contact_cache},    //
+    {"joints", diff_joints},             //
+    {"particles", diff_particles},       //
+    {"vehicles", diff_vehicles},         //
+    {"characters", diff_characters},     //
+    {"game", diff_game},                 //
 };
 
 /// The hashes of a state's sections from its bytes (a state that may not restore here), and its

@@ -318,6 +318,7 @@ constexpr WorldSection kSections[] = {
     {"contacts", 2, write_contacts, read_contacts},
     {"joints", 1, write_joints, read_joints},
     {"particles", 1, write_particles, read_particles},
+    {"vehicles", 1, write_vehicles, read_vehicles, has_vehicles, clear_vehicles},
     {"characters", 1, write_characters, read_characters, has_characters, clear_characters},
     {"game", 1, write_game, read_game, has_game, clear_game},
 };

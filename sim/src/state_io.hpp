@@ -32,6 +32,13 @@ void write_particles(const WorldState& s, ByteWriter& w);
 void write_particle_group(const ParticleGroup& g, std::uint32_t previous_id, ByteWriter& w);
 bool read_particles(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState& s,
                     std::string& error);
+/// The optional "vehicles" payload (state_vehicles.cpp), written when the world has had a
+/// vehicle; its reader (bodies already read), and what a state without it reads as.
+void write_vehicles(const WorldState& s, ByteWriter& w);
+bool read_vehicles(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState& s,
+                   std::string& error);
+[[nodiscard]] bool has_vehicles(const WorldState& s);
+void clear_vehicles(WorldState& s);
 /// The optional "characters" payload (state_characters.cpp), written when the world has had a
 /// character; its reader (bodies already read), and what a state without it reads as.
 void write_characters(const WorldState& s, ByteWriter& w);

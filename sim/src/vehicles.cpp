@@ -7,6 +7,7 @@
 #include <detsim/fixed/math.hpp>
 
 #include "limits.hpp"
+#include "vehicle_fields.hpp"
 #include "world_state.hpp"
 
 namespace detsim {
@@ -67,10 +68,10 @@ std::string check_wheel(const WheelDef& w, std::size_t i) {
                Fixed::from_int(1000000), "kg m^2");
 }
 
-std::string check_vehicle_def(const WorldState& s, const VehicleDef& d) {
+std::string check_vehicle_def(const WorldState& s, const VehicleDef& d, bool require_dynamic) {
   const std::ptrdiff_t c = s.find(d.chassis.value);
   if (c < 0) return "chassis: no body with ID " + std::to_string(d.chassis.value);
-  if (s.bodies[static_cast<std::size_t>(c)].type != BodyType::dynamic)
+  if (require_dynamic && s.bodies[static_cast<std::size_t>(c)].type != BodyType::dynamic)
     return "chassis: body " + std::to_string(d.chassis.value) + " is not dynamic";
   if (d.wheels.empty() || d.wheels.size() > kMaxWheels)
     return "wheels: 1 .. 16 wheels, got " + std::to_string(d.wheels.size());
@@ -156,6 +157,41 @@ Status unknown_vehicle(VehicleId id) {
 
 }  // namespace
 
+std::string check_vehicle_record(const WorldState& s, const VehicleState& v) {
+  if (auto e = check_vehicle_def(s, v.def, false); !e.empty()) return e;
+  if (auto e = check_vehicle_input(v.input); !e.empty()) return "input." + e;
+  if (v.gear < 1 || v.gear > v.def.gear_ratios.size())
+    return "gear must be within 1 .. " + std::to_string(v.def.gear_ratios.size()) + ", got " +
+           std::to_string(v.gear);
+  if (v.wheels.size() != v.def.wheels.size())
+    return std::to_string(v.wheels.size()) + " wheel states for " +
+           std::to_string(v.def.wheels.size()) + " wheels";
+  const Fixed most = max_velocity;
+  if (auto e = range("engine_rpm", v.engine_rpm, Fixed::zero(), Fixed::from_int(1000000), "rpm");
+      !e.empty())
+    return e;
+  if (auto e = range("forward_speed", v.forward_speed, -most, most, "m/s"); !e.empty()) return e;
+  for (std::size_t i = 0; i < v.wheels.size(); ++i) {
+    const WheelState& w = v.wheels[i];
+    const std::string at = "wheel[" + std::to_string(i) + "].";
+    if (auto e = range(at + "angular_velocity", w.angular_velocity, -most, most, "rad/s");
+        !e.empty())
+      return e;
+    if (auto e = range(at + "compression", w.compression, Fixed::zero(),
+                       v.def.wheels[i].suspension_rest_length, "m");
+        !e.empty())
+      return e;
+    if (auto e = check_position(w.contact_point); !e.empty()) return at + "contact_" + e;
+    if (!w.contact_body.is_null() && s.find(w.contact_body.value) < 0)
+      return at + "contact_body " + std::to_string(w.contact_body.value) + " does not exist";
+    if (w.contact && w.contact_normal == Vec3{}) return at + "contact without a contact normal";
+    if (w.contact_normal != Vec3{})
+      if (auto e = check_unit_vector((at + "contact_normal").c_str(), w.contact_normal); !e.empty())
+        return e;
+  }
+  return {};
+}
+
 void forget_vehicles_of(WorldState& s, BodyId body) {
   std::erase_if(s.vehicles, [body](const VehicleState& v) { return v.def.chassis == body; });
   for (VehicleState& v : s.vehicles)
@@ -166,7 +202,7 @@ void forget_vehicles_of(WorldState& s, BodyId body) {
 }  // namespace sim_detail
 
 Expected<VehicleId> World::create_vehicle(const VehicleDef& def) {
-  if (auto e = sim_detail::check_vehicle_def(*s_, def); !e.empty())
+  if (auto e = sim_detail::check_vehicle_def(*s_, def, true); !e.empty())
     return Status::error("invalid vehicle definition: " + e);
   for (const VehicleState& v : s_->vehicles)
     if (v.def.chassis == def.chassis)

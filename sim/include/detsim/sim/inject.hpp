@@ -24,6 +24,10 @@
 //                         is contact[OTHER/0/0]. Diff prints contacts in this form.
 //   joint[J].FIELD        BODY 0; FIELD a field of joint J as diff names it (anchor.x,
 //                         linear_impulse.y, motor_speed, broken, ...): DELTA as for its kind
+//   vehicle[V].FIELD      BODY 0; a field of vehicle V as diff names it (throttle, gear,
+//                         engine_rpm, ...); vehicle[V].wheel[K].FIELD of its wheel K's state or
+//                         definition (angular_velocity, compression, radius, ...): DELTA as for
+//                         its kind
 //   character[C].FIELD    BODY 0; FIELD a field of character C as diff names it (position.y,
 //                         velocity.x, grounded, ground_body, desired_velocity.z, ...): DELTA as
 //                         for its kind
