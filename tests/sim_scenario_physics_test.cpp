@@ -790,5 +790,54 @@ TEST(CharactersScenario, CharactersKeepToTheFloorAndTheYardStayOffTheSteepSlopeA
   EXPECT_TRUE(landed) << "someone climbed the stairs to their top";
 }
 
+TEST(VehiclesScenario, CarsDriveTheLotOnTheirWheelsAndNeverLeaveItOrSinkIntoIt) {
+  // Four cars driven by the RNG for 20 s over ramps and bumps: none passes the walls (their inner
+  // faces, found at frame 0) or sinks below the ground, and most spend most of the time on their
+  // wheels (a car may roll over landing from a bump at speed) and drive more than 20 m on them.
+  Scenario s = make("vehicles");
+  const World& w = s.world();
+  Fixed inner = Fixed::max();
+  for (const BodyId id : w.body_ids()) {
+    const BodyState b = state(w, id);
+    if (b.type == BodyType::static_body && b.shape.type == ShapeType::box &&
+        b.shape.half_extents.y == 1_fx)
+      inner = std::min(inner, std::max(abs(b.position.x) - b.shape.half_extents.x,
+                                       abs(b.position.z) - b.shape.half_extents.z));
+  }
+  ASSERT_LT(inner, 100_fx);
+  const std::vector<VehicleId> ids = w.vehicle_ids();
+  ASSERT_EQ(ids.size(), 4U);
+  std::vector<double> travelled(ids.size(), 0);
+  std::vector<int> on_wheels(ids.size(), 0);
+  std::vector<Vec3> last;
+  for (const VehicleId id : ids)
+    last.push_back(state(w, w.vehicle(id)->def.chassis).position);
+  constexpr int frames = 1200;
+  for (int f = 0; f < frames; ++f) {
+    s.step();
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      const VehicleState v = w.vehicle(ids[k]).value();
+      const BodyState b = state(w, v.def.chassis);
+      ASSERT_GT(b.position.y, 0_fx) << "car " << k << " frame " << f;
+      ASSERT_LT(abs(b.position.x), inner) << "car " << k << " frame " << f;
+      ASSERT_LT(abs(b.position.z), inner) << "car " << k << " frame " << f;
+      travelled[k] += length(b.position - last[k]).to_double();
+      last[k] = b.position;
+      bool all = true;
+      for (const WheelState& wheel : v.wheels) {
+        all = all && wheel.contact;
+        ASSERT_LE(wheel.compression, v.def.wheels[0].suspension_rest_length);
+      }
+      on_wheels[k] += all ? 1 : 0;
+    }
+  }
+  int on_wheels_most = 0;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (on_wheels[k] <= frames / 2) continue;  // rolled over: it stays where it lies
+    ++on_wheels_most;
+    EXPECT_GT(travelled[k], 20.0) << "car " << k;
+  }
+  EXPECT_GE(on_wheels_most, 3) << "a car may roll over on a ramp; most stay on their wheels";
+}
 }  // namespace
 }  // namespace detsim

@@ -109,6 +109,7 @@ TEST(Vehicle, LockedWheelsStopItInVSquaredOverTwoMuG) {
   while (to_d(car.body().linear_velocity.z) > 0.01 && frames < 1200) {
     car.w.step();
     ++frames;
+    if (car.body().linear_velocity.z < 0.5_fx) continue;  // stopped: reverse may engage
     for (const WheelState& wheel : car.vehicle().wheels)
       ASSERT_LT(abs(wheel.angular_velocity), 0.001_fx) << "locked, frame " << frames;
   }
@@ -249,6 +250,49 @@ TEST(Vehicle, TheVehiclesSectionIsWrittenOnlyByAWorldThatHasHadOneAndDiffNamesAW
   ASSERT_TRUE(copy.restore(now).ok());
   EXPECT_EQ(copy.save(), now);
   EXPECT_EQ(copy.vehicle(car.id).value(), car.vehicle());
+}
+
+TEST(Vehicle, AParkedCarSleepsAndAnInputWakesIt) {
+  Car car;
+  car.run(240);
+  EXPECT_FALSE(car.body().awake) << "parked on its wheels, it sleeps";
+  const Vec3 parked = car.body().position;
+  car.run(60);
+  EXPECT_EQ(car.body().position, parked) << "asleep, nothing moves it";
+  VehicleInput in;
+  in.throttle = 1_fx;
+  car.input(in);
+  EXPECT_TRUE(car.body().awake);
+  car.run(60);
+  EXPECT_GT(to_d(car.vehicle().forward_speed), 2.0) << "and it drives off";
+  EXPECT_GT(to_d(car.body().position.z), to_d(parked.z) + 1.0);
+}
+
+TEST(Vehicle, StoppedWithTheBrakeHeldItReversesAndTheThrottleTakesItForwardAgain) {
+  Car car;
+  car.run(60);
+  VehicleInput in;
+  in.brake = 1_fx;
+  car.input(in);
+  car.run(120);
+  EXPECT_EQ(car.vehicle().gear, 0U) << "reverse";
+  EXPECT_LT(to_d(car.vehicle().forward_speed), -1.0) << "backwards";
+  in = {};
+  in.throttle = 1_fx;
+  car.input(in);
+  car.run(180);
+  EXPECT_GE(car.vehicle().gear, 1U);
+  EXPECT_GT(to_d(car.vehicle().forward_speed), 1.0) << "forwards again";
+}
+
+TEST(Vehicle, DestroyingItsChassisRemovesTheVehicle) {
+  Car car;
+  car.run(10);
+  ASSERT_TRUE(car.w.destroy_body(car.chassis).ok());
+  EXPECT_TRUE(car.w.vehicle_ids().empty());
+  EXPECT_FALSE(car.w.vehicle(car.id).ok());
+  car.run(10);  // and the world steps on
+  ASSERT_TRUE(car.w.validate().ok());
 }
 
 TEST(Vehicle, BadDefinitionsAndInputsAreRefusedNamingTheField) {

@@ -165,6 +165,13 @@ constexpr std::array entries{
     Entry{{"stack", "10 boxes of 1 m stacked on a plane", 1200, 0, 0, 0, 0, 0, false},
           scenes_detail::build_stack,
           nullptr},
+    Entry{{"vehicles",
+           "four cars (rear-driven, 1200 kg, sphere-cast suspension, magic-formula tires) "
+           "driven by inputs drawn from the RNG each second over a walled lot with ramps and "
+           "speed bumps",
+           600, 0, 0, 0, 0, 0, true},
+          scenes_detail::build_vehicles,
+          scenes_detail::control_vehicles},
     Entry{{"wrecking_ball",
            "a 500 kg ball on a chain swings into a wall of bricks welded by breakable fixed joints",
            600, 0, 0, 0, 0, 0, false},

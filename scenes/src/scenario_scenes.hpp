@@ -46,6 +46,10 @@ void build_dam_break(World& w, const ScenarioParams& p);
 
 // The scene of character controllers (scenario_characters.cpp).
 void build_characters(World& w, const ScenarioParams& p);
+// The scene of vehicles (scenario_vehicles.cpp), and the car it (and a game) builds: a chassis
+// tagged `tag`, four wheels, the rear two driven, at `position` turned by `heading`.
+void build_vehicles(World& w, const ScenarioParams& p);
+VehicleId add_car(World& w, Vec3 position, Quat heading, std::uint64_t tag);
 
 // Per-frame logic, run before each step. Reads only the World and the inputs.
 void control_spray(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
@@ -53,6 +57,7 @@ void control_arena(World& w, std::span<const PlayerInput> inputs, const Scenario
 void control_bridge(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_flag(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_characters(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
+void control_vehicles(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 
 // Tags in BodyDef::user_data by which game logic finds its bodies again (the World is the whole
 // scenario state, so nothing else may remember them). A player's tag is player_tag + index.
@@ -204,6 +209,16 @@ inline constexpr std::uint32_t segments = 24;
 inline constexpr Fixed ball_radius = 0.4_fx;
 inline constexpr Fixed ball_mass = 200_fx;
 }  // namespace wrecking_rope
+
+namespace cars {
+inline constexpr Fixed lot = 30_fx;  ///< the walls' inner faces are at +-lot in x and z
+inline constexpr Vec3 chassis_half{0.9_fx, 0.4_fx, 2_fx};
+inline constexpr Fixed chassis_mass = 1200_fx;
+inline constexpr Fixed track = 0.8_fx;  ///< the wheels' x, either side
+inline constexpr Fixed axle = 1.3_fx;   ///< the axles' z, front and rear
+inline constexpr Fixed max_steer = 0.5_fx;
+inline constexpr Fixed anti_roll = 20000_fx;
+}  // namespace cars
 
 namespace characters {
 inline constexpr Fixed yard = 12_fx;  ///< the walls' inner faces are at +-yard in x and z

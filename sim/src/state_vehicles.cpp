@@ -28,6 +28,8 @@ constexpr VehicleField kVehicleFields[] = {
                               DETSIM_VEHICLE_REF(Fixed, def.engine.max_rpm)),
     fixed_field<VehicleState>("engine.inertia", "vehicle engine inertia",
                               DETSIM_VEHICLE_REF(Fixed, def.engine.inertia)),
+    fixed_field<VehicleState>("reverse_ratio", "vehicle reverse ratio",
+                              DETSIM_VEHICLE_REF(Fixed, def.reverse_ratio)),
     fixed_field<VehicleState>("final_drive", "vehicle final drive",
                               DETSIM_VEHICLE_REF(Fixed, def.final_drive)),
     flag_field<VehicleState>("automatic", "vehicle automatic",
@@ -119,8 +121,8 @@ constexpr AxleField kAxleFields[] = {
 #undef DETSIM_WHEEL_STATE_REF
 #undef DETSIM_AXLE_REF
 
-// The smallest record: ID step, flags, one byte per value (21), and the four lists' counts.
-constexpr std::size_t kMinVehicleBytes = 1 + 1 + 21 + 4;
+// The smallest record: ID step, flags, one byte per value (22), and the four lists' counts.
+constexpr std::size_t kMinVehicleBytes = 1 + 1 + 22 + 4;
 constexpr std::uint32_t kMaxListEntries = 16;
 
 /// A list's count, refused above `most` (the reader's failure names it).

@@ -106,6 +106,10 @@ std::string check_vehicle_def(const WorldState& s, const VehicleDef& d, bool req
                        Fixed::from_raw(Fixed::one_raw >> 8), Fixed::from_int(100), "");
         !m.empty())
       return m;
+  if (auto m = range("reverse_ratio", d.reverse_ratio, Fixed::from_raw(Fixed::one_raw >> 8),
+                     Fixed::from_int(100), "");
+      !m.empty())
+    return m;
   if (auto m = range("final_drive", d.final_drive, Fixed::from_raw(Fixed::one_raw >> 8),
                      Fixed::from_int(100), "");
       !m.empty())
@@ -160,9 +164,9 @@ Status unknown_vehicle(VehicleId id) {
 std::string check_vehicle_record(const WorldState& s, const VehicleState& v) {
   if (auto e = check_vehicle_def(s, v.def, false); !e.empty()) return e;
   if (auto e = check_vehicle_input(v.input); !e.empty()) return "input." + e;
-  if (v.gear < 1 || v.gear > v.def.gear_ratios.size())
-    return "gear must be within 1 .. " + std::to_string(v.def.gear_ratios.size()) + ", got " +
-           std::to_string(v.gear);
+  if (v.gear > v.def.gear_ratios.size())
+    return "gear must be within 0 (reverse) .. " + std::to_string(v.def.gear_ratios.size()) +
+           ", got " + std::to_string(v.gear);
   if (v.wheels.size() != v.def.wheels.size())
     return std::to_string(v.wheels.size()) + " wheel states for " +
            std::to_string(v.def.wheels.size()) + " wheels";

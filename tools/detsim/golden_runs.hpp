@@ -44,6 +44,7 @@ inline constexpr GoldenRun runs[] = {
     {"slope", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"spray", {.seed = 3, .players = 0, .count = 0}, 1200},
     {"stack", {.seed = 1, .players = 0, .count = 0}, 1200},
+    {"vehicles", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"wrecking_ball", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"wrecking_rope", {.seed = 1, .players = 0, .count = 0}, 1000},
 };

@@ -22,6 +22,10 @@ namespace {
 using namespace detsim::literals;
 
 constexpr Fixed kStaticSpeed = 1_fx;  ///< m/s: below it, the tire grips with its peak
+/// The cosine of the steepest ground a wheel stands on (60 degrees from the chassis' up).
+constexpr Fixed kSteepestGround = 0.5_fx;
+/// m/s: slower than this, a car is stopped (the automatic gearbox may select reverse).
+constexpr Fixed kStoppedSpeed = 0.1_fx;
 
 /// The magic formula d sin(c atan(b x - e (b x - atan(b x)))).
 Fixed magic(const TireCurve& t, Fixed x) {
@@ -53,9 +57,19 @@ Vec3 axis_y(Quat q) {
   return rotate(q, {Fixed::zero(), Fixed::one(), Fixed::zero()});
 }
 
-/// The gearbox's total ratio now: the gear's and the final drive's.
+/// The gearbox's total ratio now: the gear's and the final drive's; negative in reverse.
 Fixed total_ratio(const VehicleState& v) {
-  return v.def.gear_ratios[v.gear - 1] * v.def.final_drive;
+  const Fixed gear = v.gear == 0 ? -v.def.reverse_ratio : v.def.gear_ratios[v.gear - 1];
+  return gear * v.def.final_drive;
+}
+
+/// What drives the engine: the throttle, or in reverse the brake pedal. The other pedal brakes:
+/// in reverse the throttle (until the car stops and the gearbox takes first).
+Fixed accelerator(const VehicleState& v) {
+  return v.gear == 0 ? v.input.brake : v.input.throttle;
+}
+Fixed brake_pedal(const VehicleState& v) {
+  return v.gear == 0 ? v.input.throttle : v.input.brake;
 }
 
 std::uint32_t driven_count(const VehicleDef& d) {
@@ -89,7 +103,7 @@ void WheelSolver::prepare() {
       if (w.driven && driven > 0)
         k.inertia += v.def.engine.inertia * ratio * ratio /
                      Fixed::from_int(static_cast<std::int32_t>(driven));
-      const Fixed brake = w.handbrake && v.input.handbrake ? Fixed::one() : v.input.brake;
+      const Fixed brake = w.handbrake && v.input.handbrake ? Fixed::one() : brake_pedal(v);
       k.brake_torque = w.max_brake_torque * brake;
       prepare_wheel(k, static_cast<std::size_t>(c));
     }
@@ -105,9 +119,20 @@ void WheelSolver::prepare_wheel(WheelConstraint& k, std::size_t c) {
   const Vec3 top = chassis.position + rotate(chassis.orientation, w.attachment);
   out.steer_angle = w.max_steer_angle * v.input.steering;
   // The wheel's sphere down its suspension: where it meets the ground is its compression.
-  QueryFilter filter{chassis.layer, chassis.mask, false, chassis.id};
-  const std::optional<ShapeHit> hit = cast_shape(s_, Shape::sphere(w.radius), top, Quat::identity(),
-                                                 -up * w.suspension_rest_length, filter);
+  const QueryFilter filter{chassis.layer, chassis.mask, false, chassis.id};
+  const Vec3 travel = -up * w.suspension_rest_length;
+  std::optional<ShapeHit> hit =
+      cast_shape(s_, Shape::sphere(w.radius), top, Quat::identity(), travel, filter);
+  // A surface steeper than 60 degrees to the chassis is a wall, not ground: the wheel would
+  // climb it. The chassis' own shape meets walls; the wheel looks for the ground past it (a
+  // second cast that leaves the wall out, and the chassis, which it starts inside and leaves).
+  if (hit && dot(hit->normal, up) < kSteepestGround) {
+    std::optional<ShapeHit> past =
+        cast_shape(s_, Shape::sphere(w.radius), top, Quat::identity(), travel,
+                   {chassis.layer, chassis.mask, false, hit->body});
+    if (past && (past->body == chassis.id || dot(past->normal, up) < kSteepestGround)) past.reset();
+    hit = past;
+  }
   k.contact = hit.has_value();
   out.contact = k.contact;
   if (!hit) {
@@ -192,7 +217,7 @@ void WheelSolver::warm_start() {
       v.engine_rpm = rpm;
       const Fixed torque = rpm >= v.def.engine.max_rpm
                                ? Fixed::zero()
-                               : curve_torque(v.def.engine, rpm) * v.input.throttle;
+                               : curve_torque(v.def.engine, rpm) * accelerator(v);
       const Fixed per_wheel = torque * ratio / n;
       for (std::size_t i = first; i < last; ++i) {
         WheelConstraint& k = wheels_[i];
@@ -317,13 +342,28 @@ void WheelSolver::store_impulses() {
     const Vec3 forward =
         rotate(s_.bodies[c].orientation, {Fixed::zero(), Fixed::zero(), Fixed::one()});
     v.forward_speed = dot(bodies_.velocities[c].linear, forward);
+    // A car whose engine drives or whose wheels still turn is not parked: it does not sleep
+    // (pushing against a wall with its wheels spinning, its chassis is still).
+    bool running = accelerator(v) > Fixed::zero();
+    for (std::size_t i = first; i < last; ++i)
+      running = running || abs(v.wheels[wheels_[i].wheel].angular_velocity) > kStaticSpeed;
+    if (running) s_.bodies[c].sleep_time = Fixed::zero();
     if (v.def.automatic) {
+      // Reverse when (nearly) stopped with the brake held and no throttle, forward again with
+      // the throttle; up above 0.9 max_rpm, down below 0.35 max_rpm.
       const Fixed rpm = v.engine_rpm;
       const auto gears = static_cast<std::uint32_t>(v.def.gear_ratios.size());
-      if (rpm >= v.def.engine.max_rpm * 0.9_fx && v.gear < gears)
+      const bool stopped = abs(v.forward_speed) < kStoppedSpeed;
+      if (v.gear != 0 && stopped && v.input.brake > Fixed::zero() &&
+          v.input.throttle == Fixed::zero()) {
+        v.gear = 0;
+      } else if (v.gear == 0) {
+        if (v.input.throttle > Fixed::zero() && v.forward_speed > -kStaticSpeed) v.gear = 1;
+      } else if (rpm >= v.def.engine.max_rpm * 0.9_fx && v.gear < gears) {
         ++v.gear;
-      else if (rpm < v.def.engine.max_rpm * 0.35_fx && v.gear > 1)
+      } else if (rpm < v.def.engine.max_rpm * 0.35_fx && v.gear > 1) {
         --v.gear;
+      }
     }
     first = last;
   }

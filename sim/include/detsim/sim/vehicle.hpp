@@ -109,9 +109,12 @@ struct VehicleDef {
   /// Forward gears, first to top (1 to 8), each > 0: wheel rpm * ratio * final_drive is the
   /// engine's rpm.
   std::vector<Fixed> gear_ratios{3.6_fx, 2.2_fx, 1.5_fx, 1.1_fx, 0.9_fx};
+  Fixed reverse_ratio = 3.6_fx;  ///< > 0: reverse turns the wheels backwards by this ratio
   Fixed final_drive = 3.5_fx;
-  /// Shift up above 0.9 max_rpm, down below 0.35 max_rpm, on its own; otherwise the gear stays
-  /// what World::set_vehicle_gear chose.
+  /// The gearbox shifts on its own: up above 0.9 max_rpm, down below 0.35 max_rpm, into reverse
+  /// when the car is stopped (below 0.1 m/s) with the brake held and no throttle: the brake pedal
+  /// then drives it backwards and the throttle brakes, as in most driving games, until the throttle
+  /// finds it stopped and takes first. Without it the gear stays as it is (first, at creation).
   bool automatic = true;
   std::vector<AxleDef> axles;  ///< 0 to 8
   TireDef tire;
@@ -152,7 +155,7 @@ struct VehicleState {
   VehicleDef def;
   VehicleInput input;
   std::vector<WheelState> wheels;  ///< as def.wheels
-  std::uint32_t gear = 1;          ///< 1 .. gear_ratios.size()
+  std::uint32_t gear = 1;          ///< 1 .. gear_ratios.size(); 0: reverse
   Fixed engine_rpm{};
   Fixed forward_speed{};  ///< m/s, the chassis' velocity along its +z
 
