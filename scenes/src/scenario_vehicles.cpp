@@ -69,13 +69,13 @@ void build_vehicles(World& w, const ScenarioParams&) {
   // Speed bumps: capsules lying across the lot, 0.12 m high above the ground.
   for (const Fixed z : {-20_fx, -4_fx, 4_fx, 20_fx}) {
     (void)add(w, lot_solid(Shape::capsule(0.12_fx, 6_fx), {-14_fx, 0_fx, z},
-                       from_axis_angle(Vec3{0_fx, 0_fx, 1_fx}, Fixed::half_pi())));
+                           from_axis_angle(Vec3{0_fx, 0_fx, 1_fx}, Fixed::half_pi())));
     (void)add(w, lot_solid(Shape::capsule(0.12_fx, 6_fx), {14_fx, 0_fx, z},
-                       from_axis_angle(Vec3{0_fx, 0_fx, 1_fx}, Fixed::half_pi())));
+                           from_axis_angle(Vec3{0_fx, 0_fx, 1_fx}, Fixed::half_pi())));
   }
   // Four cars at the lot's quarters, heading round it.
-  const Vec3 starts[4] = {{-14_fx, 1_fx, -10_fx}, {14_fx, 1_fx, 10_fx}, {-14_fx, 1_fx, 10_fx},
-                          {14_fx, 1_fx, -10_fx}};
+  const Vec3 starts[4] = {
+      {-14_fx, 1_fx, -10_fx}, {14_fx, 1_fx, 10_fx}, {-14_fx, 1_fx, 10_fx}, {14_fx, 1_fx, -10_fx}};
   const Fixed headings[4] = {0_fx, Fixed::pi(), Fixed::pi(), 0_fx};
   for (std::uint32_t k = 0; k < 4; ++k)
     (void)add_car(w, starts[k], from_axis_angle(kLotY, headings[k]), chassis_tag + k);
@@ -97,8 +97,8 @@ void control_vehicles(World& w, std::span<const PlayerInput>, const ScenarioPara
     // Stuck (against a wall, on a bump) with a pedal down: the other way for a second (the brake
     // reverses a stopped car; in reverse the throttle takes it forward).
     const bool reversing = v.gear == 0;
-    const bool stuck = (reversing ? v.input.brake : v.input.throttle) > 0_fx &&
-                       abs(v.forward_speed) < 0.5_fx;
+    const bool stuck =
+        (reversing ? v.input.brake : v.input.throttle) > 0_fx && abs(v.forward_speed) < 0.5_fx;
     if (stuck && reversing) {
       // forwards: the throttle drawn above
     } else if (stuck || roll < 0.15_fx) {
