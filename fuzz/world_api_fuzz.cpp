@@ -6,7 +6,8 @@
 // groups: create_rope, create_cloth, create_soft_body with any values, apply_particle_force,
 // destroy_particle_group; the queries raycast_particles, shape_cast, shape_contacts and
 // contacts_of with any shape and pose; and the game's own state: set_game_state of any size,
-// describe_game_state with good and bad fields, set_user_data).
+// describe_game_state with good and bad fields, set_user_data; characters and vehicles with any
+// definition and input).
 //
 // Properties checked beyond the sanitizers' (no crash, no undefined behaviour, no leak):
 // - a refused call changes nothing: the world's saved bytes are those from before the call;
@@ -51,7 +52,7 @@ constexpr std::size_t kMaxJoints = 64;
 constexpr int kMaxSteps = 16;
 constexpr int kMaxCalls = 256;
 constexpr std::size_t kMaxGeometries = 16;
-constexpr int kOps = 31;                    // the calls' opcodes, op % kOps
+constexpr int kOps = 33;                    // the calls' opcodes, op % kOps
 constexpr std::size_t kMaxParticles = 600;  // what the groups of one input may hold in all
 // Sub-steps x iterations x (bodies + joints + 1), summed over the steps: what the steps of one
 // input may cost in total.
@@ -297,6 +298,64 @@ BodyId body_id(Input& in, const World& world) {
   const std::vector<BodyId> ids = world.body_ids();
   if ((pick & 0x80U) == 0 && !ids.empty()) return ids[pick % ids.size()];
   return BodyId{pick % 0x80U};
+}
+
+/// A character's definition: the defaults, each field replaced by a hostile value when a bit says.
+detsim::CharacterDef character_def(Input& in) {
+  detsim::CharacterDef d;
+  const std::uint8_t fields = in.byte();
+  d.position = in.vec3();
+  if ((fields & 1U) != 0) d.radius = in.fixed();
+  if ((fields & 2U) != 0) d.half_height = in.fixed();
+  if ((fields & 4U) != 0) d.max_slope = in.fixed();
+  if ((fields & 8U) != 0) d.step_height = in.fixed();
+  if ((fields & 16U) != 0) d.mass = in.fixed();
+  if ((fields & 32U) != 0) d.mask = in.u32();
+  return d;
+}
+
+/// A vehicle's definition on a body of the world: 0 to 5 wheels, each default or hostile, and
+/// hostile engine, gears, axles and tire when a bit says.
+detsim::VehicleDef vehicle_def(Input& in, const World& world) {
+  detsim::VehicleDef d;
+  d.chassis = body_id(in, world);
+  const std::uint8_t fields = in.byte();
+  const std::size_t wheels = in.byte() % 6U;
+  for (std::size_t i = 0; i < wheels; ++i) {
+    detsim::WheelDef w;
+    w.attachment = in.vec3();
+    const std::uint8_t wf = in.byte();
+    if ((wf & 1U) != 0) w.radius = in.fixed();
+    if ((wf & 2U) != 0) w.suspension_rest_length = in.fixed();
+    if ((wf & 4U) != 0) w.suspension_stiffness = in.fixed();
+    if ((wf & 8U) != 0) w.suspension_damping = in.fixed();
+    if ((wf & 16U) != 0) w.max_steer_angle = in.fixed();
+    if ((wf & 32U) != 0) w.inertia = in.fixed();
+    w.driven = (wf & 64U) != 0;
+    w.handbrake = (wf & 128U) != 0;
+    d.wheels.push_back(w);
+  }
+  if ((fields & 1U) != 0) {
+    d.engine.torque_curve.resize(in.byte() % 4U);
+    for (detsim::TorquePoint& p : d.engine.torque_curve)
+      p = {in.fixed(), in.fixed()};
+    d.engine.max_rpm = in.fixed();
+    d.engine.inertia = in.fixed();
+  }
+  if ((fields & 2U) != 0) {
+    d.gear_ratios.resize(in.byte() % 4U);
+    for (Fixed& g : d.gear_ratios)
+      g = in.fixed();
+    d.final_drive = in.fixed();
+  }
+  if ((fields & 4U) != 0) {
+    d.axles.resize(in.byte() % 3U);
+    for (detsim::AxleDef& a : d.axles)
+      a = {in.byte() % 6U, in.byte() % 6U, in.fixed()};
+  }
+  if ((fields & 8U) != 0) d.tire.lateral = {in.fixed(), in.fixed(), in.fixed(), in.fixed()};
+  d.automatic = (fields & 16U) == 0;
+  return d;
 }
 
 detsim::JointDef joint_def(Input& in, const World& world) {
@@ -706,6 +765,42 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 30: {
         const BodyId id = body_id(in, world);
         status = world.set_user_data(id, in.u32());
+        break;
+      }
+      case 31: {  // characters: a hostile definition, or any input to one (or to no one)
+        const std::vector<detsim::CharacterId> ids = world.character_ids();
+        if ((in.byte() & 1U) != 0) {
+          const detsim::CharacterDef c = character_def(in);
+          if (ids.size() >= 8) break;
+          auto id = world.create_character(c);
+          if (!id) status = id.status();
+        } else {
+          const std::uint8_t pick = in.byte();
+          const detsim::CharacterId id = ids.empty() || (pick & 0x80U) != 0
+                                             ? detsim::CharacterId{pick % 0x80U}
+                                             : ids[pick % ids.size()];
+          const Vec3 v = in.vec3();
+          status = world.set_character_input(id, {v, in.fixed()});
+        }
+        break;
+      }
+      case 32: {  // vehicles: a hostile definition, or any input to one (or to no one)
+        const std::vector<detsim::VehicleId> ids = world.vehicle_ids();
+        if ((in.byte() & 1U) != 0) {
+          const detsim::VehicleDef v = vehicle_def(in, world);
+          if (ids.size() >= 8) break;
+          auto id = world.create_vehicle(v);
+          if (!id) status = id.status();
+        } else {
+          const std::uint8_t pick = in.byte();
+          const detsim::VehicleId id = ids.empty() || (pick & 0x80U) != 0
+                                           ? detsim::VehicleId{pick % 0x80U}
+                                           : ids[pick % ids.size()];
+          const Fixed throttle = in.fixed();
+          const Fixed brake = in.fixed();
+          const Fixed steering = in.fixed();
+          status = world.set_vehicle_input(id, {throttle, brake, steering, (in.byte() & 1U) != 0});
+        }
         break;
       }
       default: {

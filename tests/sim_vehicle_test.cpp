@@ -43,15 +43,15 @@ struct Car {
   BodyId chassis;
   VehicleId id;
 
-  explicit Car(Fixed friction = 1_fx, VehicleDef tune = {}) {
-    ground = add_ground(w, {}, friction);
+  Car() {
+    ground = add_ground(w, {}, Fixed::one());
     BodyDef c;
     c.shape = Shape::box({0.9_fx, 0.4_fx, 2_fx});
     c.position = {0_fx, 0.8_fx, 0_fx};
     c.mass = Fixed::from_int(static_cast<std::int32_t>(kChassisMass));
     c.friction = 0.2_fx;
     chassis = add(w, c);
-    VehicleDef d = std::move(tune);
+    VehicleDef d;
     d.chassis = chassis;
     for (const Fixed x : {0.8_fx, -0.8_fx}) {
       for (const Fixed z : {1.3_fx, -1.3_fx}) {

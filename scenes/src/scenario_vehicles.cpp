@@ -74,11 +74,11 @@ void build_vehicles(World& w, const ScenarioParams&) {
                            from_axis_angle(Vec3{0_fx, 0_fx, 1_fx}, Fixed::half_pi())));
   }
   // Four cars at the lot's quarters, heading round it.
-  const Vec3 starts[4] = {
+  const Vec3 car_starts[4] = {
       {-14_fx, 1_fx, -10_fx}, {14_fx, 1_fx, 10_fx}, {-14_fx, 1_fx, 10_fx}, {14_fx, 1_fx, -10_fx}};
-  const Fixed headings[4] = {0_fx, Fixed::pi(), Fixed::pi(), 0_fx};
+  const Fixed car_headings[4] = {0_fx, Fixed::pi(), Fixed::pi(), 0_fx};
   for (std::uint32_t k = 0; k < 4; ++k)
-    (void)add_car(w, starts[k], from_axis_angle(kLotY, headings[k]), chassis_tag + k);
+    (void)add_car(w, car_starts[k], from_axis_angle(kLotY, car_headings[k]), chassis_tag + k);
 }
 
 void control_vehicles(World& w, std::span<const PlayerInput>, const ScenarioParams&) {
