@@ -523,6 +523,14 @@ void trace(int op, const detsim::Status& status, const World& world) {
   if (!on) return;
   std::fprintf(stderr, "op %d: %s\n", op, status.ok() ? "ok" : status.message().c_str());
   const auto num = [](Fixed x) { return x.to_double(); };  // display only
+  for (const detsim::ParticleGroupId id : world.particle_group_ids()) {
+    const std::size_t n = world.particle_positions(id)->size();
+    const char* type = world.rope_def(id).ok()        ? "rope"
+                       : world.cloth_def(id).ok()     ? "cloth"
+                       : world.soft_body_def(id).ok() ? "soft body"
+                                                      : "fluid";
+    std::fprintf(stderr, "  particle group %u: %s of %zu particles\n", id.value, type, n);
+  }
   for (const BodyId id : world.body_ids()) {
     const detsim::BodyState b = world.body(id).value();
     std::fprintf(stderr,

@@ -227,6 +227,9 @@ TEST(FluidApi, RefusalsNameTheField) {
   f.max = f.min;
   expect_refused(f, "max.x - min.x");
   f = FluidDef{};
+  f.max = f.min + Vec3{f.spacing, f.spacing, f.spacing};  // room for one particle only
+  expect_refused(f, "1 x 1 x 1 particles");
+  f = FluidDef{};
   f.spacing = 0.01_fx;  // 100^3 particles
   expect_refused(f, "max_particles_per_group");
   f = FluidDef{};

@@ -368,6 +368,10 @@ std::string check_fluid_def(const FluidDef& def) {
   if (particle_count(def) == 0)
     return std::to_string(c[0]) + " x " + std::to_string(c[1]) + " x " + std::to_string(c[2]) +
            " particles: above max_particles_per_group " + std::to_string(max_particles_per_group);
+  // Every group has at least two particles (a rope of one segment); a fluid of one is a ball.
+  if (c[0] * c[1] * c[2] < 2)
+    return "1 x 1 x 1 particles: a fluid needs at least 2 (max - min at least twice the spacing "
+           "along an axis)";
   if (auto e = in_range("rest_density", def.rest_density, kMinDensity, kMaxDensity, "kg/m^3");
       !e.empty())
     return e;

@@ -348,7 +348,8 @@ class World {
   /// shape that holds fewer than two particles along an axis).
   Expected<ParticleGroupId> create_soft_body(const SoftBodyDef& def);
   /// Creates a fluid (FluidDef), refused like create_rope (and for max not above min + spacing
-  /// on every axis, or a particle_radius above the spacing).
+  /// on every axis, a block with room for one particle only, or a particle_radius above the
+  /// spacing).
   Expected<ParticleGroupId> create_fluid(const FluidDef& def);
   /// Removes a group; wakes the bodies it was attached to. Unknown IDs are an error.
   Status destroy_particle_group(ParticleGroupId id);
