@@ -153,8 +153,8 @@ struct BulletVehicles {
   std::vector<int> indices;
   std::unique_ptr<btTriangleIndexVertexArray> mesh;
   std::unique_ptr<btBvhTriangleMeshShape> ground_shape;
-  std::unique_ptr<btRigidBody> ground;
-  btBoxShape chassis_shape{btVector3(0.9, 0.4, 2)};
+  std::unique_ptr<btRigidBody> floor;
+  btBoxShape chassis_shape{btVector3(0.9f, 0.4f, 2.0f)};
   std::vector<std::unique_ptr<btDefaultMotionState>> states;
   std::vector<std::unique_ptr<btRigidBody>> chassis;
   std::unique_ptr<btDefaultVehicleRaycaster> raycaster;
@@ -162,7 +162,7 @@ struct BulletVehicles {
   btRaycastVehicle::btVehicleTuning tuning;
 
   BulletVehicles() {
-    world.setGravity(btVector3(0, -9.81, 0));
+    world.setGravity(btVector3(0, -9.81f, 0));
     const Ground& g = ground();
     for (const Vec3& v : g.vertices) {
       vertices.push_back(btScalar(v.x.to_double()));
@@ -178,8 +178,8 @@ struct BulletVehicles {
     ground_shape = std::make_unique<btBvhTriangleMeshShape>(mesh.get(), true);
     btRigidBody::btRigidBodyConstructionInfo ground_info(0, nullptr, ground_shape.get());
     ground_info.m_friction = 1;
-    ground = std::make_unique<btRigidBody>(ground_info);
-    world.addRigidBody(ground.get());
+    floor = std::make_unique<btRigidBody>(ground_info);
+    world.addRigidBody(floor.get());
     raycaster = std::make_unique<btDefaultVehicleRaycaster>(&world);
     tuning.m_suspensionStiffness = btScalar(40000 / kChassisMass);
     tuning.m_suspensionDamping = btScalar(4000 / kChassisMass);
@@ -223,7 +223,7 @@ struct BulletVehicles {
       world.removeVehicle(v.get());
     for (auto& b : chassis)
       world.removeRigidBody(b.get());
-    world.removeRigidBody(ground.get());
+    world.removeRigidBody(floor.get());
   }
 };
 
