@@ -727,7 +727,10 @@ Status apply_injection(World& world, const Injection& injection) {
     std::erase_if(s.contacts,
                   [id](const sim_detail::Contact& c) { return c.a == id || c.b == id; });
     s.bodies.erase(s.bodies.begin() + index);
-    sim_detail::forget_ground(s, BodyId{id});  // no character may stand on a body that is gone
+    // No character may stand on a body that is gone, no vehicle drive one: a chassis takes its
+    // vehicle with it.
+    sim_detail::forget_ground(s, BodyId{id});
+    sim_detail::forget_vehicles_of(s, BodyId{id});
     return Status::success();
   }
 

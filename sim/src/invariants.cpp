@@ -45,6 +45,27 @@ std::string validate_world(const WorldState& s) {
     if (c.touching != (c.point_count > 0)) return pair + "touching disagrees with its points";
     if (c.reported && !c.touching) return pair + "reported without points";
   }
+  for (std::size_t k = 0; k < s.characters.size(); ++k) {
+    const CharacterState& c = s.characters[k];
+    const std::string character = "character " + std::to_string(c.id.value) + ": ";
+    if (c.id.value == 0 || c.id.value >= s.next_character_id)
+      return character + "ID outside 1.." + std::to_string(s.next_character_id - 1);
+    if (k > 0 && s.characters[k - 1].id >= c.id) return character + "IDs are not ascending";
+    if (!c.ground_body.is_null() && s.find(c.ground_body.value) < 0)
+      return character + "stands on a body that does not exist";
+  }
+  for (std::size_t k = 0; k < s.vehicles.size(); ++k) {
+    const VehicleState& v = s.vehicles[k];
+    const std::string vehicle = "vehicle " + std::to_string(v.id.value) + ": ";
+    if (v.id.value == 0 || v.id.value >= s.next_vehicle_id)
+      return vehicle + "ID outside 1.." + std::to_string(s.next_vehicle_id - 1);
+    if (k > 0 && s.vehicles[k - 1].id >= v.id) return vehicle + "IDs are not ascending";
+    if (s.find(v.def.chassis.value) < 0) return vehicle + "its chassis does not exist";
+    if (v.wheels.size() != v.def.wheels.size()) return vehicle + "wheel states and wheels differ";
+    for (const WheelState& w : v.wheels)
+      if (!w.contact_body.is_null() && s.find(w.contact_body.value) < 0)
+        return vehicle + "a wheel touches a body that does not exist";
+  }
   for (std::size_t k = 0; k < s.joints.size(); ++k) {
     const JointState& j = s.joints[k];
     const std::string joint = "joint " + std::to_string(j.id.value) + ": ";

@@ -153,10 +153,12 @@ std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query, Ve
     const Vec3 direction = translation / travel;
     const Fixed along = dot(offset, direction);
     const Fixed nearest = clamp(along, Fixed::zero(), travel);
-    if (length(offset - direction * nearest) >
-        query.reach + kind.bounding_radius(b.shape, g) + target + cull_slack(along)) {
-      return std::nullopt;
-    }
+    // Squared, without a root per body: the square's rounding (2^-32 m^2) is far inside the
+    // slack, and a square that saturates is only ever of a gap far beyond the reach (or of a
+    // reach so large that both saturate, and then nothing is culled).
+    const Vec3 gap = offset - direction * nearest;
+    const Fixed reach = query.reach + kind.bounding_radius(b.shape, g) + target + cull_slack(along);
+    if (dot(gap, gap) > reach * reach) return std::nullopt;
   }
   const Pose pose = pose_of(b);
   const std::optional<ConvexView> body_view = convex_view(b.shape, g);

@@ -85,6 +85,10 @@ WheelSolver::WheelSolver(WorldState& s, SolverBodies& bodies) : s_(s), bodies_(b
 
 void WheelSolver::prepare() {
   wheels_.clear();
+  std::size_t total = 0;
+  for (const VehicleState& v : s_.vehicles)
+    total += v.def.wheels.size();
+  wheels_.reserve(total);
   for (std::size_t vi = 0; vi < s_.vehicles.size(); ++vi) {
     VehicleState& v = s_.vehicles[vi];
     const std::ptrdiff_t c = s_.find(v.def.chassis.value);

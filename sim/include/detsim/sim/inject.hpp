@@ -12,7 +12,8 @@
 //   force.x|y|z  torque.x|y|z  sleep_time                         DELTA: a decimal, added
 //   awake                                                         DELTA: 1 toggles the flag
 //   user_data                                                     DELTA: an integer, added
-//   present               DELTA -1: BODY is removed (its contacts with it; nothing is woken);
+//   present               DELTA -1: BODY is removed (its contacts with it, a vehicle it is the
+//                         chassis of, characters forget it as ground; nothing is woken);
 //                         +1: a static copy of BODY's shape and material is added 1000 m above
 //                         it with the next free ID and user_data 0 (not for a plane)
 //   rng.state[0..3]       BODY 0; DELTA: an integer, added modulo 2^64

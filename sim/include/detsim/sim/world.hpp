@@ -527,7 +527,8 @@ class World {
   [[nodiscard]] Expected<std::uint64_t> body_hash(BodyId id) const;
   /// Checks the world's invariants (docs/ARCHITECTURE.md): body IDs ascending and below the next
   /// ID, valid shapes, unit orientations, static bodies asleep, the contact cache ascending and
-  /// consistent, and (after a step) islands asleep or awake as a whole. Changes
+  /// consistent, joints, characters and vehicles ascending and naming bodies that exist, and
+  /// (after a step) islands asleep or awake as a whole. Changes
   /// nothing; an error names what is broken. Builds with DETSIM_CHECKS run it after every step.
   [[nodiscard]] Status validate() const;
   /// The contact cache (part of the saved state), ascending (a, b).
