@@ -839,5 +839,66 @@ TEST(VehiclesScenario, CarsDriveTheLotOnTheirWheelsAndNeverLeaveItOrSinkIntoIt) 
   }
   EXPECT_GE(on_wheels_most, 3) << "a car may roll over on a ramp; most stay on their wheels";
 }
+
+TEST(SoccarScenario, ABallInAGoalScoresForTheOtherTeamAndGoesBackToTheCentre) {
+  // The ball rolled at the goal at +z: once its centre is inside the mouth, that goal's count
+  // (its user data's low bits) goes up by one and the ball is back on the centre spot, at rest.
+  Scenario s = make("soccar", {.seed = 1, .players = 2, .count = 0});
+  World& w = s.world();
+  BodyId ball;
+  std::vector<BodyId> goals;
+  for (const BodyId id : w.body_ids()) {
+    const BodyState b = state(w, id);
+    if (b.shape.type == ShapeType::sphere) ball = id;
+    if (b.sensor) goals.push_back(id);
+  }
+  ASSERT_FALSE(ball.is_null());
+  ASSERT_EQ(goals.size(), 2U);
+  const BodyId plus = state(w, goals[0]).position.z > 0_fx ? goals[0] : goals[1];
+  const BodyId minus = plus == goals[0] ? goals[1] : goals[0];
+  const std::uint64_t before = state(w, plus).user_data;
+  // Off the line of the car waiting at +z (x = 0), inside the goal's mouth (|x| < 4).
+  ASSERT_TRUE(w.set_transform(ball, {2.5_fx, 1_fx, 0_fx}, Quat::identity()).ok());
+  ASSERT_TRUE(w.set_linear_velocity(ball, {0_fx, 0_fx, 15_fx}).ok());
+  bool reset = false;
+  for (int f = 0; f < 300 && !reset; ++f) {
+    s.step();
+    reset = state(w, plus).user_data != before;
+  }
+  ASSERT_TRUE(reset) << "the ball reached the goal";
+  EXPECT_EQ(state(w, plus).user_data, before + 1);
+  EXPECT_EQ(state(w, minus).user_data & 0xFFFFFFFFU, 0U);
+  s.step();
+  const BodyState b = state(w, ball);
+  EXPECT_LT(abs(b.position.z), 0.1_fx) << "back on the centre spot";
+  EXPECT_LT(abs(b.position.x), 0.1_fx);
+}
+
+TEST(SoccarScenario, TheJumpButtonLiftsACarOffItsWheelsAndTheStickDrivesIt) {
+  // A jump of 5 m/s along the chassis' up lifts it by about v^2 / (2 g) = 1.27 m; the stick
+  // forwards drives it forwards.
+  Scenario s = make("soccar", {.seed = 1, .players = 2, .count = 0});
+  World& w = s.world();
+  for (int f = 0; f < 60; ++f)
+    s.step();
+  const VehicleId car = w.vehicle_ids()[0];
+  const BodyId chassis = w.vehicle(car)->def.chassis;
+  const Fixed rest = state(w, chassis).position.y;
+  std::vector<PlayerInput> inputs(2);
+  inputs[0].buttons = PlayerInput::jump;
+  s.step(inputs);
+  inputs[0].buttons = 0;
+  Fixed highest = rest;
+  for (int f = 0; f < 60; ++f) {
+    s.step(inputs);
+    highest = std::max(highest, state(w, chassis).position.y);
+  }
+  const double rise = (highest - rest).to_double();
+  EXPECT_NEAR(rise, 25.0 / (2 * 9.81), 0.3) << "about v^2 / 2g, less the springs' give";
+  inputs[0].move_z = 127;
+  for (int f = 0; f < 120; ++f)
+    s.step(inputs);
+  EXPECT_GT(w.vehicle(car)->forward_speed, 3_fx);
+}
 }  // namespace
 }  // namespace detsim

@@ -156,6 +156,13 @@ constexpr std::array entries{
          600, 0, 0, 0, 0, 0, false},
         scenes_detail::build_slope,
         nullptr},
+    Entry{{"soccar",
+           "car soccer: 2-8 players' cars (throttle, brake, steering, jump, boost) and a 30 kg "
+           "ball in a walled 40 x 60 m arena with a goal at each end; a goal scores and resets "
+           "the ball",
+           3600, 2, 8, 4, 0, 0, true},
+          scenes_detail::build_soccar,
+          scenes_detail::control_soccar},
     Entry{{"spray",
            "RNG-driven spawns of spheres, boxes and capsules onto a rotating paddle and a "
            "moving platform (kinematic)",

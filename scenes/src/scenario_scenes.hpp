@@ -50,6 +50,8 @@ void build_characters(World& w, const ScenarioParams& p);
 // tagged `tag`, four wheels, the rear two driven, at `position` turned by `heading`.
 void build_vehicles(World& w, const ScenarioParams& p);
 VehicleId add_car(World& w, Vec3 position, Quat heading, std::uint64_t tag);
+// Car soccer (scenario_soccar.cpp): the players' cars, a ball, two goals.
+void build_soccar(World& w, const ScenarioParams& p);
 
 // Per-frame logic, run before each step. Reads only the World and the inputs.
 void control_spray(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
@@ -58,6 +60,7 @@ void control_bridge(World& w, std::span<const PlayerInput> inputs, const Scenari
 void control_flag(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_characters(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_vehicles(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
+void control_soccar(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 
 // Tags in BodyDef::user_data by which game logic finds its bodies again (the World is the whole
 // scenario state, so nothing else may remember them). A player's tag is player_tag + index.
@@ -219,6 +222,24 @@ inline constexpr Fixed axle = 1.3_fx;   ///< the axles' z, front and rear
 inline constexpr Fixed max_steer = 0.5_fx;
 inline constexpr Fixed anti_roll = 20000_fx;
 }  // namespace cars
+
+namespace soccar {
+inline constexpr Fixed half_width = 20_fx;   ///< the side walls' inner faces at +-half_width (x)
+inline constexpr Fixed half_length = 30_fx;  ///< the end walls' inner faces at +-half_length (z)
+inline constexpr Fixed wall_height = 2_fx;   ///< half the walls' height
+inline constexpr Fixed goal_half_width = 4_fx;
+inline constexpr Fixed goal_height = 3_fx;
+inline constexpr Fixed goal_depth = 1_fx;  ///< the scoring zone inside the mouth
+inline constexpr Fixed ball_radius = 1_fx;
+inline constexpr Fixed ball_mass = 30_fx;
+inline constexpr Fixed kickoff_z = 20_fx;
+inline constexpr Fixed car_spacing = 6_fx;
+inline constexpr Fixed car_jump_speed = 5_fx;       ///< m/s, along the chassis' up
+inline constexpr Fixed boost_acceleration = 10_fx;  ///< m/s^2, along the chassis' forward
+inline constexpr std::uint64_t goal_tag = 0x474F'414C'0000'0000ULL;   // "GOAL"
+inline constexpr std::uint64_t goal_plus = 0x0000'0001'0000'0000ULL;  ///< the goal at +z
+inline constexpr std::uint64_t goal_count_mask = 0xFFFF'FFFFULL;      ///< goals let in
+}  // namespace soccar
 
 namespace characters {
 inline constexpr Fixed yard = 12_fx;  ///< the walls' inner faces are at +-yard in x and z

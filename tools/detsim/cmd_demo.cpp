@@ -1,7 +1,8 @@
-// detsim demo, the main job: a 4-player arena match of bots, each player with its own game and
-// rollback session, over one simulated network with a 100 ms round trip, jitter, loss,
-// duplication and reordering, in virtual time. Player 0 records its confirmed frames; the replay
-// is then verified, and the summary says whether every peer confirmed the same hash at every frame.
+// detsim demo, the main job: a 4-player match of bots (the arena, or --scenario: soccar), each
+// player with its own game and rollback session, over one simulated network with a 100 ms round
+// trip, jitter, loss, duplication and reordering, in virtual time. Player 0 records its confirmed
+// frames; the replay is then verified, and the summary says whether every peer confirmed the same
+// hash at every frame.
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -91,6 +92,14 @@ class Demo {
 };
 
 Status Demo::set_up(const std::string& replay_path) {
+  const ScenarioInfo* info = find_scenario(args_.scenario);
+  if (info == nullptr)
+    return Status::error("unknown scenario '" + args_.scenario + "' (detsim scenarios lists them)");
+  if (info->min_players > demo_players || info->max_players < demo_players ||
+      info->input_size != PlayerInput::encoded_size)
+    return Status::error("scenario '" + args_.scenario +
+                         "' does not take 4 players of built-in input; the demo's bots need one "
+                         "that does (arena, soccar)");
   auto network =
       net::SimNetwork::create(demo_players, args_.seed * 7919 + 13, net::internet_link());
   if (!network) return network.status();
@@ -101,7 +110,7 @@ Status Demo::set_up(const std::string& replay_path) {
   params.players = demo_players;
   for (std::uint32_t p = 0; p < demo_players; ++p) {
     Peer& peer = peers_[p];
-    auto scenario = Scenario::create("arena", params);
+    auto scenario = Scenario::create(args_.scenario, params);
     if (!scenario) return scenario.status();
     peer.scenario = std::make_unique<Scenario>(std::move(scenario.value()));
     peer.game = std::make_unique<net::ScenarioGame>(*peer.scenario);
@@ -245,7 +254,7 @@ int Demo::report(const MatchResult& match, const replay::VerifyResult& verified,
                           .text());
     }
     Json j;
-    j.str("scenario", "arena")
+    j.str("scenario", args_.scenario)
         .num("seed", args_.seed)
         .num("players", demo_players)
         .num("frames", frames);
@@ -272,9 +281,9 @@ int Demo::report(const MatchResult& match, const replay::VerifyResult& verified,
         .print();
     return code;
   }
-  std::printf("match        arena (seed %llu, 4 bots), %llu frames, rollback, input delay %u\n",
-              static_cast<unsigned long long>(args_.seed), static_cast<unsigned long long>(frames),
-              demo_input_delay);
+  std::printf("match        %s (seed %llu, 4 bots), %llu frames, rollback, input delay %u\n",
+              args_.scenario.c_str(), static_cast<unsigned long long>(args_.seed),
+              static_cast<unsigned long long>(frames), demo_input_delay);
   std::printf(
       "network      simulated: 50 ms each way (100 ms round trip), 20 ms jitter, 5%% loss, "
       "1%% duplicated, 1%% reordered\n");

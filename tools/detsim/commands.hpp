@@ -93,6 +93,7 @@ int golden_command(const GoldenArgs& args);
 /// The main job of scripts/run.sh: a 4-player arena match of bots over a simulated bad network
 /// (rollback sessions in virtual time), player 0 recorded, the replay verified, a summary.
 struct DemoArgs {
+  std::string scenario = "arena";  ///< any scenario that takes 4 players
   std::uint64_t frames = 1200;
   std::uint64_t seed = 1;
   std::string record;  ///< empty: a temporary file, removed afterwards

@@ -42,6 +42,7 @@ inline constexpr GoldenRun runs[] = {
     {"rocks", {.seed = 1, .players = 0, .count = 30}, 1000},
     {"rope_bridge", {.seed = 1, .players = 0, .count = 4}, 1000},
     {"slope", {.seed = 1, .players = 0, .count = 0}, 1000},
+    {"soccar", {.seed = 1, .players = 4, .count = 0}, 1000},
     {"spray", {.seed = 3, .players = 0, .count = 0}, 1200},
     {"stack", {.seed = 1, .players = 0, .count = 0}, 1200},
     {"vehicles", {.seed = 1, .players = 0, .count = 0}, 1000},

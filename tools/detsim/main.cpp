@@ -414,6 +414,10 @@ verify. Every architecture must reproduce them (golden/README.md).)");
   c = app.add_subcommand("demo",
                          "The main job: a 4-player arena match of bots over a simulated bad "
                          "network, recorded, verified, summarised");
+  c->add_option("--scenario", demo.scenario,
+                "The match's scenario: any that takes 4 players (default arena; soccar is car "
+                "soccer)")
+      ->type_name("NAME");
   c->add_option("--frames", demo.frames, "Frames to play (default 1200: 20 s at 60 Hz)")
       ->type_name("N")
       ->check(CLI::Range(std::uint64_t{1}, detsim::cli::max_frames));
@@ -426,7 +430,7 @@ verify. Every architecture must reproduce them (golden/README.md).)");
   c->add_flag("--json", demo.json,
               "Print one JSON object: frames, final_hash, rollbacks, peers_agree, verified, ...");
   c->footer(std::string(R"(
-Four players, each with its own game and rollback session, play the arena scenario over one
+Four players, each with its own game and rollback session, play the scenario over one
 simulated network: 50 ms latency each way (100 ms round trip), 20 ms jitter, 5% loss, 1%
 duplication, 1% reordering. Time is virtual (nothing sleeps), so the run takes a few seconds and
 gives the same result every time. Player 0's confirmed frames are recorded to a replay, which is
