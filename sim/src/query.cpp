@@ -166,7 +166,8 @@ std::vector<BodyId> World::overlap(const Shape& shape, Vec3 position, Quat orien
     if (!passes(b, filter)) continue;
     if (sim_detail::shape_kind(b.shape.type).bounded) {
       const Fixed gap = distance(b.position, position);
-      if (gap > reach + bounding_radius(b.shape, s_->geometry(b.shape)) + cull_slack(gap)) continue;
+      if (gap > reach + sim_detail::cull_radius(b.shape, s_->geometry(b.shape)) + cull_slack(gap))
+        continue;
     }
     // collide() accepts its shapes in either order (it swaps them into its canonical one); the
     // normal's direction, the only thing the order changes, does not matter here.

@@ -116,7 +116,7 @@ void touches_of(const WorldState& s, const Query& query, const BodyState& b,
   const Geometry* g = s.geometry(b.shape);
   if (kind.bounded && query.bounded) {
     const Fixed gap = distance(b.position, query.pose.position);
-    if (gap > query.reach + kind.bounding_radius(b.shape, g) + cull_slack(gap)) return;
+    if (gap > query.reach + sim_detail::cull_radius(b.shape, g) + cull_slack(gap)) return;
   }
   const Pose pose = pose_of(b);
   collide_all({query.shape, query.geometry, query.pose}, {b.shape, g, pose}, Fixed::zero(),
@@ -138,11 +138,21 @@ void touches_of(const WorldState& s, const Query& query, const BodyState& b,
   }
 }
 
-/// The earliest fraction at which the cast of `query` along `translation` (length `travel`)
-/// meets body b, below `before`, or nothing.
-std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query, Vec3 translation,
-                                     Fixed travel, const BodyState& b, Fixed before,
+/// A cast's motion: the translation, its length and its direction (translation / travel), the
+/// last two once per cast rather than once per body.
+struct Sweep {
+  Vec3 translation;
+  Fixed travel;
+  Vec3 direction;
+};
+
+/// The earliest fraction at which the cast of `query` along `sweep` meets body b, below `before`,
+/// or nothing.
+std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query, const Sweep& sweep,
+                                     const BodyState& b, Fixed before,
                                      std::vector<SubManifold>& manifolds, std::vector<Gap>& gaps) {
+  const Vec3 translation = sweep.translation;
+  const Fixed travel = sweep.travel;
   const sim_detail::ShapeKind& kind = shape_kind(b.shape.type);
   const Geometry* g = s.geometry(b.shape);
   const Fixed target = s.def.linear_slop;
@@ -150,14 +160,14 @@ std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query, Ve
   if (kind.bounded) {
     // The swept ball of the query shape against b's bounding ball.
     const Vec3 offset = b.position - query.pose.position;
-    const Vec3 direction = translation / travel;
+    const Vec3 direction = sweep.direction;
     const Fixed along = dot(offset, direction);
     const Fixed nearest = clamp(along, Fixed::zero(), travel);
     // Squared, without a root per body: the square's rounding (2^-32 m^2) is far inside the
     // slack, and a square that saturates is only ever of a gap far beyond the reach (or of a
     // reach so large that both saturate, and then nothing is culled).
     const Vec3 gap = offset - direction * nearest;
-    const Fixed reach = query.reach + kind.bounding_radius(b.shape, g) + target + cull_slack(along);
+    const Fixed reach = query.reach + sim_detail::cull_radius(b.shape, g) + target + cull_slack(along);
     if (dot(gap, gap) > reach * reach) return std::nullopt;
   }
   const Pose pose = pose_of(b);
@@ -234,11 +244,12 @@ std::optional<ShapeHit> cast_shape(const WorldState& s, const Shape& shape, Vec3
   if (!query || !query->view || travel == Fixed::zero()) return std::nullopt;
   thread_local std::vector<SubManifold> manifolds;  // reused between queries
   thread_local std::vector<Gap> gaps;
+  const Sweep sweep{translation, travel, translation / travel};
   std::optional<ShapeHit> best;
   for (const BodyState& b : s.bodies) {
     if (!passes(b, filter)) continue;
     const Fixed before = best ? best->fraction : Fixed::one() + Fixed::from_raw(1);
-    if (auto hit = cast_against(s, *query, translation, travel, b, before, manifolds, gaps)) {
+    if (auto hit = cast_against(s, *query, sweep, b, before, manifolds, gaps)) {
       best = hit;
     }
   }

@@ -24,6 +24,17 @@ std::span<const ShapeKind* const> shape_kinds() noexcept {
   return kKinds;
 }
 
+Fixed cull_radius(const Shape& shape, const Geometry* g) noexcept {
+  switch (shape.type) {
+    case ShapeType::box:
+      return shape.half_extents.x + shape.half_extents.y + shape.half_extents.z;
+    case ShapeType::cylinder:
+      return shape.radius + shape.half_height;
+    default:
+      return bounding_radius(shape, g);
+  }
+}
+
 const ShapeKind* find_shape_kind(ShapeType t) noexcept {
   for (const ShapeKind* kind : kKinds) {
     if (kind->type == t) return kind;

@@ -132,6 +132,12 @@ extern const ShapeKind compound_kind;
   return shape_kind(shape.type).bounding_radius(shape, g);
 }
 
+/// An upper bound of bounding_radius with no square root, for culling queries body by body: a
+/// box's and a cylinder's half sizes summed (|h| <= |h.x| + |h.y| + |h.z|); the other kinds'
+/// radius (a stored number or a sum already). Never smaller, so a cull by it keeps every body
+/// the exact radius keeps: only the culling's cost changes, never a query's result.
+[[nodiscard]] Fixed cull_radius(const Shape& shape, const Geometry* g) noexcept;
+
 // Ray pieces shared by the round kinds (shape_sphere.cpp).
 
 /// Where the ray enters the ball of radius r about the origin, for p outside it.
