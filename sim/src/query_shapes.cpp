@@ -167,7 +167,8 @@ std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query, co
     // slack, and a square that saturates is only ever of a gap far beyond the reach (or of a
     // reach so large that both saturate, and then nothing is culled).
     const Vec3 gap = offset - direction * nearest;
-    const Fixed reach = query.reach + sim_detail::cull_radius(b.shape, g) + target + cull_slack(along);
+    const Fixed reach =
+        query.reach + sim_detail::cull_radius(b.shape, g) + target + cull_slack(along);
     if (dot(gap, gap) > reach * reach) return std::nullopt;
   }
   const Pose pose = pose_of(b);
