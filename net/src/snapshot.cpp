@@ -3,22 +3,15 @@
 
 #include <string>
 
-#if DETSIM_WITH_ZSTD
-#include <zstd.h>
-#endif
+#include "envelope.hpp"
+#include "wire.hpp"
 
 namespace detsim::net::detail {
 namespace {
 
-constexpr std::uint8_t magic[4] = {'D', 'S', 'N', 'P'};
-constexpr std::size_t envelope_size = 4 + 1 + 8;
-constexpr std::uint8_t uncompressed = 0;
-constexpr std::uint8_t zstd_compressed = 1;
+constexpr EnvelopeMagic rejoin_magic{'D', 'S', 'N', 'P'};
 
-void put(std::vector<std::uint8_t>& out, std::uint64_t v, std::size_t n) {
-  for (std::size_t i = 0; i < n; ++i)
-    out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-}
+using wire::put;
 
 class Reader {
  public:
@@ -70,76 +63,15 @@ std::vector<std::uint8_t> encode_snapshot(const Snapshot& s, bool compress) {
   put(payload, s.state.size(), 8);
   payload.insert(payload.end(), s.state.begin(), s.state.end());
 
-  std::vector<std::uint8_t> out(magic, magic + 4);
-#if DETSIM_WITH_ZSTD
-  if (!compress) {
-    out.push_back(uncompressed);
-    put(out, payload.size(), 8);
-    out.insert(out.end(), payload.begin(), payload.end());
-    return out;
-  }
-  out.push_back(zstd_compressed);
-  put(out, payload.size(), 8);
-  const std::size_t bound = ZSTD_compressBound(payload.size());
-  out.resize(envelope_size + bound);
-  // Level 3 (zstd's default): a 100 KB world state compresses in about a millisecond. With the
-  // frame's checksum, so a snapshot altered on the way fails to decompress instead of loading.
-  ZSTD_CCtx* context = ZSTD_createCCtx();
-  std::size_t written = 1;
-  if (context != nullptr) {
-    ZSTD_CCtx_setParameter(context, ZSTD_c_compressionLevel, 3);
-    ZSTD_CCtx_setParameter(context, ZSTD_c_checksumFlag, 1);
-    written =
-        ZSTD_compress2(context, out.data() + envelope_size, bound, payload.data(), payload.size());
-    ZSTD_freeCCtx(context);
-  }
-  if (context != nullptr && !ZSTD_isError(written)) {
-    out.resize(envelope_size + written);
-    return out;
-  }
-  out.resize(4);  // out of memory, or a zstd error: send it uncompressed then
-#else
-  (void)compress;
-#endif
-  out.push_back(uncompressed);
-  put(out, payload.size(), 8);
-  out.insert(out.end(), payload.begin(), payload.end());
-  return out;
+  return seal_envelope(rejoin_magic, payload, compress);
 }
 
 Expected<Snapshot> decode_snapshot(std::span<const std::uint8_t> bytes, std::uint32_t players,
                                    std::uint32_t input_size, std::size_t capacity) {
-  if (bytes.size() < envelope_size || !std::equal(magic, magic + 4, bytes.begin()))
-    return bad("not a snapshot (no DSNP header)");
-  Reader envelope(bytes.subspan(4));
-  std::uint64_t compression = 0;
-  std::uint64_t size = 0;
-  envelope.get(compression, 1);
-  envelope.get(size, 8);
-  if (size > max_snapshot_payload)
-    return bad("payload of " + std::to_string(size) + " bytes is over the limit of " +
-               std::to_string(max_snapshot_payload));
-  const std::span<const std::uint8_t> body = bytes.subspan(envelope_size);
-  std::vector<std::uint8_t> payload;
-  if (compression == uncompressed) {
-    if (body.size() != size) return bad("payload size differs from its header");
-    payload.assign(body.begin(), body.end());
-  } else if (compression == zstd_compressed) {
-#if DETSIM_WITH_ZSTD
-    const unsigned long long content = ZSTD_getFrameContentSize(body.data(), body.size());
-    if (content != size) return bad("compressed payload size differs from its header");
-    payload.resize(static_cast<std::size_t>(size));
-    const std::size_t got =
-        ZSTD_decompress(payload.data(), payload.size(), body.data(), body.size());
-    if (ZSTD_isError(got) || got != size)
-      return bad("compressed payload does not decompress (corrupt)");
-#else
-    return bad("compressed with zstd, and this build has no zstd (DETSIM_WITH_ZSTD=OFF)");
-#endif
-  } else {
-    return bad("unknown compression " + std::to_string(compression));
-  }
-
+  Expected<std::vector<std::uint8_t>> opened =
+      open_envelope(rejoin_magic, bytes, max_snapshot_payload, "snapshot");
+  if (!opened) return opened.status();
+  const std::vector<std::uint8_t>& payload = *opened;
   Reader in(payload);
   Snapshot s;
   std::uint64_t count_players = 0;

@@ -1,9 +1,13 @@
-// The network layer: sessions (rollback, lockstep) over a transport (UDP, simulated network).
+// The network layer: sessions (rollback, lockstep) and a game server with its clients, over a
+// transport (UDP, simulated network).
 #pragma once
 
+#include <detsim/net/client.hpp>
 #include <detsim/net/game.hpp>
 #include <detsim/net/protection.hpp>
 #include <detsim/net/protocol.hpp>
+#include <detsim/net/server.hpp>
+#include <detsim/net/server_protocol.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/net/spectator.hpp>

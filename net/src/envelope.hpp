@@ -1,0 +1,38 @@
+// A compressed envelope: what the rejoin snapshot (snapshot.cpp) and the server's snapshots
+// (server_snapshot.cpp) put their payloads in before they go on the wire.
+//
+//     magic (4 bytes, the caller's) | compression u8 (0: none, 1: zstd) | size u64 (of the payload
+//     uncompressed) | payload, compressed or not
+//
+// zstd (Debian's libzstd) at level 3 with its frame checksum, so bytes altered on the way fail to
+// decompress instead of loading; a build without zstd writes the payload as it is and refuses a
+// compressed one with a clear error.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <detsim/core/status.hpp>
+
+namespace detsim::net::detail {
+
+using EnvelopeMagic = std::array<std::uint8_t, 4>;
+
+/// The envelope around `payload`: zstd-compressed where the build has zstd and `compress` says so
+/// (and compression succeeds), else stored.
+[[nodiscard]] std::vector<std::uint8_t> seal_envelope(const EnvelopeMagic& magic,
+                                                      std::span<const std::uint8_t> payload,
+                                                      bool compress = true);
+
+/// The payload of an envelope with `magic`, at most `max_payload` bytes uncompressed whatever the
+/// header says; errors say what is wrong ("not a ... (no DSNP header)", "corrupt", ...), with
+/// `what` naming the thing ("snapshot").
+[[nodiscard]] Expected<std::vector<std::uint8_t>> open_envelope(const EnvelopeMagic& magic,
+                                                                std::span<const std::uint8_t> bytes,
+                                                                std::size_t max_payload,
+                                                                const char* what);
+
+}  // namespace detsim::net::detail

@@ -1,0 +1,305 @@
+// The game server and its clients (net/server.hpp, net/client.hpp) over the simulated network with
+// a cheap game: admission, stamping without waiting, exact reconciliation, joins in progress,
+// restarts, bad networks, forged datagrams, and state authority's snapshots.
+#include <gtest/gtest.h>
+
+#include <detsim/net/client.hpp>
+#include <detsim/net/server.hpp>
+#include <detsim/net/server_protocol.hpp>
+#include <detsim/net/sim_network.hpp>
+
+#include "support/server_match.hpp"
+
+namespace detsim {
+namespace {
+
+namespace sp = net::server_protocol;
+using test::ServerMatch;
+using test::ServerMatchOptions;
+
+/// Every live client ended on the server's final state: the same hash, no desync.
+void expect_all_agree(ServerMatch& m, std::uint32_t clients) {
+  const std::uint64_t final_hash = m.server().current_hash();
+  for (std::uint32_t c = 0; c < clients; ++c) {
+    net::Client* client = m.client(c);
+    if (client == nullptr) continue;
+    SCOPED_TRACE("client " + std::to_string(c));
+    EXPECT_TRUE(client->ended());
+    EXPECT_EQ(client->current_frame(), m.server().current_frame());
+    EXPECT_EQ(client->server_hash(), final_hash);
+    std::vector<std::uint8_t> state;
+    EXPECT_EQ(m.game(c)->save(state), final_hash);
+    EXPECT_EQ(client->stats().desyncs, 0U);
+  }
+}
+
+TEST(NetServer, RejectsInvalidConfigsNamingTheField) {
+  test::CounterGame game;
+  auto network = net::SimNetwork::create(2, 1);
+  ASSERT_TRUE(network.ok());
+  const auto error_of = [&](auto&& edit) {
+    net::ServerConfig c;
+    edit(c);
+    auto s = net::Server::create(c, game, network->endpoint(0));
+    return s.ok() ? std::string() : s.message();
+  };
+  EXPECT_EQ(error_of([](net::ServerConfig&) {}), "");
+  EXPECT_NE(error_of([](net::ServerConfig& c) { c.players = 0; }).find("players"),
+            std::string::npos);
+  EXPECT_NE(error_of([](net::ServerConfig& c) { c.players = 129; }).find("players"),
+            std::string::npos);
+  // 128 players of 16 bytes: a frame's inputs would not fit a datagram.
+  EXPECT_NE(error_of([](net::ServerConfig& c) {
+              c.players = 128;
+              c.input_size = 16;
+            }).find("players"),
+            std::string::npos);
+  EXPECT_NE(error_of([](net::ServerConfig& c) { c.input_size = 65; }).find("input_size"),
+            std::string::npos);
+  EXPECT_NE(error_of([](net::ServerConfig& c) { c.frame_us = 10; }).find("frame_us"),
+            std::string::npos);
+  EXPECT_NE(error_of([](net::ServerConfig& c) { c.start_clients = 3; }).find("start_clients"),
+            std::string::npos);
+  EXPECT_NE(error_of([](net::ServerConfig& c) { c.update_interval = 0; }).find("update_interval"),
+            std::string::npos);
+  EXPECT_NE(error_of([](net::ServerConfig& c) { c.history = 4; }).find("history"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of([](net::ServerConfig& c) { c.description.assign(513, 0); }).find("description"),
+      std::string::npos);
+  net::ClientConfig cc;
+  cc.max_prediction = 0;
+  auto client = net::Client::create(cc, network->endpoint(1));
+  ASSERT_FALSE(client.ok());
+  EXPECT_NE(client.message().find("max_prediction"), std::string::npos);
+}
+
+TEST(NetServer, ClientsOnAPerfectNetworkEndOnTheServersState) {
+  ServerMatchOptions o;
+  o.clients = 3;
+  o.frames = 300;
+  ServerMatch m(o);
+  ASSERT_TRUE(m.run());
+  EXPECT_EQ(m.server().current_frame(), 300U);
+  EXPECT_EQ(m.server_hashes().size(), 300U);
+  expect_all_agree(m, 3);
+  // The server's game simulated every frame once, and its own hash is its game's.
+  EXPECT_EQ(m.server_game().simulated, 300U);
+  EXPECT_EQ(m.server_game().resimulated, 0U);
+  for (const net::ServerClientStats& c : m.server().client_stats()) {
+    EXPECT_EQ(c.packets_rejected, 0U);
+    EXPECT_EQ(c.acknowledged_frame, 300U);
+  }
+}
+
+TEST(NetServer, RightPredictionsMakeNoCorrection) {
+  // Every input zero: what each client predicts for the others (their last input, zero before
+  // the first) and what the server stamps for a late or missing one (the last again) is right.
+  ServerMatchOptions o;
+  o.clients = 3;
+  o.frames = 400;
+  o.link.latency_us = 40'000;
+  o.link.jitter_us = 10'000;
+  o.input = [](std::uint32_t, std::uint64_t, std::span<std::uint8_t> out) {
+    std::fill(out.begin(), out.end(), std::uint8_t{0});
+  };
+  ServerMatch m(o);
+  ASSERT_TRUE(m.run());
+  expect_all_agree(m, 3);
+  for (std::uint32_t c = 0; c < 3; ++c) {
+    EXPECT_EQ(m.client(c)->stats().mispredictions, 0U);
+    EXPECT_EQ(m.client(c)->stats().corrections, 0U);
+    EXPECT_EQ(m.game(c)->resimulated, 0U);
+    EXPECT_GT(m.client(c)->stats().checks_passed, 0U);
+  }
+}
+
+TEST(NetServer, MispredictionsAreCorrectedExactly) {
+  // Inputs that change every 8 frames: the others' changes are mispredicted, and each is
+  // corrected by re-simulation; every correction has a misprediction behind it.
+  ServerMatchOptions o;
+  o.clients = 4;
+  o.frames = 600;
+  o.link.latency_us = 30'000;
+  ServerMatch m(o);
+  ASSERT_TRUE(m.run());
+  expect_all_agree(m, 4);
+  for (std::uint32_t c = 0; c < 4; ++c) {
+    const net::ClientStats& s = m.client(c)->stats();
+    EXPECT_GT(s.mispredictions, 0U);
+    EXPECT_GT(s.corrections, 0U);
+    EXPECT_LE(s.corrections, s.mispredictions);
+    EXPECT_GT(s.resimulated_frames, 0U);
+  }
+}
+
+TEST(NetServer, ABadNetworkStillEndsOnTheServersState) {
+  ServerMatchOptions o;
+  o.clients = 4;
+  o.frames = 600;
+  o.seed = 7;
+  o.link.latency_us = 50'000;
+  o.link.jitter_us = 20'000;
+  o.link.loss_ppm = 100'000;      // 10 %
+  o.link.duplicate_ppm = 50'000;  // 5 %
+  o.link.reorder_ppm = 50'000;
+  o.link.reorder_delay_us = 30'000;
+  ServerMatch m(o);
+  ASSERT_TRUE(m.run());
+  expect_all_agree(m, 4);
+  std::uint64_t late = 0;
+  for (const net::ServerClientStats& c : m.server().client_stats())
+    late += c.inputs_late + c.inputs_missing;
+  EXPECT_GT(late, 0U);  // the server never waited for them
+}
+
+TEST(NetServer, TheServerNeverWaitsForASlowClient) {
+  // Client 2 is 200 ms away: the server runs on the clock regardless, its inputs arrive late
+  // at first (stamped to later frames) and the time sync then moves it ahead.
+  ServerMatchOptions o;
+  o.clients = 3;
+  o.frames = 600;
+  o.setup = [](net::SimNetwork& n) {
+    net::LinkConditions slow;
+    slow.latency_us = 200'000;
+    ASSERT_TRUE(n.set_link(3, 0, slow).ok());
+    ASSERT_TRUE(n.set_link(0, 3, slow).ok());
+  };
+  ServerMatch m(o);
+  ASSERT_TRUE(m.run());
+  expect_all_agree(m, 3);
+  // 600 frames at 60 Hz, started when the last client joined (about 200 ms in): the server
+  // ended close to 10 s after its start, not later.
+  EXPECT_LT(m.now_ms(), 10'000U + 2'000U);
+  const auto stats = m.server().client_stats();
+  EXPECT_GT(stats[2].inputs_late + stats[2].inputs_missing, 0U);
+}
+
+TEST(NetServer, ALateJoinerAndARestartedClientPlayOn) {
+  ServerMatchOptions o;
+  o.clients = 4;
+  o.frames = 900;  // 15 s
+  o.start_clients = 2;
+  o.join_ms = {0, 0, 0, 5'000};      // client 3 joins 5 s late
+  o.restarts = {{1, 6'000, 6'500}};  // client 1 killed at 6 s, back at 6.5 s
+  o.link.latency_us = 20'000;
+  o.link.loss_ppm = 20'000;
+  ServerMatch m(o);
+  ASSERT_TRUE(m.run());
+  expect_all_agree(m, 4);
+  // The late one and the restarted one started from snapshots.
+  EXPECT_GE(m.client(3)->stats().snapshots_received, 1U);
+  EXPECT_GE(m.client(1)->stats().snapshots_received, 1U);
+  // Nobody paused: the server simulated its frames on time.
+  EXPECT_EQ(m.server_hashes().size(), 900U);
+  bool left = false;
+  for (const net::ServerEvent& e : m.server().take_events())
+    left = left || e.type == net::ServerEventType::left;
+  EXPECT_TRUE(left);  // the killed client's seat was freed
+}
+
+/// Client 2's transport: it plays honestly, and after every datagram it sends, forges more —
+/// another token, another client's seat by guessing, frames far ahead, a server's packet type,
+/// garbage.
+class Forger final : public net::Transport {
+ public:
+  explicit Forger(net::Transport& inner) : inner_(inner) {}
+  void send(net::PeerId to, std::span<const std::uint8_t> bytes) override {
+    inner_.send(to, bytes);
+    sp::Packet p;
+    if (sp::decode(bytes, {3, 4}, p) != sp::DecodeError::none) return;
+    if (p.header.type != sp::PacketType::input) return;
+    ++n_;
+    std::vector<std::uint8_t> out;
+    sp::Packet forged = p;
+    forged.header.token = p.header.token + 1 + n_;  // a guessed token
+    forged.input.inputs.assign(forged.input.inputs.size(), 0xEE);
+    if (sp::encode(forged, {3, 4}, out)) inner_.send(to, out);
+    forged = p;
+    forged.input.start = p.input.start + 5000;  // far beyond the input window
+    forged.input.inputs.assign(forged.input.inputs.size(), 0xDD);
+    if (sp::encode(forged, {3, 4}, out)) inner_.send(to, out);
+    forged = p;
+    forged.input.ack = p.input.ack + 100'000;  // acknowledges what was never sent
+    if (sp::encode(forged, {3, 4}, out)) inner_.send(to, out);
+    forged = p;
+    forged.header.type = sp::PacketType::update;  // a server's packet, from a client
+    forged.update.count = 0;
+    if (sp::encode(forged, {3, 4}, out)) inner_.send(to, out);
+    forged = p;
+    forged.header.type = sp::PacketType::connect;  // another game, on its own address
+    forged.connect = {0xBAD, 7, 0};
+    if (sp::encode(forged, {3, 4}, out)) inner_.send(to, out);
+    std::vector<std::uint8_t> garbage(bytes.begin(), bytes.end());
+    garbage[garbage.size() / 2] ^= 0x5A;
+    inner_.send(to, garbage);
+  }
+  void receive(std::vector<net::Datagram>& out) override { inner_.receive(out); }
+
+ private:
+  net::Transport& inner_;
+  std::uint64_t n_ = 0;
+};
+
+TEST(NetServer, AForgingClientChangesNothing) {
+  ServerMatchOptions o;
+  o.clients = 3;
+  o.frames = 300;
+  ServerMatch honest(o);
+  ASSERT_TRUE(honest.run());
+  o.wrap = [](std::uint32_t c, net::Transport& inner) -> std::unique_ptr<net::Transport> {
+    if (c != 2) return nullptr;
+    return std::make_unique<Forger>(inner);
+  };
+  ServerMatch forged(o);
+  ASSERT_TRUE(forged.run());
+  // The same frames, bit for bit: nothing forged reached the simulation.
+  EXPECT_EQ(forged.server_hashes(), honest.server_hashes());
+  expect_all_agree(forged, 3);
+  const auto stats = forged.server().client_stats();
+  EXPECT_EQ(stats[0].packets_rejected, 0U);
+  EXPECT_EQ(stats[1].packets_rejected, 0U);
+  EXPECT_GT(stats[2].packets_rejected, 0U);
+  EXPECT_GT(forged.server().stats().dropped_unknown, 0U);
+  std::uint64_t malformed = 0;
+  for (std::uint64_t n : forged.server().stats().dropped_malformed)
+    malformed += n;
+  EXPECT_GT(malformed, 0U);
+}
+
+TEST(NetServer, StateAuthorityReconstructsTheServersStateThroughLoss) {
+  ServerMatchOptions o;
+  o.clients = 3;
+  o.frames = 600;
+  o.seed = 3;
+  o.authority = sp::Authority::state;
+  o.snapshot_interval = 6;
+  o.link.latency_us = 30'000;
+  o.link.loss_ppm = 50'000;
+  ServerMatch m(o);
+  ASSERT_TRUE(m.run());
+  expect_all_agree(m, 3);
+  for (std::uint32_t c = 0; c < 3; ++c) {
+    EXPECT_GT(m.client(c)->stats().snapshots_received, 10U);
+    EXPECT_GT(m.client(c)->stats().checks_passed, 0U);
+  }
+}
+
+TEST(NetServer, AWrongGameIsRejectedWithAReason) {
+  ServerMatchOptions o;
+  o.clients = 2;
+  o.frames = 60;
+  o.start_clients = 1;
+  o.configure_client = [](std::uint32_t c, net::ClientConfig& config) {
+    if (c == 1) config.game = 0xBAD;
+  };
+  o.max_ms = 500;
+  ServerMatch m(o);
+  EXPECT_FALSE(m.run());  // client 1 never plays
+  EXPECT_EQ(m.client(1)->failure(), "the server runs another game");
+  EXPECT_EQ(m.client(1)->welcome(), nullptr);
+  EXPECT_EQ(m.server().stats().rejects, 1U);
+}
+
+}  // namespace
+}  // namespace detsim

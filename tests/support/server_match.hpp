@@ -1,0 +1,93 @@
+// Test support for the game server (net/server.hpp, net/client.hpp): a server and N clients, each
+// with its own game, over a SimNetwork stepped in virtual time (1 ms a tick). Clients join at a
+// chosen time, may be killed and restarted (a new client and a new game at frame 0), and play
+// scripted inputs; everything the server simulates is recorded.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <detsim/net/client.hpp>
+#include <detsim/net/server.hpp>
+#include <detsim/net/sim_network.hpp>
+
+#include "support/net_match.hpp"
+
+namespace detsim::test {
+
+struct ServerMatchOptions {
+  std::uint32_t clients = 2;
+  std::uint32_t players = 0;  ///< seats (0: as many as clients)
+  std::uint32_t input_size = 4;
+  std::uint32_t frames = 300;
+  std::uint64_t seed = 1;
+  net::server_protocol::Authority authority = net::server_protocol::Authority::inputs;
+  std::uint32_t update_interval = 3;
+  std::uint32_t snapshot_interval = 1;
+  std::uint32_t start_clients = 0;  ///< ServerConfig::start_clients (0: as many as clients)
+  net::LinkConditions link{};       ///< every link, both ways
+  /// Client c's first poll (ms); 0 for every client not listed.
+  std::vector<std::uint64_t> join_ms;
+  /// A kill of client c at kill_ms: its client and game are destroyed and it falls silent; at
+  /// restart_ms a new client and game (at frame 0) connect from the same network node.
+  struct Restart {
+    std::uint32_t client = 0;
+    std::uint64_t kill_ms = 0;
+    std::uint64_t restart_ms = 0;
+  };
+  std::vector<Restart> restarts;
+  /// Client c's input for frame f (input_size bytes); default: changes every 8 frames.
+  std::function<void(std::uint32_t client, std::uint64_t frame, std::span<std::uint8_t> out)> input;
+  /// Called with the network before the match (per-link conditions, outages).
+  std::function<void(net::SimNetwork&)> setup;
+  /// Wraps client c's transport (forged-packet tests); nullptr keeps the endpoint.
+  std::function<std::unique_ptr<net::Transport>(std::uint32_t client, net::Transport& inner)> wrap;
+  std::function<void(net::ServerConfig&)> configure_server;
+  std::function<void(std::uint32_t client, net::ClientConfig&)> configure_client;
+  std::uint64_t max_ms = 0;  ///< 0: frames * 17 * 4 + 10000
+};
+
+/// Node 0 is the server, node c + 1 client c.
+class ServerMatch {
+ public:
+  explicit ServerMatch(const ServerMatchOptions& options);
+  ~ServerMatch();
+
+  /// Ticks until the server settled and every live client ended (or max_ms); true if so.
+  bool run();
+
+  net::Server& server() { return *server_; }
+  CounterGame& server_game() { return server_game_; }
+  net::SimNetwork& network() { return network_; }
+  /// Client c's current client and game (after a restart: the new ones); nullptr while killed.
+  net::Client* client(std::uint32_t c) { return clients_[c].client.get(); }
+  CounterGame* game(std::uint32_t c) { return clients_[c].game.get(); }
+  /// The frames the server simulated: each one's inputs and hash, in order.
+  const std::vector<std::uint64_t>& server_hashes() const { return hashes_; }
+  std::uint64_t now_ms() const { return now_ms_; }
+
+ private:
+  struct Seat {
+    std::unique_ptr<CounterGame> game;
+    std::unique_ptr<net::Transport> wrapped;
+    std::unique_ptr<net::Client> client;
+    std::uint64_t next_frame_us = 0;
+    std::uint64_t ticks = 0;
+    bool killed = false;
+  };
+  void connect(std::uint32_t c);
+  void tick_client(std::uint32_t c);
+
+  ServerMatchOptions options_;
+  net::SimNetwork network_;
+  CounterGame server_game_;
+  std::unique_ptr<net::Server> server_;
+  std::vector<Seat> clients_;
+  std::vector<std::uint64_t> hashes_;
+  std::uint64_t now_ms_ = 0;
+};
+
+}  // namespace detsim::test
