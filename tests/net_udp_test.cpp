@@ -287,6 +287,40 @@ TEST(NetUdpTransport, DropsAndCountsDatagramsFromUnknownSenders) {
   EXPECT_EQ(b.stats().received, 1U);
 }
 
+TEST(NetUdpTransport, AServerSocketAdmitsUnknownSendersUpToItsLimit) {
+  UdpOptions options;
+  options.admit_unknown_senders = 2;
+  OPEN_LOOPBACK(server, IpFamily::v4, options);
+  OPEN_LOOPBACK(c1, IpFamily::v4);
+  OPEN_LOOPBACK(c2, IpFamily::v4);
+  OPEN_LOOPBACK(c3, IpFamily::v4);
+  for (UdpTransport* c : {&c1, &c2, &c3})
+    ASSERT_TRUE(c->add_peer({0, server.local_endpoint()}).ok());
+  c1.send(0, bytes_of("one"));
+  ASSERT_EQ(receive_count(server, 1).size(), 1U);
+  c2.send(0, bytes_of("two"));
+  const std::vector<Datagram> second = receive_count(server, 1);
+  ASSERT_EQ(second.size(), 1U);
+  // Registered in arrival order, from first_admitted_peer up, and answerable.
+  EXPECT_EQ(second[0].from, first_admitted_peer + 1);
+  ASSERT_EQ(server.peers().size(), 2U);
+  EXPECT_EQ(server.peers()[0].endpoint, c1.local_endpoint());
+  server.send(first_admitted_peer, bytes_of("hello one"));
+  const std::vector<Datagram> answer = receive_count(c1, 1);
+  ASSERT_EQ(answer.size(), 1U);
+  EXPECT_EQ(answer[0].bytes, bytes_of("hello one"));
+  // The limit is reached: a third stranger is dropped, until the program frees a peer.
+  c3.send(0, bytes_of("three"));
+  ASSERT_TRUE(poll_stats(server, [](const UdpStats& s) { return s.dropped_unknown_sender >= 1; }));
+  EXPECT_EQ(server.admitted_peers(), 2U);
+  EXPECT_TRUE(server.remove_peer(first_admitted_peer));
+  c3.send(0, bytes_of("three again"));
+  const std::vector<Datagram> third = receive_count(server, 1);
+  ASSERT_EQ(third.size(), 1U);
+  EXPECT_EQ(third[0].from, first_admitted_peer + 2);
+  EXPECT_EQ(server.stats().admitted_senders, 3U);
+}
+
 TEST(NetUdpTransport, DropsAndCountsOversizeDatagrams) {
   OPEN_LOOPBACK(b, IpFamily::v4);
   const RawSocket raw;

@@ -334,6 +334,7 @@ UdpTransport::UdpTransport(UdpTransport&& other) noexcept
       peers_by_id_(std::move(other.peers_by_id_)),
       peers_by_endpoint_(std::move(other.peers_by_endpoint_)),
       buffer_(std::move(other.buffer_)),
+      next_admitted_(other.next_admitted_),
       stats_(other.stats_),
       last_error_(std::move(other.last_error_)) {}
 
@@ -346,6 +347,7 @@ UdpTransport& UdpTransport::operator=(UdpTransport&& other) noexcept {
     peers_by_id_ = std::move(other.peers_by_id_);
     peers_by_endpoint_ = std::move(other.peers_by_endpoint_);
     buffer_ = std::move(other.buffer_);
+    next_admitted_ = other.next_admitted_;
     stats_ = other.stats_;
     last_error_ = std::move(other.last_error_);
   }
@@ -481,6 +483,12 @@ Status UdpTransport::add_peer(const UdpPeer& given) {
   return Status::success();
 }
 
+std::size_t UdpTransport::admitted_peers() const noexcept {
+  const auto first = std::lower_bound(peers_by_id_.begin(), peers_by_id_.end(), first_admitted_peer,
+                                      [](const UdpPeer& p, PeerId key) { return p.id < key; });
+  return static_cast<std::size_t>(peers_by_id_.end() - first);
+}
+
 bool UdpTransport::remove_peer(PeerId id) {
   const UdpPeer* peer = find_peer(id);
   if (peer == nullptr) return false;
@@ -554,8 +562,14 @@ void UdpTransport::receive(std::vector<Datagram>& out) {
       return;  // anything else may repeat on every call: stop here, try again next call
     }
     Endpoint sender;
-    const UdpPeer* peer =
-        udp_impl::from_sockaddr(from, from_length, sender) ? find_peer(sender) : nullptr;
+    const bool parsed = udp_impl::from_sockaddr(from, from_length, sender);
+    const UdpPeer* peer = parsed ? find_peer(sender) : nullptr;
+    if (peer == nullptr && parsed && admitted_peers() < options_.admit_unknown_senders &&
+        next_admitted_ != 0 && add_peer({next_admitted_, sender}).ok()) {
+      ++next_admitted_;  // 0 after the last id: no more admissions, ever
+      ++stats_.admitted_senders;
+      peer = find_peer(sender);
+    }
     if (peer == nullptr) {
       ++stats_.dropped_unknown_sender;
       continue;

@@ -115,6 +115,7 @@ struct UdpStats {
   std::uint64_t received = 0;     ///< datagrams delivered by receive()
   std::uint64_t received_bytes = 0;
   std::uint64_t dropped_unknown_sender = 0;  ///< from an address and port that is no peer
+  std::uint64_t admitted_senders = 0;        ///< unknown senders registered (admit_unknown_senders)
   std::uint64_t dropped_oversize = 0;        ///< longer than max_datagram
   std::uint64_t receive_errors = 0;          ///< recvfrom failed with anything but "no more data"
 
@@ -128,7 +129,17 @@ struct UdpOptions {
   std::size_t max_datagrams_per_receive = 1024;
   /// SO_RCVBUF and SO_SNDBUF in bytes; 0 keeps the OS default. The OS may round or cap it.
   std::uint32_t socket_buffer_bytes = 0;
+  /// A server's socket: a datagram from an unknown sender registers it as a new peer (PeerIds
+  /// from first_admitted_peer up, in arrival order), until this many are registered that way;
+  /// beyond that, unknown senders are dropped as usual. 0: none (every peer is registered by
+  /// the program). The program frees the ones it is done with (remove_peer): a game server the
+  /// peers that are not, or no longer, its clients.
+  std::uint32_t admit_unknown_senders = 0;
 };
+
+/// The first PeerId an admitting transport gives an unknown sender (UdpOptions): far above the
+/// small ids programs choose for the peers they register themselves.
+inline constexpr PeerId first_admitted_peer = 0x8000'0000U;
 
 class UdpTransport final : public Transport {
  public:
@@ -164,6 +175,9 @@ class UdpTransport final : public Transport {
   Status add_peer(const UdpPeer& peer);
   /// Forgets a peer; its later datagrams are dropped as unknown. False if `id` was not known.
   bool remove_peer(PeerId id);
+  /// How many registered peers have PeerIds at or above first_admitted_peer: those the transport
+  /// registered itself (UdpOptions::admit_unknown_senders) and still holds.
+  [[nodiscard]] std::size_t admitted_peers() const noexcept;
   /// The registered peers, ascending by PeerId.
   [[nodiscard]] const std::vector<UdpPeer>& peers() const noexcept { return peers_by_id_; }
 
@@ -188,6 +202,7 @@ class UdpTransport final : public Transport {
   std::vector<UdpPeer> peers_by_id_;        // ascending PeerId: lookup for send()
   std::vector<UdpPeer> peers_by_endpoint_;  // ascending Endpoint: lookup for receive()
   std::vector<std::uint8_t> buffer_;        // max_datagram + 1 bytes: a longer read is oversize
+  PeerId next_admitted_ = first_admitted_peer;
   UdpStats stats_;
   std::string last_error_;
 };
