@@ -76,6 +76,12 @@ void ScenarioRecorder::attach(SpectatorSession& spectator,
   spectator.set_confirmed_listener([impl](const ConfirmedFrame& f) { impl->record(f); });
 }
 
+void ScenarioRecorder::attach(Server& server, std::function<void(const ConfirmedFrame&)> listener) {
+  impl_->listener = std::move(listener);
+  Impl* impl = impl_.get();
+  server.set_confirmed_listener([impl](const ConfirmedFrame& f) { impl->record(f); });
+}
+
 std::uint64_t ScenarioRecorder::frames() const noexcept {
   return impl_->writer.frames();
 }

@@ -626,6 +626,7 @@ void Netplay::print_text_report(double handshake_seconds, double match_seconds) 
 }  // namespace
 
 int netplay_command(const NetplayArgs& args) {
+  if (!args.server.empty()) return server_client_command(args);
   if (args.frames == 0 || args.frames > 100'000'000)
     return usage_error(netplay_name,
                        "--frames must be 1 .. 100000000, got " + std::to_string(args.frames));

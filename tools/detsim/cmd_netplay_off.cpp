@@ -11,4 +11,9 @@ int netplay_command(const NetplayArgs& /*args*/) {
   return 2;
 }
 
+int serve_command(const ServeArgs& /*args*/) {
+  std::fputs("detsim serve: built without UDP (DETSIM_WITH_UDP=OFF)\n", stderr);
+  return 2;
+}
+
 }  // namespace detsim::cli

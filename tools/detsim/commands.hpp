@@ -129,7 +129,31 @@ struct NetplayArgs {
   std::string partition = "end";  ///< --partition: end, pause or play-on
   bool rejoin = false;            ///< --rejoin/--join: take this player's seat (again)
   bool open_seat = false;         ///< --open-seat: start without the other player
+  /// --server IP:PORT: play against a game server (detsim serve) instead of peers; --me, when
+  /// given, is the seat to ask for.
+  std::string server;
+  bool seat_given = false;
 };
 int netplay_command(const NetplayArgs& args);
+/// `detsim netplay --server`: one client of a server (cmd_serve.cpp).
+int server_client_command(const NetplayArgs& args);
+
+/// `detsim serve`: a server-authoritative match over UDP (net::Server; docs/SERVER.md).
+struct ServeArgs {
+  std::string bind;  ///< IP:PORT
+  std::string scenario = "arena";
+  std::uint32_t players = 2;  ///< seats
+  std::uint32_t count = 0;    ///< the scenario's size (0: its default)
+  std::uint64_t frames = 3600;
+  std::uint64_t seed = 1;
+  std::string authority = "inputs";  ///< or "state"
+  double snapshot_rate = 20;         ///< the server's word per second: updates, or snapshots
+  std::uint32_t fps = 60;
+  std::uint32_t wait_for = 0;  ///< clients before the match starts (main.cpp: default players)
+  double timeout_seconds = 30;
+  std::string record;
+  bool json = false;
+};
+int serve_command(const ServeArgs& args);
 
 }  // namespace detsim::cli

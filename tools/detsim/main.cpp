@@ -215,12 +215,96 @@ void add_netplay(CLI::App& app, int& exit_code) {
   c->add_flag("--json", netplay.json,
               "Print one JSON object: frames, final_hash (16 hex digits), rollbacks, "
               "resimulated_frames, desyncs, peers, spectator, ...");
+  c->add_option("--server", netplay.server,
+                "Play against a game server (detsim serve) at IP:PORT instead of peers: it names "
+                "the scenario, seed, players and frames; --me asks for a seat")
+      ->type_name("IP:PORT");
   c->footer(std::string(netplay_footer) + inject_footer);
   c->callback([&exit_code, bot, me] {
     netplay.bot = bot->count() > 0;
     netplay.me_given = me->count() > 0;
+    netplay.seat_given = netplay.me_given;
     exit_code = detsim::cli::netplay_command(netplay);
   });
+}
+#endif
+
+constexpr const char* serve_footer = R"(
+The server owns the match: clients (detsim netplay --server IP:PORT --bind IP:PORT) connect,
+take a seat, and learn the scenario, seed, players and frames from it. It simulates on its own
+clock and never waits for a client: an input that arrives late goes to the next frame not yet
+simulated, a missing one repeats the player's last. Each client predicts and reconciles exactly:
+a right prediction costs nothing, a wrong one is re-simulated (--authority inputs: the server
+sends every player's inputs and a hash of its state) or replaced by the server's state
+(--authority state: delta-coded, zstd-compressed snapshots, checked against their hash). A client
+may join at any time, or come back after its process was killed: it gets a snapshot of now, and
+nobody waits. With --record the server writes an ordinary replay (detsim verify checks it).
+Packets are not encrypted: the server takes a client's inputs only from the address and token it
+admitted, for that client's seat, within a window of frames; anything else is counted and
+dropped. docs/SERVER.md explains when to pick a server over rollback or lockstep.
+
+Exit status: 0 the match ran to its end; 2 bad usage, a port in use, or no match (fewer than
+--wait-for clients within --timeout). --json prints exactly one JSON object on stdout: frames,
+final_hash, clients (player, bytes_sent, bytes_received, inputs_late, packets_rejected, ...),
+bytes_sent_per_client_per_second.)";
+
+#if DETSIM_WITH_UDP
+void add_serve(CLI::App& app, int& exit_code) {
+  static detsim::cli::ServeArgs serve;
+  auto* c = app.add_subcommand(
+      "serve",
+      "Run a server-authoritative match of a scenario over UDP for detsim netplay "
+      "--server clients");
+  c->add_option("--bind", serve.bind,
+                "Local UDP address and port to serve on, numeric: 0.0.0.0:7000, 127.0.0.1:7000 "
+                "or [::1]:7000")
+      ->required()
+      ->type_name("IP:PORT");
+  c->add_option("--players", serve.players, "Seats in the match, 1 .. 128 (default 2)")
+      ->type_name("N");
+  c->add_option("--frames", serve.frames, "Frames to play (default 3600: one minute at 60 fps)")
+      ->type_name("F");
+  c->add_option("--scenario", serve.scenario,
+                "The scenario, one that takes players (default arena)")
+      ->type_name("NAME");
+  c->add_option("--count", serve.count, "The scenario's size (default: its own)")->type_name("N");
+  c->add_option("--seed", serve.seed, "Seed of the scenario (default 1)")->type_name("S");
+  c->add_option("--authority", serve.authority,
+                "inputs (clients get every player's inputs and a hash: bandwidth independent of "
+                "the scene) or state (clients get the server's state, delta-coded); default "
+                "inputs")
+      ->type_name("KIND");
+  c->add_option("--snapshot-rate", serve.snapshot_rate,
+                "The server's word to each client per second: updates (inputs), or snapshots "
+                "(state); default 20")
+      ->type_name("HZ");
+  c->add_option("--fps", serve.fps, "Frames per second, 1 .. 1000 (default 60)")->type_name("N");
+  auto* wait = c->add_option("--wait-for", serve.wait_for,
+                             "Clients that must be in before frame 0 (default: every seat); the "
+                             "rest join the match under way")
+                   ->type_name("N");
+  c->add_option("--timeout", serve.timeout_seconds,
+                "Seconds to wait for --wait-for clients, and for the clients' last "
+                "acknowledgements after the last frame (default 30)")
+      ->type_name("SECONDS");
+  c->add_option("--record", serve.record,
+                "Record the match (every frame the server simulates) to a replay file")
+      ->type_name("FILE");
+  c->add_flag("--json", serve.json,
+              "Print one JSON object: frames, final_hash, clients, "
+              "bytes_sent_per_client_per_second, ...");
+  c->footer(serve_footer);
+  c->callback([&exit_code, wait] {
+    if (wait->count() == 0) serve.wait_for = serve.players;
+    exit_code = detsim::cli::serve_command(serve);
+  });
+}
+#else
+void add_serve(CLI::App& app, int& exit_code) {
+  auto* c =
+      app.add_subcommand("serve", "Not in this build: built without UDP (DETSIM_WITH_UDP=OFF)");
+  c->allow_extras();
+  c->callback([&exit_code] { exit_code = detsim::cli::serve_command(detsim::cli::ServeArgs{}); });
 }
 #endif
 
@@ -440,6 +524,7 @@ confirmed hashes ever disagree or the replay does not verify.
   c->callback([&exit_code] { exit_code = cli::demo_command(demo); });
 
   add_netplay(app, exit_code);
+  add_serve(app, exit_code);
 }
 
 }  // namespace

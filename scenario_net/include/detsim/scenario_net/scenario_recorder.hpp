@@ -11,6 +11,7 @@
 #include <string>
 
 #include <detsim/core/status.hpp>
+#include <detsim/net/server.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/spectator.hpp>
 #include <detsim/replay/desync_report.hpp>
@@ -37,6 +38,8 @@ class ScenarioRecorder {
   /// The same for a spectator: it records exactly the file the players record.
   void attach(SpectatorSession& spectator,
               std::function<void(const ConfirmedFrame&)> listener = {});
+  /// The same for a game server (net::Server): every frame it simulates, as it simulates it.
+  void attach(Server& server, std::function<void(const ConfirmedFrame&)> listener = {});
 
   /// Frames recorded so far.
   [[nodiscard]] std::uint64_t frames() const noexcept;

@@ -1,0 +1,575 @@
+// detsim serve, and detsim netplay --server: a server-authoritative match of a scenario over UDP
+// (net::Server, net::Client; docs/SERVER.md).
+//
+// The server binds a socket that admits unknown senders, builds the scenario, and runs the match
+// on its clock: it starts when --wait-for clients are in (default: every seat), simulates frame
+// after frame without waiting for anyone, and stops once the last frame is simulated and every
+// connected client has acknowledged it (or --timeout after the last frame). Clients learn the
+// scenario, seed and players from its welcome: the description "scenario=NAME seed=S players=N
+// count=C", space-separated.
+//
+// A client predicts with the scripted bot's input (--bot) or none, keeps its inputs a couple of
+// frames ahead of the server (Client::recommended_frame_adjust: one frame extra or skipped, one
+// tick in three), and stops once it has simulated the last frame with the server's inputs and
+// compared the server's hash of the last state.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <detsim/core/hash.hpp>
+#include <detsim/core/version.hpp>
+#include <detsim/net/client.hpp>
+#include <detsim/net/server.hpp>
+#include <detsim/net/udp.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
+#include <detsim/scenario_net/scenario_recorder.hpp>
+
+#include "commands.hpp"
+#include "netplay_plan.hpp"
+#include "output.hpp"
+#include "scenario_args.hpp"
+
+namespace detsim::cli {
+
+namespace {
+
+namespace sp = net::server_protocol;
+using Clock = std::chrono::steady_clock;
+
+constexpr std::string_view serve_name = "serve";
+
+/// What a server and its clients must both run: this detsim's built-in scenarios.
+std::uint64_t game_fingerprint() {
+  const std::string text = "detsim serve " + std::string(version);
+  return hash_bytes(std::span<const std::uint8_t>(
+      reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
+struct Description {
+  std::string scenario;
+  std::uint64_t seed = 1;
+  std::uint32_t players = 0;
+  std::uint32_t count = 0;
+};
+
+std::vector<std::uint8_t> describe(const Description& d) {
+  const std::string text = "scenario=" + d.scenario + " seed=" + std::to_string(d.seed) +
+                           " players=" + std::to_string(d.players) +
+                           " count=" + std::to_string(d.count);
+  return {text.begin(), text.end()};
+}
+
+Expected<Description> parse_description(std::span<const std::uint8_t> bytes) {
+  std::istringstream in(std::string(bytes.begin(), bytes.end()));
+  Description d;
+  std::string field;
+  bool named = false;
+  while (in >> field) {
+    const std::size_t eq = field.find('=');
+    if (eq == std::string::npos) return Status::error("the server's description is malformed");
+    const std::string key = field.substr(0, eq);
+    const std::string value = field.substr(eq + 1);
+    try {
+      if (key == "scenario") {
+        d.scenario = value;
+        named = true;
+      } else if (key == "seed") {
+        d.seed = std::stoull(value);
+      } else if (key == "players") {
+        d.players = static_cast<std::uint32_t>(std::stoul(value));
+      } else if (key == "count") {
+        d.count = static_cast<std::uint32_t>(std::stoul(value));
+      }
+    } catch (const std::exception&) {
+      return Status::error("the server's description has a bad " + key);
+    }
+  }
+  if (!named) return Status::error("the server's description names no scenario");
+  return d;
+}
+
+Expected<Scenario> build(const Description& d) {
+  ScenarioParams params;
+  params.seed = d.seed;
+  params.players = d.players;
+  params.count = d.count;
+  return Scenario::create(d.scenario, params);
+}
+
+std::uint64_t micros_since(Clock::time_point start) {
+  return static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - start).count());
+}
+
+// ---- the server --------------------------------------------------------------------------------
+
+class Serve {
+ public:
+  explicit Serve(const ServeArgs& args) : args_(args) {}
+  int run();
+
+ private:
+  Status start();
+  void say(const std::string& line) const {
+    if (!args_.json) std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  }
+  /// Frees transport peers that are no client of the server's (strangers, clients gone): a
+  /// peer that stayed a stranger for two sweeps in a row.
+  void sweep_peers();
+  void handle_events();
+  int report(double match_seconds);
+
+  const ServeArgs& args_;
+  Clock::time_point start_ = Clock::now();
+  std::optional<Scenario> scenario_;
+  std::optional<net::ScenarioGame> game_;
+  std::optional<net::UdpTransport> transport_;
+  std::optional<net::ScenarioRecorder> recorder_;
+  std::optional<net::Server> server_;
+  std::set<net::PeerId> strangers_;
+  std::string failure_;
+};
+
+Status Serve::start() {
+  Description d{args_.scenario, args_.seed, args_.players, args_.count};
+  auto scenario = build(d);
+  if (!scenario) return scenario.status();
+  if (scenario->info().max_players == 0)
+    return Status::error("--scenario " + args_.scenario + " takes no players");
+  scenario_.emplace(std::move(scenario.value()));
+  game_.emplace(*scenario_);
+  auto bind = net::parse_endpoint(args_.bind);
+  if (!bind) return Status::error("--bind " + args_.bind + ": " + bind.message());
+  net::UdpOptions options;
+  options.admit_unknown_senders = 4 * args_.players + 64;
+  auto transport = net::UdpTransport::open(bind.value(), {}, options);
+  if (!transport) return transport.status();
+  transport_.emplace(std::move(transport.value()));
+  if (!args_.record.empty()) {
+    auto recorder = net::ScenarioRecorder::create(args_.record, *game_);
+    if (!recorder) return recorder.status();
+    recorder_.emplace(std::move(recorder.value()));
+  }
+  net::ServerConfig config;
+  config.players = args_.players;
+  config.input_size = game_->input_size();
+  config.game = game_fingerprint();
+  config.description = describe(d);
+  config.authority = args_.authority == "state" ? sp::Authority::state : sp::Authority::inputs;
+  config.frame_us = 1'000'000 / args_.fps;
+  config.frames = static_cast<std::uint32_t>(args_.frames);
+  config.start_clients = args_.wait_for;
+  const auto interval = static_cast<std::uint32_t>(
+      std::clamp(static_cast<double>(args_.fps) / args_.snapshot_rate + 0.5, 1.0, 60.0));
+  config.update_interval = interval;
+  config.snapshot_interval = interval;
+  auto server = net::Server::create(config, *game_, *transport_);
+  if (!server) return server.status();
+  server_.emplace(std::move(server.value()));
+  if (recorder_) recorder_->attach(*server_);
+  return Status::success();
+}
+
+void Serve::sweep_peers() {
+  std::set<net::PeerId> clients;
+  for (const net::ServerClientStats& c : server_->client_stats())
+    if (c.connected) clients.insert(c.peer);
+  std::set<net::PeerId> now;
+  std::vector<net::PeerId> remove;
+  for (const net::UdpPeer& p : transport_->peers()) {
+    if (clients.count(p.id) != 0) continue;
+    if (strangers_.count(p.id) != 0) {
+      remove.push_back(p.id);
+    } else {
+      now.insert(p.id);
+    }
+  }
+  for (const net::PeerId id : remove)
+    transport_->remove_peer(id);
+  strangers_ = std::move(now);
+}
+
+void Serve::handle_events() {
+  for (const net::ServerEvent& e : server_->take_events()) {
+    switch (e.type) {
+      case net::ServerEventType::started:
+        say("the match starts");
+        break;
+      case net::ServerEventType::joined:
+        say("player " + std::to_string(e.player) + " joined at frame " + std::to_string(e.frame));
+        break;
+      case net::ServerEventType::left:
+        say("player " + std::to_string(e.player) + " left at frame " + std::to_string(e.frame) +
+            " (" + std::string(e.reason) + ")");
+        break;
+    }
+  }
+}
+
+int Serve::run() {
+  if (Status s = start(); !s) return usage_error(serve_name, s.message());
+  say(args_.scenario + " (seed " + std::to_string(args_.seed) + ", " +
+      std::to_string(args_.players) + " seats) served on " +
+      transport_->local_endpoint().to_string() + ", authority " + args_.authority + ", " +
+      std::to_string(args_.frames) + " frames at " + std::to_string(args_.fps) +
+      " fps; waiting for " + std::to_string(args_.wait_for) + " clients");
+  const auto timeout_us = static_cast<std::uint64_t>(args_.timeout_seconds * 1e6);
+  std::optional<std::uint64_t> started_at;
+  std::optional<std::uint64_t> ended_at;
+  std::uint64_t next_sweep = 1'000'000;
+  const std::uint64_t frame_us = 1'000'000 / args_.fps;
+  for (;;) {
+    const std::uint64_t now = micros_since(start_);
+    server_->poll(now);
+    server_->advance(now);
+    server_->poll(now);
+    handle_events();
+    if (now >= next_sweep) {
+      sweep_peers();
+      next_sweep = now + 1'000'000;
+    }
+    if (!started_at && server_->current_frame() > 0) started_at = now;
+    if (!started_at && now >= timeout_us) {
+      failure_ = "no match: fewer than " + std::to_string(args_.wait_for) +
+                 " clients came within " + milliseconds(timeout_us);
+      break;
+    }
+    if (server_->ended()) {
+      if (!ended_at) ended_at = now;
+      if (server_->settled()) {
+        // A last round of updates so that every client has the last frame's acknowledgement.
+        const std::uint64_t linger_end = now + netplay_linger_us;
+        while (micros_since(start_) < linger_end) {
+          server_->poll(micros_since(start_));
+          std::this_thread::sleep_for(std::chrono::microseconds(netplay_idle_sleep_us));
+        }
+        break;
+      }
+      if (now - *ended_at >= timeout_us) {
+        std::fprintf(stderr,
+                     "detsim serve: stopped %s after the last frame with clients that had not "
+                     "acknowledged it\n",
+                     milliseconds(timeout_us).c_str());
+        break;
+      }
+    }
+    const std::uint64_t next = started_at ? *started_at + server_->current_frame() * frame_us : 0;
+    const std::uint64_t after = micros_since(start_);
+    std::this_thread::sleep_for(std::chrono::microseconds(
+        next > after ? std::min(next - after, netplay_idle_sleep_us) : netplay_idle_sleep_us));
+  }
+  if (recorder_) {
+    if (Status s = recorder_->finish(); !s && failure_.empty()) failure_ = s.message();
+  }
+  if (!failure_.empty()) return usage_error(serve_name, failure_);
+  const std::uint64_t end = micros_since(start_);
+  return report(static_cast<double>(ended_at.value_or(end) - started_at.value_or(end)) / 1e6);
+}
+
+int Serve::report(double match_seconds) {
+  const std::vector<net::ServerClientStats> clients = server_->client_stats();
+  std::uint64_t sent = 0;
+  std::vector<std::string> rows;
+  for (const net::ServerClientStats& c : clients) {
+    sent += c.bytes_sent;
+    const net::UdpPeer* peer = nullptr;
+    for (const net::UdpPeer& p : transport_->peers())
+      if (p.id == c.peer) peer = &p;
+    rows.push_back(Json()
+                       .num("player", c.player)
+                       .str("address", peer != nullptr ? peer->endpoint.to_string() : "")
+                       .boolean("connected", c.connected)
+                       .num("joined_frame", c.joined_frame)
+                       .num("acknowledged_frame", c.acknowledged_frame)
+                       .num("bytes_sent", c.bytes_sent)
+                       .num("bytes_received", c.bytes_received)
+                       .num("inputs_late", c.inputs_late)
+                       .num("inputs_missing", c.inputs_missing)
+                       .num("packets_rejected", c.packets_rejected)
+                       .num("snapshots_sent", c.snapshots_sent)
+                       .text());
+  }
+  const double per_client =
+      clients.empty() || match_seconds <= 0
+          ? 0.0
+          : static_cast<double>(sent) / static_cast<double>(clients.size()) / match_seconds;
+  const net::ServerStats& st = server_->stats();
+  std::uint64_t malformed = 0;
+  for (const std::uint64_t n : st.dropped_malformed)
+    malformed += n;
+  if (args_.json) {
+    Json j;
+    j.str("scenario", args_.scenario)
+        .num("seed", args_.seed)
+        .num("players", args_.players)
+        .str("authority", args_.authority)
+        .num("frames", server_->current_frame())
+        .hash("final_hash", server_->current_hash())
+        .raw("clients", Json::array(rows))
+        .real("bytes_sent_per_client_per_second", per_client)
+        .num("dropped_malformed", malformed)
+        .num("dropped_unknown", st.dropped_unknown)
+        .real("match_seconds", match_seconds);
+    if (args_.record.empty()) {
+      j.null("record");
+    } else {
+      j.str("record", args_.record);
+    }
+    j.print();
+    return exit_ok;
+  }
+  std::printf("frames       %llu, final hash %s\n",
+              static_cast<unsigned long long>(server_->current_frame()),
+              hex(server_->current_hash()).c_str());
+  for (const net::ServerClientStats& c : clients)
+    std::printf(
+        "player %-4u  %s; %llu bytes sent, %llu received; inputs %llu late, %llu "
+        "missing; %llu packets rejected\n",
+        c.player, c.connected ? "connected" : "gone", static_cast<unsigned long long>(c.bytes_sent),
+        static_cast<unsigned long long>(c.bytes_received),
+        static_cast<unsigned long long>(c.inputs_late),
+        static_cast<unsigned long long>(c.inputs_missing),
+        static_cast<unsigned long long>(c.packets_rejected));
+  std::printf("down         %.0f bytes/s per client; dropped %llu malformed, %llu unknown\n",
+              per_client, static_cast<unsigned long long>(malformed),
+              static_cast<unsigned long long>(st.dropped_unknown));
+  if (!args_.record.empty()) std::printf("replay       %s\n", args_.record.c_str());
+  return exit_ok;
+}
+
+// ---- a client ----------------------------------------------------------------------------------
+
+class ServerClient {
+ public:
+  explicit ServerClient(const NetplayArgs& args) : args_(args) {}
+  int run();
+
+ private:
+  Status begin();
+  /// Builds the scenario the welcome describes and starts the client on it.
+  Status start_game();
+  void say(const std::string& line) const {
+    if (!args_.json) std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  }
+  void advance();
+  int report(double seconds);
+
+  const NetplayArgs& args_;
+  Clock::time_point start_ = Clock::now();
+  std::optional<net::UdpTransport> transport_;
+  std::optional<net::Client> client_;
+  std::optional<Scenario> scenario_;
+  std::optional<net::ScenarioGame> game_;
+  std::vector<net::ClientEvent> desyncs_;
+  std::uint64_t ticks_ = 0;
+  std::string failure_;
+};
+
+Status ServerClient::begin() {
+  auto bind = net::parse_endpoint(args_.bind);
+  if (!bind) return Status::error("--bind " + args_.bind + ": " + bind.message());
+  auto server = net::parse_endpoint(args_.server);
+  if (!server) return Status::error("--server " + args_.server + ": " + server.message());
+  const net::UdpPeer peer{0, server.value()};
+  auto transport = net::UdpTransport::open(bind.value(), std::span<const net::UdpPeer>(&peer, 1));
+  if (!transport) return transport.status();
+  transport_.emplace(std::move(transport.value()));
+  net::ClientConfig config;
+  config.game = game_fingerprint();
+  config.server = 0;
+  if (args_.seat_given) config.seat = static_cast<std::uint8_t>(args_.me);
+  auto client = net::Client::create(config, *transport_);
+  if (!client) return client.status();
+  client_.emplace(std::move(client.value()));
+  return Status::success();
+}
+
+Status ServerClient::start_game() {
+  const sp::Welcome& w = *client_->welcome();
+  auto d = parse_description(w.description);
+  if (!d) return d.status();
+  auto scenario = build(d.value());
+  if (!scenario)
+    return Status::error("the server's scenario does not build here: " + scenario.message());
+  scenario_.emplace(std::move(scenario.value()));
+  game_.emplace(*scenario_);
+  if (game_->input_size() != w.input_size)
+    return Status::error("the server's inputs are " + std::to_string(w.input_size) +
+                         " bytes, this scenario's " + std::to_string(game_->input_size()));
+  auto injections = parse_injections(args_.injections);
+  if (!injections) return injections.status();
+  if (!injections->empty()) {
+    game_->set_after_step([list = std::move(injections).value()](Scenario& s) {
+      return apply_injections(s.world(), list);
+    });
+  }
+  if (Status s = client_->start(*game_); !s) return s;
+  say(d->scenario + " (seed " + std::to_string(d->seed) + ", " + std::to_string(d->players) +
+      " players): player " + std::to_string(w.player) + " of the server at " + args_.server +
+      (w.start_frame > 0 ? ", joining at frame " + std::to_string(w.start_frame) : ""));
+  return Status::success();
+}
+
+void ServerClient::advance() {
+  ++ticks_;
+  const sp::Welcome& w = *client_->welcome();
+  const std::int32_t adjust = client_->recommended_frame_adjust();
+  int runs = 1;
+  if (ticks_ % 3 == 0 && adjust > 0) runs = adjust > 4 ? 3 : 2;
+  if (ticks_ % 3 == 0 && adjust < 0) runs = 0;
+  std::vector<std::uint8_t> input(w.input_size);
+  for (int r = 0; r < runs; ++r) {
+    std::fill(input.begin(), input.end(), std::uint8_t{0});
+    if (args_.bot) scenario_->scripted(args_.bot_seed, client_->current_frame(), w.player, input);
+    if (!client_->advance_frame(input).ok()) return;
+  }
+}
+
+int ServerClient::run() {
+  if (Status s = begin(); !s) return usage_error(netplay_name, s.message());
+  say("connecting to " + args_.server + " from " + transport_->local_endpoint().to_string());
+  const auto timeout_us = static_cast<std::uint64_t>(args_.timeout_seconds * 1e6);
+  std::optional<std::uint64_t> running_at;
+  std::optional<std::uint64_t> ended_at;
+  std::uint64_t next_tick = 0;
+  for (;;) {
+    const std::uint64_t now = micros_since(start_);
+    client_->poll(now);
+    for (const net::ClientEvent& e : client_->take_events()) {
+      if (e.type == net::ClientEventType::desync) {
+        desyncs_.push_back(e);
+        say("DESYNC at frame " + std::to_string(e.frame) + ": this machine " + hex(e.local_hash) +
+            ", the server " + hex(e.remote_hash));
+      } else if (e.type == net::ClientEventType::running) {
+        say("running from frame " + std::to_string(e.frame));
+      }
+    }
+    if (!client_->failure().empty()) {
+      failure_ = std::string(client_->failure());
+      break;
+    }
+    if (client_->welcome() != nullptr && !client_->started()) {
+      if (Status s = start_game(); !s) {
+        failure_ = s.message();
+        break;
+      }
+    }
+    if (!client_->running()) {
+      if (now >= timeout_us) {
+        failure_ = client_->welcome() == nullptr
+                       ? "no answer from the server at " + args_.server + " within " +
+                             milliseconds(timeout_us)
+                       : "no state from the server within " + milliseconds(timeout_us);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(netplay_idle_sleep_us));
+      continue;
+    }
+    if (!running_at) running_at = next_tick = now;
+    if (client_->ended()) {
+      if (!ended_at) ended_at = now;
+      if (now - *ended_at >= netplay_linger_us) break;  // the server has our last acknowledgement
+    }
+    const std::uint64_t period = client_->welcome()->frame_us;
+    if (now >= next_tick) {
+      next_tick = now - next_tick > 4 * period ? now + period : next_tick + period;
+      advance();
+    } else {
+      std::this_thread::sleep_for(
+          std::chrono::microseconds(std::min(next_tick - now, netplay_idle_sleep_us)));
+    }
+  }
+  if (!failure_.empty()) return usage_error(netplay_name, failure_);
+  const std::uint64_t end = micros_since(start_);
+  return report(static_cast<double>(ended_at.value_or(end) - running_at.value_or(end)) / 1e6);
+}
+
+int ServerClient::report(double seconds) {
+  const net::ClientStats& s = client_->stats();
+  const int code = desyncs_.empty() && s.desyncs == 0 ? exit_ok : exit_check_failed;
+  const double per_second = seconds > 0 ? static_cast<double>(s.bytes_received) / seconds : 0.0;
+  if (args_.json) {
+    Json()
+        .str("server", args_.server)
+        .num("player", client_->welcome()->player)
+        .num("frames", client_->current_frame())
+        .hash("final_hash", client_->server_hash())
+        .num("mispredictions", s.mispredictions)
+        .num("corrections", s.corrections)
+        .num("resimulated_frames", s.resimulated_frames)
+        .num("desyncs", s.desyncs)
+        .num("checks_passed", s.checks_passed)
+        .num("snapshots_received", s.snapshots_received)
+        .num("bytes_received", s.bytes_received)
+        .real("bytes_received_per_second", per_second)
+        .num("bytes_sent", s.bytes_sent)
+        .num("rtt_ms", s.rtt_ms)
+        .real("match_seconds", seconds)
+        .print();
+    return code;
+  }
+  std::printf("frames       %llu, final hash %s\n",
+              static_cast<unsigned long long>(client_->current_frame()),
+              hex(client_->server_hash()).c_str());
+  std::printf("predictions  %llu frames mispredicted, %llu corrections, %llu re-simulated\n",
+              static_cast<unsigned long long>(s.mispredictions),
+              static_cast<unsigned long long>(s.corrections),
+              static_cast<unsigned long long>(s.resimulated_frames));
+  std::printf("desyncs      %llu (%llu server hashes matched)\n",
+              static_cast<unsigned long long>(s.desyncs),
+              static_cast<unsigned long long>(s.checks_passed));
+  std::printf("down         %.0f bytes/s; round trip %llu ms\n", per_second,
+              static_cast<unsigned long long>(s.rtt_ms));
+  return code;
+}
+
+}  // namespace
+
+int serve_command(const ServeArgs& args) {
+  if (args.frames == 0 || args.frames > 100'000'000)
+    return usage_error(serve_name,
+                       "--frames must be 1 .. 100000000, got " + std::to_string(args.frames));
+  if (args.players < 1 || args.players > sp::max_players)
+    return usage_error(serve_name, "--players must be 1 .. " + std::to_string(sp::max_players) +
+                                       ", got " + std::to_string(args.players));
+  if (args.wait_for > args.players)
+    return usage_error(
+        serve_name, "--wait-for must be at most --players (" + std::to_string(args.players) + ")");
+  if (args.authority != "inputs" && args.authority != "state")
+    return usage_error(serve_name,
+                       "--authority must be inputs or state, got '" + args.authority + "'");
+  if (args.fps < 1 || args.fps > 1000)
+    return usage_error(serve_name, "--fps must be 1 .. 1000, got " + std::to_string(args.fps));
+  if (!(args.snapshot_rate > 0 && args.snapshot_rate <= static_cast<double>(args.fps)))
+    return usage_error(serve_name, "--snapshot-rate must be above 0 and at most --fps");
+  if (!(args.timeout_seconds > 0 && args.timeout_seconds <= 86'400))
+    return usage_error(serve_name, "--timeout must be more than 0 and at most 86400 seconds");
+  Serve serve(args);
+  return serve.run();
+}
+
+int server_client_command(const NetplayArgs& args) {
+  if (!args.peers.empty() || args.spectate || !args.spectators.empty() || args.rejoin ||
+      args.open_seat || !args.key.empty() || !args.key_file.empty())
+    return usage_error(netplay_name,
+                       "--server plays against a server: --peer, --spectate, --spectator, "
+                       "--rejoin, --open-seat and --key are for peer-to-peer matches");
+  if (!args.record.empty())
+    return usage_error(netplay_name,
+                       "--record with --server: the server records the match (detsim serve "
+                       "--record)");
+  if (!(args.timeout_seconds > 0 && args.timeout_seconds <= 86'400))
+    return usage_error(netplay_name, "--timeout must be more than 0 and at most 86400 seconds");
+  ServerClient client(args);
+  return client.run();
+}
+
+}  // namespace detsim::cli
