@@ -23,11 +23,11 @@ bool contains(const std::string& text, const std::string& part) {
 TEST(ScenarioRegistry, ListsEveryScenarioOnceSortedByName) {
   const auto list = scenario_list();
   const std::vector<std::string> expected{
-      "arena",     "bounce",   "bridge",        "bullet_wall",  "chain",        "characters",
-      "dam_break", "dominoes", "drape",         "flag",         "furniture",    "jelly",
-      "level",     "motors",   "pendulum",      "pile_boxes",   "pile_spheres", "pyramid",
-      "ragdolls",  "rocks",    "rope_bridge",   "slope",        "soccar",       "spray",
-      "stack",     "vehicles", "wrecking_ball", "wrecking_rope"};
+      "arena",   "bounce",    "bridge",   "bullet_wall",   "chain",        "characters",
+      "cubes",   "dam_break", "dominoes", "drape",         "flag",         "furniture",
+      "jelly",   "level",     "motors",   "pendulum",      "pile_boxes",   "pile_spheres",
+      "pyramid", "ragdolls",  "rocks",    "rope_bridge",   "slope",        "soccar",
+      "spray",   "stack",     "vehicles", "wrecking_ball", "wrecking_rope"};
   ASSERT_EQ(list.size(), expected.size());
   for (std::size_t i = 0; i < list.size(); ++i) {
     EXPECT_EQ(std::string(list[i].name), expected[i]);

@@ -70,6 +70,13 @@ constexpr std::array entries{
            600, 0, 0, 0, 8, 100, true, "characters"},
           scenes_detail::build_characters,
           scenes_detail::control_characters},
+    Entry{{"cubes",
+           "N small cubes (default 900, a 30 x 30 grid) resting on a plane, asleep until one of "
+           "the 1-8 players' large cubes (stick: roll and push; jump) reaches them",
+           600, 1, 8, 1, scenes_detail::cubes::default_count, scenes_detail::cubes::max_count, true,
+           "small cubes"},
+          scenes_detail::build_cubes,
+          scenes_detail::control_cubes},
     Entry{{"dam_break",
            "a block of water N particles wide, 2N high and 2N deep (default 10: 4000 particles) "
            "released at one end of a tank with an obstacle",

@@ -52,6 +52,8 @@ void build_vehicles(World& w, const ScenarioParams& p);
 VehicleId add_car(World& w, Vec3 position, Quat heading, std::uint64_t tag);
 // Car soccer (scenario_soccar.cpp): the players' cars, a ball, two goals.
 void build_soccar(World& w, const ScenarioParams& p);
+// Gaffer On Games' cubes (scenario_cubes.cpp): a grid of small cubes and a large cube per player.
+void build_cubes(World& w, const ScenarioParams& p);
 
 // Per-frame logic, run before each step. Reads only the World and the inputs.
 void control_spray(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
@@ -61,6 +63,7 @@ void control_flag(World& w, std::span<const PlayerInput> inputs, const ScenarioP
 void control_characters(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_vehicles(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 void control_soccar(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
+void control_cubes(World& w, std::span<const PlayerInput> inputs, const ScenarioParams& p);
 
 // Tags in BodyDef::user_data by which game logic finds its bodies again (the World is the whole
 // scenario state, so nothing else may remember them). A player's tag is player_tag + index.
@@ -240,6 +243,34 @@ inline constexpr std::uint64_t goal_tag = 0x474F'414C'0000'0000ULL;   // "GOAL"
 inline constexpr std::uint64_t goal_plus = 0x0000'0001'0000'0000ULL;  ///< the goal at +z
 inline constexpr std::uint64_t goal_count_mask = 0xFFFF'FFFFULL;      ///< goals let in
 }  // namespace soccar
+
+namespace cubes {
+inline constexpr std::uint32_t default_count = 900;  ///< small cubes: a 30 x 30 grid
+inline constexpr std::uint32_t max_count = 10000;    ///< a 100 x 100 grid
+inline constexpr Fixed small_half = 0.25_fx;         ///< the small cubes' half side
+inline constexpr Fixed small_mass = 1_fx;
+inline constexpr Fixed spacing = 1_fx;     ///< centre to centre: a 0.5 m gap between resting cubes
+inline constexpr Fixed large_half = 1_fx;  ///< the large (player) cubes' half side
+inline constexpr Fixed large_mass = 100_fx;
+/// 1/s: under the full stick (below) a large cube tumbles along at about 5 m/s, and a tumble
+/// dies out once the stick is let go.
+inline constexpr Fixed large_linear_damping = 1_fx;
+inline constexpr Fixed large_angular_damping = 2_fx;
+inline constexpr Fixed friction = 0.5_fx;  ///< every body's, the plane's too
+inline constexpr Fixed start_gap = 2_fx;   ///< at least, between the grid and a large cube's face
+/// The stick at full: a force of drive_acceleration * mass along it at the centre, and a torque of
+/// roll_torque * mass about up x stick. Neither alone tips a large cube over its leading edge (that
+/// takes g * large_half = 9.81 N m per kg); together (6 + 6 * large_half) they do: it rolls.
+inline constexpr Fixed drive_acceleration = 6_fx;  ///< m/s^2
+inline constexpr Fixed roll_torque = 6_fx;         ///< N m per kg
+inline constexpr Fixed jump_speed = 6_fx;          ///< m/s: the jump's impulse per kg
+/// A large cube may jump while its centre is below this (m; 1 on a face, sqrt 3 on a corner, 1.5
+/// on a small cube) and it moves up or down slower than 1 m/s.
+inline constexpr Fixed jump_height = 2_fx;
+inline constexpr std::uint64_t small_tag = 0x4355'4245'0000'0000ULL;  // "CUBE"
+/// Half the side of the square the small cubes' centres fill, for `count` small cubes.
+Fixed grid_half(std::uint32_t count);
+}  // namespace cubes
 
 namespace characters {
 inline constexpr Fixed yard = 12_fx;  ///< the walls' inner faces are at +-yard in x and z

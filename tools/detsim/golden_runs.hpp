@@ -26,6 +26,7 @@ inline constexpr GoldenRun runs[] = {
     {"bullet_wall", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"chain", {.seed = 1, .players = 0, .count = 30}, 1200},
     {"characters", {.seed = 1, .players = 0, .count = 8}, 1000},
+    {"cubes", {.seed = 1, .players = 2, .count = 100}, 1000},
     {"dam_break", {.seed = 1, .players = 0, .count = 3}, 1000},
     {"dominoes", {.seed = 1, .players = 0, .count = 0}, 1000},
     {"drape", {.seed = 1, .players = 0, .count = 12}, 1000},
