@@ -273,9 +273,11 @@ TEST(NetServer, StateAuthorityReconstructsTheServersStateThroughLoss) {
   o.frames = 600;
   o.seed = 3;
   o.authority = sp::Authority::state;
-  o.snapshot_interval = 6;
-  o.link.latency_us = 30'000;
+  o.snapshot_interval = 2;
+  o.link.latency_us = 20'000;
+  o.link.jitter_us = 5'000;
   o.link.loss_ppm = 50'000;
+  o.link.duplicate_ppm = 20'000;
   ServerMatch m(o);
   ASSERT_TRUE(m.run());
   expect_all_agree(m, 3);

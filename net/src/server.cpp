@@ -375,10 +375,10 @@ struct Server::Impl {
       c.snapshot.pending = false;
       c.ack = std::max<std::uint64_t>(c.ack, c.snapshot.frame);
     }
-    if (in.snapshot_ack > c.snapshot_ack && in.snapshot_ack <= frame + 1) {
+    // The newest snapshot it holds: its next one's base. Units go on from its own ack: a client
+    // predicts with them, whatever state it holds.
+    if (in.snapshot_ack > c.snapshot_ack && in.snapshot_ack <= frame + 1)
       c.snapshot_ack = in.snapshot_ack;
-      c.ack = std::max<std::uint64_t>(c.ack, in.snapshot_ack - 1U);
-    }
     take_inputs(c, in);
   }
 

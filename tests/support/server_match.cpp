@@ -106,9 +106,14 @@ bool ServerMatch::run() {
       const std::uint64_t join = c < options_.join_ms.size() ? options_.join_ms[c] : 0;
       if (now_ms_ == join && !clients_[c].client && !clients_[c].killed) connect(c);
     }
-    server_->poll(now_us);
-    server_->advance(now_us);
-    server_->poll(now_us);
+    // A server that settled lingers half a second, then stops, as `detsim serve` does: a client
+    // that still needed something from it never ends.
+    if (!settled_at_ms_ && server_->settled()) settled_at_ms_ = now_ms_;
+    if (!settled_at_ms_ || now_ms_ < *settled_at_ms_ + 500) {
+      server_->poll(now_us);
+      server_->advance(now_us);
+      server_->poll(now_us);
+    }
     bool all_ended = server_->settled();
     for (std::uint32_t c = 0; c < options_.clients; ++c) {
       if (!clients_[c].client) {

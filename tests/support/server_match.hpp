@@ -88,6 +88,7 @@ class ServerMatch {
   std::vector<Seat> clients_;
   std::vector<std::uint64_t> hashes_;
   std::uint64_t now_ms_ = 0;
+  std::optional<std::uint64_t> settled_at_ms_;
 };
 
 }  // namespace detsim::test

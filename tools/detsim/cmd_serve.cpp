@@ -454,6 +454,11 @@ int ServerClient::run() {
     }
     if (!client_->failure().empty()) {
       failure_ = std::string(client_->failure());
+      if (client_->started())
+        failure_ += " (at frame " + std::to_string(client_->current_frame()) +
+                    "; the server's inputs held up to frame " +
+                    std::to_string(client_->authoritative_frame()) + ", its hashes checked up to " +
+                    std::to_string(client_->checked_frame()) + ")";
       break;
     }
     if (client_->welcome() != nullptr && !client_->started()) {
