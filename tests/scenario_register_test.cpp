@@ -332,8 +332,8 @@ TEST(ScenarioRegister, BadDefinitionsAreRefusedNamingTheProblem) {
   refused(d, "build is empty");
   d = tally();
   d.name = "tally2";
-  d.max_players = 9;
-  refused(d, "at most 8 players");
+  d.max_players = 65;
+  refused(d, "at most 64 players");
   d = tally();
   d.name = "tally2";
   d.default_players = 5;

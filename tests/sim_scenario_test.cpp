@@ -52,9 +52,9 @@ TEST(ScenarioRegistry, BadNamesAndParametersAreErrorsThatSayWhatIsAllowed) {
   EXPECT_TRUE(contains(bad.message(), "unknown scenario 'pyramids'")) << bad.message();
   EXPECT_TRUE(contains(bad.message(), "pyramid,")) << bad.message();  // the known names
 
-  bad = Scenario::create("arena", {.players = 9});
+  bad = Scenario::create("arena", {.players = 65});
   ASSERT_FALSE(bad.ok());
-  EXPECT_TRUE(contains(bad.message(), "2 to 8 players, got 9")) << bad.message();
+  EXPECT_TRUE(contains(bad.message(), "2 to 64 players, got 65")) << bad.message();
   bad = Scenario::create("arena", {.players = 1});
   EXPECT_FALSE(bad.ok());
   bad = Scenario::create("stack", {.players = 2});

@@ -32,8 +32,8 @@ struct SyncTestSession::Impl {
 
 Expected<SyncTestSession> SyncTestSession::create(const SyncTestConfig& c, Game& game) {
   const auto bad = [](const std::string& what) { return Status::error("synctest: " + what); };
-  if (c.players < 1 || c.players > 8)
-    return bad("players must be 1 .. 8, got " + std::to_string(c.players));
+  if (c.players < 1 || c.players > 128)
+    return bad("players must be 1 .. 128, got " + std::to_string(c.players));
   if (c.input_size < 1 || c.input_size > 64)
     return bad("input_size must be 1 .. 64 bytes, got " + std::to_string(c.input_size));
   if (c.check_distance < 1 || c.check_distance > 600)

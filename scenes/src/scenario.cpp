@@ -37,9 +37,9 @@ namespace scenes {
 // The built-in scenarios, sorted by name.
 constexpr std::array entries{
     Entry{{"arena",
-           "2-8 player-controlled spheres pushing crates in a walled arena; RNG-driven crate "
+           "2-64 player-controlled spheres pushing crates in a walled arena; RNG-driven crate "
            "spawns and kicks",
-           3600, 2, 8, 2, 0, 0, true},
+           3600, 2, 64, 2, 0, 0, true},
           scenes_detail::build_arena,
           scenes_detail::control_arena},
     Entry{{"bounce", "five spheres dropped from 5 m with restitution 0, 0.25, 0.5, 0.75 and 1", 600,

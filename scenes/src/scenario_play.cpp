@@ -112,6 +112,19 @@ const Vec3 starts[8] = {
     {-Fixed::from_raw(diagonal_raw), 0.5_fx, Fixed::from_raw(diagonal_raw)},
 };
 
+/// Player i's start: the eight above first; then 24 on a ring of radius 11 m and 32 on one of
+/// 13 m (players 8 .. 31 and 32 .. 63), evenly spaced, clear of the crates and the walls (the
+/// floor's half side is 15 m) and at least 2.5 m apart.
+Vec3 arena_start(std::uint32_t i) {
+  if (i < 8) return starts[i];
+  const bool inner = i < 32;
+  const std::int32_t k = static_cast<std::int32_t>(inner ? i - 8 : i - 32);
+  const std::int32_t n = inner ? 24 : 32;
+  const Fixed radius = inner ? 11_fx : 13_fx;
+  const Fixed angle = Fixed::two_pi() * Fixed::from_int(k) / Fixed::from_int(n);
+  return {radius * cos(angle), 0.5_fx, radius * sin(angle)};
+}
+
 }  // namespace
 
 void build_arena(World& w, const ScenarioParams& p) {
@@ -125,7 +138,7 @@ void build_arena(World& w, const ScenarioParams& p) {
   }
   for (std::uint32_t i = 0; i < p.players; ++i) {
     add(w, {.shape = Shape::sphere(0.5_fx),
-            .position = starts[i],
+            .position = arena_start(i),
             .mass = 80_fx,
             .friction = 0.8_fx,
             .linear_damping = 0.5_fx,

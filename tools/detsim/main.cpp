@@ -124,7 +124,7 @@ void add_netplay(CLI::App& app, int& exit_code) {
                 "The scenario to play, one that takes players (default arena; same on all peers)")
       ->type_name("NAME");
   c->add_option("--players", netplay.players,
-                "Players in the match, 2 .. the scenario's most (arena: 8; default 2)")
+                "Players in the match, 2 .. 8 (and at most the scenario's; default 2)")
       ->type_name("N");
   auto* me = c->add_option("--me", netplay.me,
                            "This machine's player index, 0 .. N-1 (default 0; not with --spectate)")

@@ -17,7 +17,7 @@
 namespace detsim::net {
 
 struct SyncTestConfig {
-  std::uint32_t players = 2;         ///< 1 .. 8
+  std::uint32_t players = 2;         ///< 1 .. 128
   std::uint32_t input_size = 4;      ///< 1 .. 64
   std::uint32_t check_distance = 8;  ///< frames rolled back every frame: 1 .. 600
 };

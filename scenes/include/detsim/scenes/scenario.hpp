@@ -61,8 +61,9 @@ struct ScenarioParams {
   friend constexpr bool operator==(const ScenarioParams&, const ScenarioParams&) noexcept = default;
 };
 
-/// The most players a scenario takes (and a session plays).
-inline constexpr std::uint32_t max_scenario_players = 8;
+/// The most players a scenario takes: what a game server's match (net::Server) and a replay
+/// allow. A peer-to-peer session plays at most 8 of them.
+inline constexpr std::uint32_t max_scenario_players = 64;
 /// The largest input a game's own scenario may take, in bytes (what a session datagram carries).
 inline constexpr std::uint32_t max_scenario_input_size = 64;
 
