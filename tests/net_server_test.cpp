@@ -8,6 +8,9 @@
 #include <detsim/net/server_protocol.hpp>
 #include <detsim/net/sim_network.hpp>
 
+#include <detsim/replay/scenario_replay.hpp>
+
+#include "support/replay_files.hpp"
 #include "support/server_match.hpp"
 
 namespace detsim {
@@ -84,8 +87,8 @@ TEST(NetServer, ClientsOnAPerfectNetworkEndOnTheServersState) {
   EXPECT_EQ(m.server_hashes().size(), 300U);
   expect_all_agree(m, 3);
   // The server's game simulated every frame once, and its own hash is its game's.
-  EXPECT_EQ(m.server_game().simulated, 300U);
-  EXPECT_EQ(m.server_game().resimulated, 0U);
+  EXPECT_EQ(m.server_counter()->simulated, 300U);
+  EXPECT_EQ(m.server_counter()->resimulated, 0U);
   for (const net::ServerClientStats& c : m.server().client_stats()) {
     EXPECT_EQ(c.packets_rejected, 0U);
     EXPECT_EQ(c.acknowledged_frame, 300U);
@@ -109,7 +112,7 @@ TEST(NetServer, RightPredictionsMakeNoCorrection) {
   for (std::uint32_t c = 0; c < 3; ++c) {
     EXPECT_EQ(m.client(c)->stats().mispredictions, 0U);
     EXPECT_EQ(m.client(c)->stats().corrections, 0U);
-    EXPECT_EQ(m.game(c)->resimulated, 0U);
+    EXPECT_EQ(m.counter(c)->resimulated, 0U);
     EXPECT_GT(m.client(c)->stats().checks_passed, 0U);
   }
 }
@@ -285,6 +288,101 @@ TEST(NetServer, StateAuthorityReconstructsTheServersStateThroughLoss) {
     EXPECT_GT(m.client(c)->stats().snapshots_received, 10U);
     EXPECT_GT(m.client(c)->stats().checks_passed, 0U);
   }
+}
+
+TEST(NetServer, AnArenaMatchOfEightIsRecordedAndTheReplayVerifies) {
+  test::TempFile replay("server_arena.dsr");
+  ServerMatchOptions o;
+  o.scenario = "arena";
+  o.record = replay.path();
+  o.clients = 8;
+  o.frames = 240;
+  o.link.latency_us = 30'000;
+  o.link.jitter_us = 10'000;
+  o.link.loss_ppm = 30'000;
+  ServerMatch m(o);
+  ASSERT_TRUE(m.run());
+  expect_all_agree(m, 8);
+  ASSERT_NE(m.recorder(), nullptr);
+  ASSERT_TRUE(m.recorder()->finish().ok());
+  auto reader = replay::ReplayReader::open(o.record);
+  ASSERT_TRUE(reader.ok()) << reader.message();
+  auto verified = replay::verify(reader.value());
+  ASSERT_TRUE(verified.ok()) << verified.message();
+  EXPECT_TRUE(verified->ok) << verified->note;
+  EXPECT_EQ(verified->frames, 240U);
+  EXPECT_EQ(verified->final_hash, m.server().current_hash());
+}
+
+TEST(NetServer, SixtyFourClientsOverABadNetworkEndOnTheServersState) {
+  ServerMatchOptions o;
+  o.clients = 64;
+  o.input_size = 3;
+  o.frames = 300;
+  o.link.latency_us = 40'000;
+  o.link.jitter_us = 10'000;
+  o.link.loss_ppm = 20'000;
+  ServerMatch m(o);
+  ASSERT_TRUE(m.run());
+  expect_all_agree(m, 64);
+}
+
+TEST(NetServer, AClientWhoseSimulationDiffersReportsADesync) {
+  // Client 1's game adds one to its state at frame 50: every input it predicted may be right,
+  // and still its state is not the server's — a desync, never a silent correction.
+  ServerMatchOptions o;
+  o.clients = 3;
+  o.frames = 200;
+  ServerMatch m(o);
+  m.run_for(1);  // the clients connect on the first tick
+  ASSERT_NE(m.counter(1), nullptr);
+  m.counter(1)->fault_frame = 50;
+  ASSERT_TRUE(m.run());
+  EXPECT_GT(m.client(1)->stats().desyncs, 0U);
+  EXPECT_EQ(m.client(0)->stats().desyncs, 0U);
+  EXPECT_EQ(m.client(2)->stats().desyncs, 0U);
+  bool event = false;
+  for (const net::ClientEvent& e : m.client(1)->take_events())
+    if (e.type == net::ClientEventType::desync) {
+      event = true;
+      EXPECT_GE(e.frame, 51U);
+      EXPECT_NE(e.local_hash, e.remote_hash);
+    }
+  EXPECT_TRUE(event);
+}
+
+TEST(NetServer, AFullServerTurnsAClientAwayAndASeatCanBeAskedFor) {
+  ServerMatchOptions o;
+  o.clients = 3;
+  o.players = 2;
+  o.start_clients = 2;
+  o.frames = 60;
+  o.join_ms = {0, 0, 200};
+  o.max_ms = 3'000;
+  o.configure_client = [](std::uint32_t c, net::ClientConfig& config) {
+    if (c == 0) config.seat = 1;  // asks for seat 1: client 1 gets seat 0
+  };
+  ServerMatch m(o);
+  EXPECT_FALSE(m.run());  // client 2 never plays
+  EXPECT_EQ(m.client(2)->failure(), "the server has no free seat");
+  EXPECT_EQ(m.client(0)->welcome()->player, 1);
+  EXPECT_EQ(m.client(1)->welcome()->player, 0);
+  EXPECT_TRUE(m.client(0)->ended());
+  EXPECT_TRUE(m.client(1)->ended());
+}
+
+TEST(NetServer, TheCorrectionSmootherHidesAJumpAndDecaysItsOffset) {
+  net::CorrectionSmoother smoother(2.0);         // halves every two frames
+  smoother.corrected({1.0, 0.0, -2.0});          // the simulation jumped by +1, 0, -2
+  EXPECT_DOUBLE_EQ(smoother.offset()[0], -1.0);  // drawn at the old place
+  EXPECT_DOUBLE_EQ(smoother.offset()[2], 2.0);
+  smoother.frame();
+  smoother.frame();
+  EXPECT_NEAR(smoother.offset()[0], -0.5, 1e-12);
+  EXPECT_NEAR(smoother.offset()[2], 1.0, 1e-12);
+  for (int i = 0; i < 60; ++i)
+    smoother.frame();
+  EXPECT_LT(std::abs(smoother.offset()[0]), 1e-9);
 }
 
 TEST(NetServer, AWrongGameIsRejectedWithAReason) {

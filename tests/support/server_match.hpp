@@ -8,17 +8,26 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <detsim/net/client.hpp>
 #include <detsim/net/server.hpp>
 #include <detsim/net/sim_network.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
+#include <detsim/scenario_net/scenario_recorder.hpp>
+#include <detsim/scenes/scenario.hpp>
 
 #include "support/net_match.hpp"
 
 namespace detsim::test {
 
 struct ServerMatchOptions {
+  /// A scenario every side plays (through ScenarioGame; its input size and the scripted bots'
+  /// inputs, seeded with `seed`), with `players` seats; empty: CounterGame.
+  std::string scenario;
+  /// With a scenario: the server records the match to this replay file.
+  std::string record;
   std::uint32_t clients = 2;
   std::uint32_t players = 0;  ///< seats (0: as many as clients)
   std::uint32_t input_size = 4;
@@ -58,20 +67,36 @@ class ServerMatch {
 
   /// Ticks until the server settled and every live client ended (or max_ms); true if so.
   bool run();
+  /// Ticks `ms` times (1 ms each); true if everything ended on the last one.
+  bool run_for(std::uint64_t ms);
 
   net::Server& server() { return *server_; }
-  CounterGame& server_game() { return server_game_; }
+  net::Game& server_game() { return *server_game_.game; }
+  /// The server's CounterGame (nullptr with a scenario).
+  CounterGame* server_counter() { return dynamic_cast<CounterGame*>(server_game_.game.get()); }
   net::SimNetwork& network() { return network_; }
   /// Client c's current client and game (after a restart: the new ones); nullptr while killed.
   net::Client* client(std::uint32_t c) { return clients_[c].client.get(); }
-  CounterGame* game(std::uint32_t c) { return clients_[c].game.get(); }
+  net::Game* game(std::uint32_t c) { return clients_[c].side.game.get(); }
+  /// Client c's CounterGame (nullptr with a scenario, or while killed).
+  CounterGame* counter(std::uint32_t c) {
+    return dynamic_cast<CounterGame*>(clients_[c].side.game.get());
+  }
+  /// The server's recorder (with options.record), to finish.
+  net::ScenarioRecorder* recorder() { return recorder_ ? &*recorder_ : nullptr; }
   /// The frames the server simulated: each one's inputs and hash, in order.
   const std::vector<std::uint64_t>& server_hashes() const { return hashes_; }
   std::uint64_t now_ms() const { return now_ms_; }
 
  private:
+  /// One side's game: a CounterGame, or a scenario and its adapter.
+  struct Side {
+    std::unique_ptr<Scenario> scenario;
+    std::unique_ptr<net::Game> game;
+  };
+  Side make_side() const;
   struct Seat {
-    std::unique_ptr<CounterGame> game;
+    Side side;
     std::unique_ptr<net::Transport> wrapped;
     std::unique_ptr<net::Client> client;
     std::uint64_t next_frame_us = 0;
@@ -79,11 +104,15 @@ class ServerMatch {
     bool killed = false;
   };
   void connect(std::uint32_t c);
+  /// One millisecond: restarts and joins due, the server, every client; true once the server
+  /// settled and every live client ended.
+  bool tick();
   void tick_client(std::uint32_t c);
 
   ServerMatchOptions options_;
   net::SimNetwork network_;
-  CounterGame server_game_;
+  Side server_game_;
+  std::optional<net::ScenarioRecorder> recorder_;
   std::unique_ptr<net::Server> server_;
   std::vector<Seat> clients_;
   std::vector<std::uint64_t> hashes_;
