@@ -108,6 +108,11 @@ struct Client::Impl {
   std::deque<std::pair<std::uint64_t, std::uint64_t>> checks;
   std::uint64_t server_hash = 0;
   std::uint64_t server_hash_frame = 0;
+  // Time sync: the server's frame as its newest update told it, when that arrived, and the
+  // smoothed round trip (7/8 old, 1/8 new, as TCP's).
+  std::uint64_t server_frame = 0;
+  std::uint64_t server_frame_at_us = 0;
+  std::uint64_t smoothed_rtt_us = 0;
   std::uint64_t checked = 0;
 
   // The snapshot being assembled, and the newest one held whole (a delta's base).
@@ -121,7 +126,10 @@ struct Client::Impl {
     std::size_t missing = 0;
   } assembly;
   std::uint32_t snapshot_ack = 0;
-  std::vector<std::uint8_t> snapshot_state;     ///< of frame snapshot_ack - 1
+  /// The states of the newest snapshots held whole (frame, state), oldest first: the server
+  /// codes each snapshot against the newest one it heard acknowledged, which may be older than
+  /// this client's newest by a round trip.
+  std::deque<std::pair<std::uint32_t, std::vector<std::uint8_t>>> snapshot_states;
   std::optional<detail::ServerSnapshot> ready;  ///< decoded this poll, applied after the updates
 
   std::vector<std::uint8_t> unit;  ///< scratch
@@ -240,7 +248,15 @@ struct Client::Impl {
                          std::min<std::uint32_t>(u.input_ack, static_cast<std::uint32_t>(present)));
     stats.lead = u.lead;
     const std::uint64_t now_ms = now_us / 1000;
-    if (u.echo_ms != 0 && now_ms >= u.echo_ms) stats.rtt_ms = now_ms - u.echo_ms;
+    if (u.echo_ms != 0 && now_ms >= u.echo_ms && now_ms - u.echo_ms < 10'000) {
+      stats.rtt_ms = now_ms - u.echo_ms;
+      const std::uint64_t sample = stats.rtt_ms * 1000;
+      smoothed_rtt_us = smoothed_rtt_us == 0 ? sample : (7 * smoothed_rtt_us + sample) / 8;
+    }
+    if (u.frame >= server_frame) {
+      server_frame = u.frame;
+      server_frame_at_us = now_us;
+    }
     if (phase == Phase::waiting && !need_snapshot && u.start == 0 && u.count > 0) {
       phase = Phase::running;  // the match's first frames: it plays from the game's start
       events.push_back({ClientEventType::running, 0, 0, 0, "start"});
@@ -351,11 +367,12 @@ struct Client::Impl {
     stats.snapshot_bytes_received += a.bytes.size();
     const std::vector<std::uint8_t>* base = nullptr;
     if (a.base != 0) {
-      if (a.base != snapshot_ack) {  // against a state this client does not hold
+      for (const auto& [frame, state] : snapshot_states)
+        if (frame + 1U == a.base) base = &state;
+      if (base == nullptr) {  // against a state this client no longer holds
         stats.dropped += 1;
         return;
       }
-      base = &snapshot_state;
     }
     Expected<detail::ServerSnapshot> s =
         detail::decode_server_snapshot(a.bytes, static_cast<std::uint32_t>(sizes.players),
@@ -365,7 +382,8 @@ struct Client::Impl {
       return;
     }
     stats.snapshots_received += 1;
-    snapshot_state = s->state;
+    if (snapshot_states.size() >= detail::kept_snapshot_states) snapshot_states.pop_front();
+    snapshot_states.emplace_back(a.frame, s->state);
     snapshot_ack = a.frame + 1;
     ready = std::move(*s);
     ready_hash = a.hash;
@@ -648,7 +666,17 @@ std::int32_t Client::recommended_frame_adjust() const noexcept {
   if (i.phase != Impl::Phase::running) return 0;
   // Behind the server's own word: catch up at once.
   if (i.auth_end > i.present) return static_cast<std::int32_t>(i.auth_end - i.present) + 1;
-  return i.config.target_lead - i.stats.lead;
+  if (i.server_frame_at_us == 0) return i.config.target_lead - i.stats.lead;
+  // Where an input sent now lands: the server's frame now (its last word, half a round trip
+  // old when it arrived, plus the time since) plus half a round trip more. The client keeps its
+  // present target_lead frames beyond that. Measured from the server's own frame counter, not
+  // from its word on how early the inputs came (which is a round trip late, and oscillates).
+  const std::uint64_t frame_us = i.welcomed.frame_us;
+  const std::uint64_t ahead_us = i.smoothed_rtt_us + (i.now_us - i.server_frame_at_us);
+  const std::uint64_t lands = i.server_frame + (ahead_us + frame_us - 1) / frame_us;
+  const std::int64_t lead = static_cast<std::int64_t>(i.present) - static_cast<std::int64_t>(lands);
+  return static_cast<std::int32_t>(
+      std::clamp<std::int64_t>(std::int64_t{i.config.target_lead} - lead, -30, 30));
 }
 
 void Client::leave() {

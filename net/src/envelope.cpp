@@ -38,7 +38,8 @@ std::vector<std::uint8_t> stored(const EnvelopeMagic& magic,
 }  // namespace
 
 std::vector<std::uint8_t> seal_envelope(const EnvelopeMagic& magic,
-                                        std::span<const std::uint8_t> payload, bool compress) {
+                                        std::span<const std::uint8_t> payload, bool compress,
+                                        std::span<const std::uint8_t> prefix) {
 #if DETSIM_WITH_ZSTD
   if (!compress) return stored(magic, payload);
   std::vector<std::uint8_t> out(magic.begin(), magic.end());
@@ -53,6 +54,7 @@ std::vector<std::uint8_t> seal_envelope(const EnvelopeMagic& magic,
   if (context != nullptr) {
     ZSTD_CCtx_setParameter(context, ZSTD_c_compressionLevel, 3);
     ZSTD_CCtx_setParameter(context, ZSTD_c_checksumFlag, 1);
+    if (!prefix.empty()) ZSTD_CCtx_refPrefix(context, prefix.data(), prefix.size());
     written =
         ZSTD_compress2(context, out.data() + envelope_size, bound, payload.data(), payload.size());
     ZSTD_freeCCtx(context);
@@ -64,13 +66,15 @@ std::vector<std::uint8_t> seal_envelope(const EnvelopeMagic& magic,
   // Out of memory, or a zstd error: stored then.
 #else
   (void)compress;
+  (void)prefix;
 #endif
   return stored(magic, payload);
 }
 
 Expected<std::vector<std::uint8_t>> open_envelope(const EnvelopeMagic& magic,
                                                   std::span<const std::uint8_t> bytes,
-                                                  std::size_t max_payload, const char* what) {
+                                                  std::size_t max_payload, const char* what,
+                                                  std::span<const std::uint8_t> prefix) {
   const std::string name = what;
   if (bytes.size() < envelope_size || !std::equal(magic.begin(), magic.end(), bytes.begin()))
     return Status::error("not a " + name + " (no " + std::string(magic.begin(), magic.end()) +
@@ -94,11 +98,17 @@ Expected<std::vector<std::uint8_t>> open_envelope(const EnvelopeMagic& magic,
   if (content != size)
     return Status::error(name + " compressed payload size differs from its header");
   payload.resize(static_cast<std::size_t>(size));
-  const std::size_t got = ZSTD_decompress(payload.data(), payload.size(), body.data(), body.size());
+  ZSTD_DCtx* context = ZSTD_createDCtx();
+  if (context == nullptr) return Status::error(name + ": out of memory to decompress");
+  if (!prefix.empty()) ZSTD_DCtx_refPrefix(context, prefix.data(), prefix.size());
+  const std::size_t got =
+      ZSTD_decompressDCtx(context, payload.data(), payload.size(), body.data(), body.size());
+  ZSTD_freeDCtx(context);
   if (ZSTD_isError(got) || got != size)
     return Status::error(name + " compressed payload does not decompress (corrupt)");
   return payload;
 #else
+  (void)prefix;
   return Status::error(name + " is compressed with zstd, and this build has no zstd " +
                        "(DETSIM_WITH_ZSTD=OFF)");
 #endif

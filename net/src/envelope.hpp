@@ -22,17 +22,19 @@ namespace detsim::net::detail {
 using EnvelopeMagic = std::array<std::uint8_t, 4>;
 
 /// The envelope around `payload`: zstd-compressed where the build has zstd and `compress` says so
-/// (and compression succeeds), else stored.
+/// (and compression succeeds), else stored. With a `prefix` (bytes the reader holds too, such as
+/// an earlier state), zstd refers to it as to bytes just before the payload: what the payload
+/// repeats of it costs a few bytes a run, wherever it moved to (a delta that survives shifts).
 [[nodiscard]] std::vector<std::uint8_t> seal_envelope(const EnvelopeMagic& magic,
                                                       std::span<const std::uint8_t> payload,
-                                                      bool compress = true);
+                                                      bool compress = true,
+                                                      std::span<const std::uint8_t> prefix = {});
 
 /// The payload of an envelope with `magic`, at most `max_payload` bytes uncompressed whatever the
 /// header says; errors say what is wrong ("not a ... (no DSNP header)", "corrupt", ...), with
-/// `what` naming the thing ("snapshot").
-[[nodiscard]] Expected<std::vector<std::uint8_t>> open_envelope(const EnvelopeMagic& magic,
-                                                                std::span<const std::uint8_t> bytes,
-                                                                std::size_t max_payload,
-                                                                const char* what);
+/// `what` naming the thing ("snapshot"). `prefix`: the one the writer sealed it with.
+[[nodiscard]] Expected<std::vector<std::uint8_t>> open_envelope(
+    const EnvelopeMagic& magic, std::span<const std::uint8_t> bytes, std::size_t max_payload,
+    const char* what, std::span<const std::uint8_t> prefix = {});
 
 }  // namespace detsim::net::detail

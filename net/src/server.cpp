@@ -29,9 +29,6 @@ constexpr std::uint64_t late_window = 64;
 constexpr std::uint64_t keepalive_us = 100'000;
 /// How long a snapshot's slices rest after a full round before they are sent again.
 constexpr std::uint64_t snapshot_resend_us = 100'000;
-/// Authority::state: the snapshot states kept as bases. A client acknowledges one within a
-/// round trip; one whose newest is older than these gets a full snapshot.
-constexpr std::size_t kept_snapshots = 32;
 /// A connect from the peer of a client heard from within this is not a restart: ignored.
 constexpr std::uint64_t restart_quiet_us = 1'000'000;
 
@@ -461,7 +458,7 @@ struct Server::Impl {
     frame += 1;
     stats.frames += 1;
     if (config.authority == sp::Authority::state && frame % config.snapshot_interval == 0) {
-      if (snapshot_states.size() >= kept_snapshots) snapshot_states.erase(snapshot_states.begin());
+      if (snapshot_states.size() >= detail::kept_snapshot_states) snapshot_states.erase(snapshot_states.begin());
       snapshot_states.emplace_back(frame, state);
     }
   }

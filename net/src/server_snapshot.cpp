@@ -1,7 +1,6 @@
 // The server's snapshots (server_snapshot.hpp).
 #include "server_snapshot.hpp"
 
-#include <algorithm>
 #include <string>
 
 #include <detsim/net/server_protocol.hpp>
@@ -23,14 +22,6 @@ std::uint64_t snapshot_get(std::span<const std::uint8_t> bytes, std::size_t at, 
   return v;
 }
 
-/// XORs `state` with `base` over their common length, in place (its own inverse).
-void xor_with(std::span<std::uint8_t> state, const std::vector<std::uint8_t>* base) {
-  if (base == nullptr) return;
-  const std::size_t n = std::min(state.size(), base->size());
-  for (std::size_t i = 0; i < n; ++i)
-    state[i] = static_cast<std::uint8_t>(state[i] ^ (*base)[i]);
-}
-
 }  // namespace
 
 std::vector<std::uint8_t> encode_server_snapshot(const ServerSnapshot& s, std::uint32_t players,
@@ -43,18 +34,19 @@ std::vector<std::uint8_t> encode_server_snapshot(const ServerSnapshot& s, std::u
   put(payload, input_size, 1);
   payload.insert(payload.end(), s.unit.begin(), s.unit.end());
   put(payload, s.state.size(), 8);
-  const std::size_t at = payload.size();
   payload.insert(payload.end(), s.state.begin(), s.state.end());
-  xor_with(std::span<std::uint8_t>(payload).subspan(at), base);
-  return seal_envelope(server_magic, payload);
+  return seal_envelope(
+      server_magic, payload, true,
+      base != nullptr ? std::span<const std::uint8_t>(*base) : std::span<const std::uint8_t>());
 }
 
 Expected<ServerSnapshot> decode_server_snapshot(std::span<const std::uint8_t> bytes,
                                                 std::uint32_t players, std::uint32_t input_size,
                                                 const std::vector<std::uint8_t>* base) {
-  Expected<std::vector<std::uint8_t>> opened =
-      open_envelope(server_magic, bytes, max_server_state + 64 + server_protocol::max_unit_size,
-                    "server snapshot");
+  Expected<std::vector<std::uint8_t>> opened = open_envelope(
+      server_magic, bytes, max_server_state + 64 + server_protocol::max_unit_size,
+      "server snapshot",
+      base != nullptr ? std::span<const std::uint8_t>(*base) : std::span<const std::uint8_t>());
   if (!opened) return opened.status();
   std::vector<std::uint8_t>& payload = *opened;
   const std::size_t unit = server_protocol::unit_size(players, input_size);
@@ -77,7 +69,6 @@ Expected<ServerSnapshot> decode_server_snapshot(std::span<const std::uint8_t> by
     return Status::error("server snapshot: the state holds " + std::to_string(payload.size() - at) +
                          " bytes, its header says " + std::to_string(size));
   s.state.assign(payload.begin() + static_cast<std::ptrdiff_t>(at), payload.end());
-  xor_with(s.state, base);
   return s;
 }
 

@@ -1,0 +1,296 @@
+// The game server's figures (docs/SERVER.md, "Figures"; issue 25): bandwidth per client under
+// each authority, what a slow client does to the others, and what the server costs per client.
+// Every match runs a server and its clients over the simulated network in virtual time (1 ms
+// ticks), each client with its own game and its own scripted bot; the counters are the figures,
+// the time is only the run's.
+//
+//   inputs_arena/8         input authority, arena, 8 clients, 60 s (3600 frames), 50 ms each way,
+//                          10 ms jitter, 2% loss, updates at 20 Hz: bytes per second down and up
+//                          per client, corrections per client
+//   slow_client/8/MS       the same match, 1200 frames, with client 7 MS ms away each way (the
+//                          others 25 ms): the most any other client re-simulated, and client 7's
+//   state_cubes/1          state authority, the cubes scene (900 cubes), one client driving the
+//                          large cube, 60 snapshots per second, 60 s: kbit/s down, bit-exact (its
+//                          final state hashes as the server's, no desync)
+//   server_cost/64         input authority, arena with 64 players, 64 clients, 300 frames: the
+//                          server's CPU time per client per frame beside one step of the scene
+//                          (the server's game timed apart from the rest of the server's work)
+// Bench code is not simulation code: double and the clock are used freely here.
+#include <benchmark/benchmark.h>
+
+#include <time.h>  // clock_gettime, CLOCK_THREAD_CPUTIME_ID (POSIX)
+
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <detsim/net/client.hpp>
+#include <detsim/net/server.hpp>
+#include <detsim/net/sim_network.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
+#include <detsim/scenes/scenario.hpp>
+
+namespace {
+
+using namespace detsim;
+namespace sp = net::server_protocol;
+
+double thread_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
+}
+
+/// A game that times what it is asked to do (the server's simulation, apart from its network).
+class TimedGame final : public net::Game {
+ public:
+  explicit TimedGame(net::Game& inner) : inner_(inner) {}
+  std::uint64_t save(std::vector<std::uint8_t>& state) override {
+    const double t0 = thread_seconds();
+    const std::uint64_t h = inner_.save(state);
+    seconds += thread_seconds() - t0;
+    return h;
+  }
+  void load(std::span<const std::uint8_t> state) override { inner_.load(state); }
+  void advance(const net::FrameInputs& inputs, bool resimulating) override {
+    const double t0 = thread_seconds();
+    inner_.advance(inputs, resimulating);
+    const double t = thread_seconds() - t0;
+    seconds += t;
+    step_seconds += t;
+  }
+  double seconds = 0;       ///< in advance and save
+  double step_seconds = 0;  ///< in advance alone
+ private:
+  net::Game& inner_;
+};
+
+struct Side {
+  std::unique_ptr<Scenario> scenario;
+  std::unique_ptr<net::ScenarioGame> game;
+};
+
+Side make_side(const std::string& name, std::uint32_t players, std::uint32_t count) {
+  ScenarioParams params;
+  params.seed = 1;
+  params.players = players;
+  params.count = count;
+  Side s;
+  s.scenario = std::make_unique<Scenario>(Scenario::create(name, params).value());
+  s.game = std::make_unique<net::ScenarioGame>(*s.scenario);
+  return s;
+}
+
+struct MatchSetup {
+  std::string scenario = "arena";
+  std::uint32_t count = 0;
+  std::uint32_t clients = 8;
+  std::uint32_t frames = 3600;
+  sp::Authority authority = sp::Authority::inputs;
+  std::uint32_t update_interval = 3;
+  std::uint32_t snapshot_interval = 1;
+  net::LinkConditions link{};
+  std::optional<std::pair<std::uint32_t, std::uint32_t>> slow;  ///< (client, latency us)
+  /// Client c's bot: scripted input (seed c + 1); `drive_only_first` leaves the others idle.
+  bool drive_only_first = false;
+};
+
+struct MatchResult {
+  bool agreed = true;  ///< every client ended on the server's final hash, no desync
+  std::vector<net::ServerClientStats> server_side;
+  std::vector<net::ClientStats> clients;
+  double server_seconds = 0;  ///< the server's CPU time, its game included
+  double game_seconds = 0;    ///< its game's (advance and save)
+  double step_seconds = 0;    ///< its game's advance alone
+  std::uint64_t frames = 0;
+};
+
+MatchResult play(const MatchSetup& m) {
+  auto network = net::SimNetwork::create(m.clients + 1, 7, m.link).value();
+  if (m.slow) {
+    net::LinkConditions slow = m.link;
+    slow.latency_us = m.slow->second;
+    (void)network.set_link(0, m.slow->first + 1, slow);
+    (void)network.set_link(m.slow->first + 1, 0, slow);
+  }
+  Side server_side = make_side(m.scenario, m.clients, m.count);
+  TimedGame timed(*server_side.game);
+  net::ServerConfig config;
+  config.players = m.clients;
+  config.input_size = server_side.game->input_size();
+  config.game = 25;
+  config.frames = m.frames;
+  config.authority = m.authority;
+  config.update_interval = m.update_interval;
+  config.snapshot_interval = m.snapshot_interval;
+  config.start_clients = m.clients;
+  net::Server server = net::Server::create(config, timed, network.endpoint(0)).value();
+  std::vector<Side> sides;
+  std::vector<net::Client> clients;
+  for (std::uint32_t c = 0; c < m.clients; ++c) {
+    sides.push_back(make_side(m.scenario, m.clients, m.count));
+    net::ClientConfig cc;
+    cc.game = 25;
+    clients.push_back(net::Client::create(cc, network.endpoint(c + 1)).value());
+  }
+  std::vector<std::uint64_t> next(m.clients, 0);
+  std::vector<std::uint64_t> ticks(m.clients, 0);
+  std::vector<std::uint8_t> input(server_side.game->input_size());
+  MatchResult r;
+  const std::uint64_t max_ms = std::uint64_t{m.frames} * 17 * 3 + 20'000;
+  std::optional<std::uint64_t> settled;
+  for (std::uint64_t ms = 0; ms < max_ms; ++ms) {
+    const std::uint64_t now = ms * 1000;
+    network.advance_to(now);
+    if (!settled || ms < *settled + 500) {
+      const double t0 = thread_seconds();
+      server.poll(now);
+      server.advance(now);
+      server.poll(now);
+      r.server_seconds += thread_seconds() - t0;
+      if (!settled && server.settled()) settled = ms;
+    }
+    bool all = server.settled();
+    for (std::uint32_t c = 0; c < m.clients; ++c) {
+      net::Client& client = clients[c];
+      client.poll(now);
+      if (client.welcome() != nullptr && !client.started()) (void)client.start(*sides[c].game);
+      if (client.running() && now >= next[c]) {
+        next[c] = std::max(next[c] + client.welcome()->frame_us, now);
+        ++ticks[c];
+        const std::int32_t adjust = client.recommended_frame_adjust();
+        int runs = 1;
+        if (ticks[c] % 3 == 0 && adjust > 0) runs = adjust > 4 ? 3 : 2;
+        if (ticks[c] % 3 == 0 && adjust < 0) runs = 0;
+        for (int k = 0; k < runs; ++k) {
+          std::fill(input.begin(), input.end(), std::uint8_t{0});
+          if (!m.drive_only_first || c == 0)
+            sides[c].scenario->scripted(c + 1, client.current_frame(), c, input);
+          (void)client.advance_frame(input);
+        }
+      }
+      all = all && client.ended();
+    }
+    if (all) break;
+  }
+  r.frames = server.current_frame();
+  r.game_seconds = timed.seconds;
+  r.step_seconds = timed.step_seconds;
+  r.server_side = server.client_stats();
+  for (std::uint32_t c = 0; c < m.clients; ++c) {
+    std::vector<std::uint8_t> state;
+    r.agreed = r.agreed && clients[c].ended() && clients[c].stats().desyncs == 0 &&
+               sides[c].game->save(state) == server.current_hash();
+    r.clients.push_back(clients[c].stats());
+  }
+  return r;
+}
+
+void report_bandwidth(benchmark::State& state, const MatchResult& r) {
+  const double seconds = static_cast<double>(r.frames) / 60.0;
+  double down = 0;
+  double up = 0;
+  double corrections = 0;
+  for (const net::ServerClientStats& c : r.server_side) {
+    down += static_cast<double>(c.bytes_sent);
+    up += static_cast<double>(c.bytes_received);
+  }
+  for (const net::ClientStats& c : r.clients)
+    corrections += static_cast<double>(c.corrections);
+  const double n = static_cast<double>(r.server_side.size());
+  state.counters["down_bytes_per_s"] = down / n / seconds;
+  state.counters["down_kbit_per_s"] = down / n / seconds * 8 / 1000;
+  state.counters["up_bytes_per_s"] = up / n / seconds;
+  state.counters["corrections_per_client"] = corrections / n;
+  state.counters["agreed"] = r.agreed ? 1 : 0;
+}
+
+void BM_InputsArena(benchmark::State& state) {
+  MatchSetup m;
+  m.clients = static_cast<std::uint32_t>(state.range(0));
+  m.link.latency_us = 50'000;
+  m.link.jitter_us = 10'000;
+  m.link.loss_ppm = 20'000;
+  MatchResult r;
+  for (auto _ : state)
+    r = play(m);
+  report_bandwidth(state, r);
+}
+BENCHMARK(BM_InputsArena)->Name("inputs_arena")->Arg(8)->Iterations(1)->Unit(benchmark::kSecond);
+
+void BM_SlowClient(benchmark::State& state) {
+  MatchSetup m;
+  m.clients = 8;
+  m.frames = 1200;
+  m.link.latency_us = 25'000;
+  m.link.jitter_us = 5'000;
+  m.slow = std::make_pair(7U, static_cast<std::uint32_t>(state.range(0)) * 1000);
+  MatchResult r;
+  for (auto _ : state)
+    r = play(m);
+  double others = 0;
+  for (std::size_t c = 0; c + 1 < r.clients.size(); ++c)
+    others = std::max(others, static_cast<double>(r.clients[c].resimulated_frames));
+  state.counters["most_resimulated_by_others"] = others;
+  state.counters["slow_client_resimulated"] =
+      static_cast<double>(r.clients.back().resimulated_frames);
+  state.counters["slow_client_inputs_late"] = static_cast<double>(r.server_side.back().inputs_late);
+  state.counters["agreed"] = r.agreed ? 1 : 0;
+}
+BENCHMARK(BM_SlowClient)
+    ->Name("slow_client/8")
+    ->Arg(50)
+    ->Arg(200)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+
+void BM_StateCubes(benchmark::State& state) {
+  MatchSetup m;
+  m.scenario = "cubes";
+  m.clients = 1;
+  m.authority = sp::Authority::state;
+  m.snapshot_interval = 1;
+  m.update_interval = 1;
+  m.link.latency_us = 50'000;
+  m.link.jitter_us = 5'000;
+  m.link.loss_ppm = 10'000;
+  MatchResult r;
+  for (auto _ : state)
+    r = play(m);
+  report_bandwidth(state, r);
+  double snapshots = 0;
+  for (const net::ClientStats& c : r.clients)
+    snapshots += static_cast<double>(c.snapshots_received);
+  state.counters["snapshots_received"] = snapshots;
+}
+BENCHMARK(BM_StateCubes)->Name("state_cubes/1")->Iterations(1)->Unit(benchmark::kSecond);
+
+void BM_ServerCost(benchmark::State& state) {
+  MatchSetup m;
+  m.clients = static_cast<std::uint32_t>(state.range(0));
+  m.frames = 300;
+  m.link.latency_us = 30'000;
+  m.link.jitter_us = 5'000;
+  m.link.loss_ppm = 10'000;
+  MatchResult r;
+  for (auto _ : state)
+    r = play(m);
+  const double frames = static_cast<double>(r.frames);
+  const double per_client_frame =
+      (r.server_seconds - r.game_seconds) / frames / static_cast<double>(m.clients);
+  const double step = r.step_seconds / frames;
+  state.counters["step_us"] = step * 1e6;
+  state.counters["server_us_per_client_per_frame"] = per_client_frame * 1e6;
+  state.counters["per_client_percent_of_step"] = 100.0 * per_client_frame / step;
+  state.counters["save_us"] = (r.game_seconds - r.step_seconds) / frames * 1e6;
+  state.counters["agreed"] = r.agreed ? 1 : 0;
+}
+BENCHMARK(BM_ServerCost)->Name("server_cost")->Arg(64)->Iterations(1)->Unit(benchmark::kSecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
