@@ -12,6 +12,8 @@
 //   state_cubes/1          state authority, the cubes scene (900 cubes), one client driving the
 //                          large cube, 60 snapshots per second, 60 s: kbit/s down, bit-exact (its
 //                          final state hashes as the server's, no desync)
+//   p2p_arena/8/MODE       the inputs_arena match played peer to peer instead, rollback (0) or
+//                          lockstep (1) sessions, input delay 2: the same figures per peer
 //   server_cost/64         input authority, arena with 64 players, 64 clients, 300 frames: the
 //                          server's CPU time per client per frame beside one step of the scene
 //                          (the server's game timed apart from the rest of the server's work)
@@ -30,6 +32,7 @@
 
 #include <detsim/net/client.hpp>
 #include <detsim/net/server.hpp>
+#include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
 #include <detsim/scenario_net/scenario_game.hpp>
 #include <detsim/scenes/scenario.hpp>
@@ -201,7 +204,11 @@ void report_bandwidth(benchmark::State& state, const MatchResult& r) {
   }
   for (const net::ClientStats& c : r.clients)
     corrections += static_cast<double>(c.corrections);
+  double resimulated = 0;
+  for (const net::ClientStats& c : r.clients)
+    resimulated += static_cast<double>(c.resimulated_frames);
   const double n = static_cast<double>(r.server_side.size());
+  state.counters["resimulated_per_client"] = resimulated / n;
   state.counters["down_bytes_per_s"] = down / n / seconds;
   state.counters["down_kbit_per_s"] = down / n / seconds * 8 / 1000;
   state.counters["up_bytes_per_s"] = up / n / seconds;
@@ -268,6 +275,90 @@ void BM_StateCubes(benchmark::State& state) {
   state.counters["snapshots_received"] = snapshots;
 }
 BENCHMARK(BM_StateCubes)->Name("state_cubes/1")->Iterations(1)->Unit(benchmark::kSecond);
+
+/// The inputs_arena match, peer to peer: 8 sessions over the same links, each with its own game
+/// and bot, in virtual time; per peer what it sends and receives, its rollbacks and stalls.
+void BM_PeerToPeer(benchmark::State& state) {
+  const std::uint32_t players = 8;
+  const bool lockstep = state.range(0) != 0;
+  net::LinkConditions link;
+  link.latency_us = 50'000;
+  link.jitter_us = 10'000;
+  link.loss_ppm = 20'000;
+  const std::uint64_t frames = 3600;
+  double sent = 0;
+  double received = 0;
+  double rollbacks = 0;
+  double resimulated = 0;
+  double stalls = 0;
+  bool agreed = true;
+  for (auto _ : state) {
+    auto network = net::SimNetwork::create(players, 7, link).value();
+    std::vector<Side> sides;
+    std::vector<net::Session> sessions;
+    std::vector<std::uint64_t> final_hash(players, 0);
+    for (std::uint32_t p = 0; p < players; ++p) {
+      sides.push_back(make_side("arena", players, 0));
+      net::SessionConfig c;
+      c.mode = lockstep ? net::SessionMode::lockstep : net::SessionMode::rollback;
+      c.players = players;
+      c.local_player = p;
+      c.input_size = sides.back().game->input_size();
+      c.max_prediction = 16;
+      for (std::uint32_t q = 0; q < players; ++q)
+        if (q != p) c.remotes.push_back({q, q});
+      sessions.push_back(net::Session::create(c, *sides.back().game, network.endpoint(p)).value());
+      sessions.back().set_confirmed_listener(
+          [&final_hash, p, frames](const net::ConfirmedFrame& f) {
+            if (f.frame + 1 == frames) final_hash[p] = f.hash;
+          });
+    }
+    std::vector<std::uint64_t> next(players, 0);
+    std::vector<std::uint64_t> ticks(players, 0);
+    std::vector<std::uint8_t> input(sides[0].game->input_size());
+    for (std::uint64_t ms = 0; ms < frames * 17 * 3 + 20'000; ++ms) {
+      const std::uint64_t now = ms * 1000;
+      network.advance_to(now);
+      bool done = true;
+      for (std::uint32_t p = 0; p < players; ++p) {
+        net::Session& s = sessions[p];
+        s.poll(now);
+        done = done && s.delivered_frame() >= frames;
+        if (!s.running() || s.current_frame() >= frames || now < next[p]) continue;
+        next[p] = std::max(next[p] + 16'667, now);
+        if (s.recommended_wait_frames() > 0 && ++ticks[p] % 3 == 0) continue;
+        sides[p].scenario->scripted(p + 1, s.current_frame() + 2, p, input);
+        auto r = s.advance_frame(input);
+        if (r.ok() && r.value() != net::Advance::advanced) stalls += 1;
+      }
+      if (done) break;
+    }
+    for (std::uint32_t p = 0; p < players; ++p) {
+      for (std::uint32_t q = 0; q < players; ++q) {
+        if (q == p) continue;
+        const net::PeerStats st = sessions[p].peer_stats(q).value();
+        sent += static_cast<double>(st.bytes_sent);
+        received += static_cast<double>(st.bytes_received);
+      }
+      rollbacks += static_cast<double>(sessions[p].stats().rollbacks);
+      resimulated += static_cast<double>(sessions[p].stats().resimulated_frames);
+      agreed = agreed && final_hash[p] != 0 && final_hash[p] == final_hash[0];
+    }
+  }
+  const double seconds = static_cast<double>(frames) / 60.0;
+  state.counters["down_bytes_per_s"] = received / players / seconds;
+  state.counters["up_bytes_per_s"] = sent / players / seconds;
+  state.counters["rollbacks_per_peer"] = rollbacks / players;
+  state.counters["resimulated_per_peer"] = resimulated / players;
+  state.counters["stalls_per_peer"] = stalls / players;
+  state.counters["agreed"] = agreed ? 1 : 0;
+}
+BENCHMARK(BM_PeerToPeer)
+    ->Name("p2p_arena/8")
+    ->Arg(0)
+    ->Arg(1)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 
 void BM_ServerCost(benchmark::State& state) {
   MatchSetup m;
