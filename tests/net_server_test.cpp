@@ -372,17 +372,18 @@ TEST(NetServer, AFullServerTurnsAClientAwayAndASeatCanBeAskedFor) {
 }
 
 TEST(NetServer, TheCorrectionSmootherHidesAJumpAndDecaysItsOffset) {
-  net::CorrectionSmoother smoother(2.0);         // halves every two frames
-  smoother.corrected({1.0, 0.0, -2.0});          // the simulation jumped by +1, 0, -2
-  EXPECT_DOUBLE_EQ(smoother.offset()[0], -1.0);  // drawn at the old place
-  EXPECT_DOUBLE_EQ(smoother.offset()[2], 2.0);
+  using namespace detsim::literals;
+  net::CorrectionSmoother smoother(2_fx);                   // halves every two frames
+  smoother.corrected({1_fx, 0_fx, -2_fx});                  // the simulation jumped by +1, 0, -2
+  EXPECT_EQ(smoother.offset(), (Vec3{-1_fx, 0_fx, 2_fx}));  // drawn where it was
   smoother.frame();
   smoother.frame();
-  EXPECT_NEAR(smoother.offset()[0], -0.5, 1e-12);
-  EXPECT_NEAR(smoother.offset()[2], 1.0, 1e-12);
-  for (int i = 0; i < 60; ++i)
+  // 2^-1/2 squared is a half, to within the rounding of two products.
+  EXPECT_NEAR(smoother.offset().x.to_double(), -0.5, 1e-8);
+  EXPECT_NEAR(smoother.offset().z.to_double(), 1.0, 1e-8);
+  for (int i = 0; i < 80; ++i)
     smoother.frame();
-  EXPECT_LT(std::abs(smoother.offset()[0]), 1e-9);
+  EXPECT_LT(std::abs(smoother.offset().x.to_double()), 1e-6);
 }
 
 TEST(NetServer, AWrongGameIsRejectedWithAReason) {

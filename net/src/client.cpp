@@ -11,8 +11,9 @@
 // state frame is compared once this client holds its own state of that frame.
 #include <detsim/net/client.hpp>
 
+#include <detsim/fixed/math.hpp>
+
 #include <algorithm>
-#include <cmath>
 #include <deque>
 #include <optional>
 #include <string>
@@ -717,17 +718,8 @@ std::string_view Client::failure() const noexcept {
   return impl_->failure;
 }
 
-CorrectionSmoother::CorrectionSmoother(double half_life_frames) noexcept
-    : keep_(std::pow(0.5, 1.0 / std::max(half_life_frames, 1e-9))) {}
-
-void CorrectionSmoother::corrected(const std::array<double, 3>& jump) noexcept {
-  for (std::size_t k = 0; k < 3; ++k)
-    offset_[k] -= jump[k];
-}
-
-void CorrectionSmoother::frame() noexcept {
-  for (double& v : offset_)
-    v *= keep_;
-}
+CorrectionSmoother::CorrectionSmoother(Fixed half_life_frames) noexcept
+    : keep_(half_life_frames > Fixed::zero() ? exp2(-(Fixed::one() / half_life_frames))
+                                             : Fixed::zero()) {}
 
 }  // namespace detsim::net

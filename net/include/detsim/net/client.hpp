@@ -16,7 +16,6 @@
 // client keeps its inputs arriving a little ahead of the server's simulation (target_lead).
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -24,6 +23,8 @@
 #include <vector>
 
 #include <detsim/core/status.hpp>
+#include <detsim/fixed/fixed.hpp>
+#include <detsim/fixed/vec3.hpp>
 #include <detsim/net/game.hpp>
 #include <detsim/net/server_protocol.hpp>
 #include <detsim/net/session.hpp>
@@ -146,23 +147,22 @@ class Client {
 };
 
 /// A display-side smoothing of corrections (outside the synced state): when a correction moves
-/// something the player sees, add the jump (old shown position - new simulated position) to an
-/// offset that decays to zero over a few frames, and draw the simulated position plus offset().
-/// Plain doubles: it is drawing, never simulation.
+/// something the player sees, tell it the jump (new simulated position - old), draw the simulated
+/// position plus offset(), and call frame() once per displayed frame: the offset starts at minus
+/// the jump (the view stays where it was) and halves every `half_life_frames`. In Fixed, as all of
+/// net/ is (a renderer converts the offset as it converts positions).
 class CorrectionSmoother {
  public:
-  /// `half_life_frames`: the frames in which the offset halves (> 0).
-  explicit CorrectionSmoother(double half_life_frames = 3.0) noexcept;
-  /// A correction moved the simulated position by `jump` (new - old): the view keeps showing the
-  /// old one, and eases to the new.
-  void corrected(const std::array<double, 3>& jump) noexcept;
+  /// `half_life_frames`: frames in which the offset halves, > 0 (default 3).
+  explicit CorrectionSmoother(Fixed half_life_frames = Fixed::from_int(3)) noexcept;
+  void corrected(Vec3 jump) noexcept { offset_ -= jump; }
   /// One displayed frame passed: the offset decays.
-  void frame() noexcept;
-  [[nodiscard]] const std::array<double, 3>& offset() const noexcept { return offset_; }
+  void frame() noexcept { offset_ = offset_ * keep_; }
+  [[nodiscard]] Vec3 offset() const noexcept { return offset_; }
 
  private:
-  double keep_;
-  std::array<double, 3> offset_{};
+  Fixed keep_;  ///< 2^(-1 / half_life_frames)
+  Vec3 offset_{};
 };
 
 }  // namespace detsim::net
