@@ -308,6 +308,49 @@ TEST(CliServe, AStrangerSprayingForgedDatagramsChangesNoClientsOutcome) {
   FAIL() << "no free ports after 6 attempts";
 }
 
+TEST(CliServe, AnInjectedClientDesyncsAndBisectAgainstTheServersReplayNamesTheField) {
+  // Client 1's machine changes body 7's position at frame 300: it reports a desync against the
+  // server's hashes and writes its side; bisect of the server's replay and that report names
+  // exactly that change. The server and the honest client are unaffected.
+  TempFile replay("desync_server.dsr");
+  TempFile report("desync_client.dsd");
+  for (int attempt = 0; attempt < 6; ++attempt) {
+    const Ports ports{port_for(attempt + 120)};
+    Process server({"serve", "--bind", endpoint(ports.server()), "--players", "2", "--frames",
+                    "600", "--fps", "240", "--record", replay.path(), "--json"},
+                   "desync_server");
+    Process honest({"netplay", "--server", endpoint(ports.server()), "--bind",
+                    endpoint(ports.client(0)), "--bot", "3", "--json"},
+                   "desync_honest");
+    Process faulty({"netplay", "--server", endpoint(ports.server()), "--bind",
+                    endpoint(ports.client(1)), "--bot", "4", "--json", "--inject",
+                    "300:7:position.y:0.001", "--desync-report", report.path()},
+                   "desync_faulty");
+    std::vector<LossyRelay> none;
+    const bool finished = run_all(none, {&server, &honest, &faulty}, std::chrono::seconds(60));
+    if (bind_failed(server)) continue;
+    ASSERT_TRUE(finished) << server.err() << honest.err() << faulty.err();
+    EXPECT_EQ(server.exit_code(), 0) << server.err();
+    EXPECT_EQ(honest.exit_code(), 0) << honest.out() << honest.err();
+    EXPECT_EQ(json_field(honest.out(), "desyncs"), "0");
+    EXPECT_EQ(faulty.exit_code(), 1) << faulty.out() << faulty.err();
+    EXPECT_NE(json_field(faulty.out(), "desyncs"), "0") << faulty.out();
+    EXPECT_EQ(json_field(faulty.out(), "desync_report"), report.path()) << faulty.out();
+    EXPECT_TRUE(has(faulty.err(), "DESYNC with the server")) << faulty.err();
+    const test::CliResult r =
+        test::detsim_cli("bisect " + replay.path() + " " + report.path() + " --json");
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_EQ(json_field(r.out, "outcome"), "diverged") << r.out;
+    EXPECT_EQ(json_field(r.out, "first_divergent_frame"), "300") << r.out;
+    EXPECT_TRUE(has(r.out, R"("diffs":[{"subsystem":"bodies","body":7,"field":"position.y",)"))
+        << r.out;
+    const test::CliResult verify = test::detsim_cli("verify " + replay.path());
+    EXPECT_EQ(verify.exit_code, 0) << verify.out << verify.err;
+    return;
+  }
+  FAIL() << "no free ports after 6 attempts";
+}
+
 TEST(CliServe, BadUsageExitsWithTwoAndNamesTheProblem) {
   const auto fails = [](const std::string& args, const std::string& needle) {
     const test::CliResult r = test::detsim_cli(args);

@@ -127,7 +127,7 @@ TEST(Cli, BadUsageAndBadInputExitWithTwoAndSayWhatIsWrong) {
   const std::vector<Case> cases = {
       {"run", "--scenario is required"},
       {"run --scenario nope", "unknown scenario 'nope'; known: arena,"},
-      {"run --scenario arena --players 9", "takes 2 to 8 players, got 9"},
+      {"run --scenario arena --players 65", "takes 2 to 64 players, got 65"},
       {"run --scenario arena --frames 0", "--frames"},
       {"run --scenario arena --frames abc", "--frames"},
       {"run --scenario stack --frames 1 --record /nonexistent-dir/x.dsr",

@@ -341,14 +341,44 @@ TEST(NetServer, AClientWhoseSimulationDiffersReportsADesync) {
   EXPECT_GT(m.client(1)->stats().desyncs, 0U);
   EXPECT_EQ(m.client(0)->stats().desyncs, 0U);
   EXPECT_EQ(m.client(2)->stats().desyncs, 0U);
-  bool event = false;
+  std::optional<std::uint64_t> first;
   for (const net::ClientEvent& e : m.client(1)->take_events())
     if (e.type == net::ClientEventType::desync) {
-      event = true;
+      if (!first) first = e.frame;
       EXPECT_GE(e.frame, 51U);
       EXPECT_NE(e.local_hash, e.remote_hash);
     }
-  EXPECT_TRUE(event);
+  ASSERT_TRUE(first.has_value());
+  // Its side of the first desync, as a peer session keeps it: the last agreed state, the
+  // divergent one, and the server's units of every frame before it.
+  const net::DesyncEvidence* e = m.client(1)->desync_evidence();
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->divergent_frame, *first);
+  EXPECT_LE(e->agreed_frame, 50U);  // the last check before the fault
+  EXPECT_LT(e->agreed_frame, e->divergent_frame);
+  EXPECT_EQ(e->player, 3U);  // the server: no seat of its own
+  EXPECT_EQ(e->confirmed_frames.size(), *first * net::server_protocol::unit_size(3, 4));
+  EXPECT_FALSE(e->agreed_state.empty());
+  EXPECT_FALSE(e->divergent_state.empty());
+  EXPECT_NE(e->local_hash, e->remote_hash);
+  // Re-simulating the evidence from the agreed state with its units reaches the divergent state
+  // (the fault is this machine's own, so it repeats), and the server's other clients have none.
+  test::CounterGame replay;
+  replay.fault_frame = 50;
+  replay.load(e->agreed_state);
+  const std::size_t unit = net::server_protocol::unit_size(3, 4);
+  for (std::uint64_t f = e->agreed_frame; f < e->divergent_frame; ++f) {
+    const std::span<const std::uint8_t> u =
+        std::span<const std::uint8_t>(e->confirmed_frames).subspan(f * unit, unit);
+    std::vector<net::InputStatus> status(3);
+    for (std::size_t p = 0; p < 3; ++p)
+      status[p] = (u[0] >> p) & 1U ? net::InputStatus::disconnected : net::InputStatus::confirmed;
+    replay.advance(net::FrameInputs{f, 4, u.subspan(1), status}, false);
+  }
+  std::vector<std::uint8_t> state;
+  EXPECT_EQ(replay.save(state), e->local_hash);
+  EXPECT_EQ(state, e->divergent_state);
+  EXPECT_EQ(m.client(0)->desync_evidence(), nullptr);
 }
 
 TEST(NetServer, AFullServerTurnsAClientAwayAndASeatCanBeAskedFor) {

@@ -46,6 +46,10 @@ Status check_client(const ClientConfig& c) {
 
 }  // namespace
 
+/// The most bytes of units a client logs for desync evidence (about 10 hours of an 8-player match
+/// of 3-byte inputs at 60 Hz); beyond, it keeps playing without evidence.
+constexpr std::size_t max_log_bytes = std::size_t{64} << 20;
+
 namespace detail {
 
 /// A ring of byte blocks of one size, by frame.
@@ -109,6 +113,15 @@ struct Client::Impl {
   std::deque<std::pair<std::uint64_t, std::uint64_t>> checks;
   std::uint64_t server_hash = 0;
   std::uint64_t server_hash_frame = 0;
+  // Evidence of the first desync (DesyncEvidence): the server's units of every frame from 0 (the
+  // log, while it is whole: a client that joined late, or skipped frames, has none), and the
+  // state of the last frame whose hash matched the server's.
+  std::vector<std::uint8_t> log;
+  bool log_whole = true;
+  std::uint64_t agreed_frame = 0;
+  std::vector<std::uint8_t> agreed_state;
+  std::optional<DesyncEvidence> evidence;
+  std::vector<std::uint8_t> initial_state;  ///< the game's state at frame 0
   // Time sync: the server's frame as its newest update told it, when that arrived, and the
   // smoothed round trip (7/8 old, 1/8 new, as TCP's).
   std::uint64_t server_frame = 0;
@@ -283,6 +296,11 @@ struct Client::Impl {
       const std::span<const std::uint8_t> src = std::span<const std::uint8_t>(units).subspan(
           static_cast<std::size_t>(f - u.start) * unit_bytes, unit_bytes);
       std::copy(src.begin(), src.end(), known.at(f).begin());
+      if (log_whole && log.size() + unit_bytes <= max_log_bytes) {
+        log.insert(log.end(), src.begin(), src.end());
+      } else {
+        log_whole = false;
+      }
     }
     if (end <= auth_end) return;
     auth_end = end;
@@ -327,12 +345,39 @@ struct Client::Impl {
       checks.pop_front();
       checked = std::max(checked, frame);
       if (mine == hash) {
-        stats.checks_passed += 1;
+        passed(frame);
       } else {
-        stats.desyncs += 1;
-        events.push_back({ClientEventType::desync, frame, mine, hash, "desync"});
+        diverged(frame, mine, hash);
       }
     }
+  }
+
+  /// The server's hash of state frame `frame` matched this client's (kept in the ring).
+  void passed(std::uint64_t frame) {
+    stats.checks_passed += 1;
+    if (evidence || !log_whole) return;
+    agreed_frame = frame;
+    agreed_state = states[static_cast<std::size_t>(frame % window)];
+  }
+
+  /// It did not, with every input before it right: a desync; the first one's evidence is kept
+  /// (for a desync report: both states, and every frame's units before it).
+  void diverged(std::uint64_t frame, std::uint64_t mine, std::uint64_t theirs) {
+    stats.desyncs += 1;
+    events.push_back({ClientEventType::desync, frame, mine, theirs, "desync"});
+    // The report's frames carry one byte of absent players: 8 seats at most.
+    if (evidence || !log_whole || sizes.players > 8 || log.size() < frame * unit_bytes) return;
+    DesyncEvidence e;
+    e.player = static_cast<std::uint32_t>(sizes.players);  // the server: no seat of its own
+    e.agreed_frame = agreed_frame;
+    e.agreed_state = agreed_frame == 0 && agreed_state.empty() ? initial_state : agreed_state;
+    e.divergent_frame = frame;
+    e.divergent_state = states[static_cast<std::size_t>(frame % window)];
+    e.local_hash = mine;
+    e.remote_hash = theirs;
+    e.confirmed_frames.assign(log.begin(),
+                              log.begin() + static_cast<std::ptrdiff_t>(frame * unit_bytes));
+    evidence = std::move(e);
   }
 
   // --- snapshots -------------------------------------------------------------------------------
@@ -393,6 +438,7 @@ struct Client::Impl {
 
   /// Plays from a snapshot: the game takes its state, and frames from there on are predicted.
   void start_from(const detail::ServerSnapshot& s) {
+    log_whole = s.frame == 0;  // a late joiner holds no units of the frames before it
     game->load(s.state);
     present = s.frame;
     verified = s.frame;
@@ -428,6 +474,7 @@ struct Client::Impl {
       present = s.frame;
       verified = s.frame;
       if (auth_end < s.frame) {
+        log_whole = false;  // frames it never had the units of
         auth_end = s.frame;
         base_frame = s.frame;
         base_unit = s.unit;
@@ -441,15 +488,12 @@ struct Client::Impl {
     if (s.frame == present) state_hashes[slot] = game->save(states[slot]);
     const std::uint64_t mine = state_hashes[slot];
     if (mine == ready_hash) {
-      stats.checks_passed += 1;
+      passed(s.frame);
       return;
     }
     // Differs. With every input before it right, that is a desync; else a misprediction the
     // server's units have not told yet. Either way the server's state is the one.
-    if (s.frame <= verified) {
-      stats.desyncs += 1;
-      events.push_back({ClientEventType::desync, s.frame, mine, ready_hash, "desync"});
-    }
+    if (s.frame <= verified) diverged(s.frame, mine, ready_hash);
     const std::uint64_t end = present;
     game->load(s.state);
     state_hashes[slot] = game->save(states[slot]);
@@ -570,8 +614,7 @@ struct Client::Impl {
 
   Status start(Game& g) {
     if (phase != Phase::welcomed) return Status::error("Client::start: not welcomed (or started)");
-    std::vector<std::uint8_t> scratch;
-    const std::uint64_t hash = g.save(scratch);
+    const std::uint64_t hash = g.save(initial_state);
     if (hash != welcomed.initial_hash)
       return Status::error("Client::start: this game's initial state hashes " +
                            std::to_string(hash) + ", the server's " +
@@ -712,6 +755,10 @@ const ClientStats& Client::stats() const noexcept {
 
 std::vector<ClientEvent> Client::take_events() {
   return std::exchange(impl_->events, {});
+}
+
+const DesyncEvidence* Client::desync_evidence() const noexcept {
+  return impl_->evidence ? &*impl_->evidence : nullptr;
 }
 
 std::string_view Client::failure() const noexcept {

@@ -27,6 +27,8 @@
 #include <detsim/net/client.hpp>
 #include <detsim/net/server.hpp>
 #include <detsim/net/udp.hpp>
+#include <detsim/replay/desync_report.hpp>
+#include <detsim/replay/replay.hpp>
 #include <detsim/scenario_net/scenario_game.hpp>
 #include <detsim/scenario_net/scenario_recorder.hpp>
 
@@ -360,6 +362,9 @@ class ServerClient {
     std::fflush(stdout);
   }
   void advance();
+  /// --desync-report: this machine's side of its first desync, for `detsim bisect` beside the
+  /// server's replay.
+  void write_desync_report();
   int report(double seconds);
 
   const NetplayArgs& args_;
@@ -368,6 +373,8 @@ class ServerClient {
   std::optional<net::Client> client_;
   std::optional<Scenario> scenario_;
   std::optional<net::ScenarioGame> game_;
+  std::optional<replay::Fingerprint> initial_fingerprint_;
+  bool report_written_ = false;
   std::vector<net::ClientEvent> desyncs_;
   std::uint64_t ticks_ = 0;
   std::string failure_;
@@ -411,11 +418,33 @@ Status ServerClient::start_game() {
       return apply_injections(s.world(), list);
     });
   }
+  // A desync report names the match by the fingerprint of the scenario at frame 0.
+  if (!args_.desync_report.empty()) initial_fingerprint_ = replay::fingerprint_of(*scenario_);
   if (Status s = client_->start(*game_); !s) return s;
   say(d->scenario + " (seed " + std::to_string(d->seed) + ", " + std::to_string(d->players) +
       " players): player " + std::to_string(w.player) + " of the server at " + args_.server +
       (w.start_frame > 0 ? ", joining at frame " + std::to_string(w.start_frame) : ""));
   return Status::success();
+}
+
+void ServerClient::write_desync_report() {
+  const net::DesyncEvidence* evidence = client_->desync_evidence();
+  Status written = Status::error(
+      "this client kept no evidence of the desync (it joined the match under way, or the match "
+      "has more than 8 seats)");
+  if (evidence != nullptr) {
+    auto report =
+        net::desync_report(*initial_fingerprint_, client_->welcome()->player, *evidence, *game_);
+    written =
+        report ? replay::write_desync_report(args_.desync_report, report.value()) : report.status();
+  }
+  if (!written) {
+    std::fprintf(stderr, "detsim netplay: --desync-report %s: %s\n", args_.desync_report.c_str(),
+                 written.message().c_str());
+    return;
+  }
+  report_written_ = true;
+  say("desync report written to " + args_.desync_report);
 }
 
 void ServerClient::advance() {
@@ -446,8 +475,12 @@ int ServerClient::run() {
     for (const net::ClientEvent& e : client_->take_events()) {
       if (e.type == net::ClientEventType::desync) {
         desyncs_.push_back(e);
+        if (args_.json)
+          std::fprintf(stderr, "detsim netplay: DESYNC with the server at frame %llu\n",
+                       static_cast<unsigned long long>(e.frame));
         say("DESYNC at frame " + std::to_string(e.frame) + ": this machine " + hex(e.local_hash) +
             ", the server " + hex(e.remote_hash));
+        if (!args_.desync_report.empty() && desyncs_.size() == 1) write_desync_report();
       } else if (e.type == net::ClientEventType::running) {
         say("running from frame " + std::to_string(e.frame));
       }
@@ -502,8 +535,8 @@ int ServerClient::report(double seconds) {
   const int code = desyncs_.empty() && s.desyncs == 0 ? exit_ok : exit_check_failed;
   const double per_second = seconds > 0 ? static_cast<double>(s.bytes_received) / seconds : 0.0;
   if (args_.json) {
-    Json()
-        .str("server", args_.server)
+    Json j;
+    j.str("server", args_.server)
         .num("player", client_->welcome()->player)
         .num("frames", client_->current_frame())
         .hash("final_hash", client_->server_hash())
@@ -517,8 +550,13 @@ int ServerClient::report(double seconds) {
         .real("bytes_received_per_second", per_second)
         .num("bytes_sent", s.bytes_sent)
         .num("rtt_ms", s.rtt_ms)
-        .real("match_seconds", seconds)
-        .print();
+        .real("match_seconds", seconds);
+    if (report_written_) {
+      j.str("desync_report", args_.desync_report);
+    } else {
+      j.null("desync_report");
+    }
+    j.print();
     return code;
   }
   std::printf("frames       %llu, final hash %s\n",
@@ -533,6 +571,7 @@ int ServerClient::report(double seconds) {
               static_cast<unsigned long long>(s.checks_passed));
   std::printf("down         %.0f bytes/s; round trip %llu ms\n", per_second,
               static_cast<unsigned long long>(s.rtt_ms));
+  if (report_written_) std::printf("desync report %s\n", args_.desync_report.c_str());
   return code;
 }
 

@@ -178,10 +178,16 @@ Expected<NetplayPlan> netplay_plan(const NetplayArgs& a) {
   const std::uint32_t lowest = std::max(2U, info->min_players);
   if (info->max_players < 2)
     return Status::error("--scenario " + a.scenario + " takes no players to play over a network");
-  if (a.players < lowest || a.players > info->max_players)
+  // A peer-to-peer session plays at most 8 (a game server, detsim serve, up to 64).
+  const std::uint32_t highest = std::min(info->max_players, max_session_players);
+  if (a.players < lowest || a.players > highest)
     return Status::error("--players must be " + std::to_string(lowest) + " .. " +
-                         std::to_string(info->max_players) + " (the " + a.scenario +
-                         " scenario's range), got " + std::to_string(a.players));
+                         std::to_string(highest) + " (the " + a.scenario + " scenario's range" +
+                         (info->max_players > max_session_players
+                              ? " in a peer-to-peer match; detsim serve takes up to " +
+                                    std::to_string(info->max_players)
+                              : std::string()) +
+                         "), got " + std::to_string(a.players));
   if (Status s = check_role(a); !s) return s;
   NetplayPlan plan;
   if (a.mode == "rollback") {

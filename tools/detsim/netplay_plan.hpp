@@ -24,6 +24,8 @@ inline constexpr std::string_view netplay_name = "netplay";
 inline constexpr std::uint64_t netplay_linger_us = 500'000;
 /// The pause between polls while there is nothing to do.
 inline constexpr std::uint64_t netplay_idle_sleep_us = 1'000;
+/// SessionConfig::players allows 8.
+inline constexpr std::uint32_t max_session_players = 8;
 /// SessionConfig::spectators allows 16.
 inline constexpr std::size_t max_spectators = 16;
 /// Spectator k's PeerId on the serving player's transport: above every player index (0 .. 7).

@@ -137,6 +137,14 @@ class Client {
   [[nodiscard]] std::uint64_t checked_frame() const noexcept;
   [[nodiscard]] const ClientStats& stats() const noexcept;
   [[nodiscard]] std::vector<ClientEvent> take_events();
+  /// This client's side of its first desync (as a peer session keeps it: net::desync_report
+  /// makes a desync report of it, which `detsim bisect` compares with the server's replay): the
+  /// state of the last frame whose hash matched the server's, the divergent state, and the
+  /// server's units of every frame before it. `player` is the number of seats (the server has
+  /// none). nullptr before a desync, and for a client that cannot give every frame's units: one
+  /// that joined a match under way, or of more than 8 seats (a report's frames carry one byte of
+  /// absent players).
+  [[nodiscard]] const DesyncEvidence* desync_evidence() const noexcept;
   /// Why the client stopped (rejected, server lost), or empty.
   [[nodiscard]] std::string_view failure() const noexcept;
 
