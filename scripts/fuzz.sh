@@ -5,6 +5,8 @@
 #           short replays), findings build-fuzz/findings
 #   packet  fuzz/net_packet_fuzz.cpp, the session wire protocol decoder: corpus
 #           build-fuzz/corpus-packet (seeded with valid datagrams), findings build-fuzz/findings-packet
+#   server  fuzz/net_server_fuzz.cpp, the game server's protocol decoder and a live server sprayed
+#           by a stranger (its frames must not change): corpus build-fuzz/corpus-server
 #   snapshot  fuzz/net_snapshot_fuzz.cpp, the rejoin snapshot decoder (net/src/snapshot.hpp):
 #           corpus build-fuzz/corpus-snapshot (seeded with valid snapshots, compressed and not)
 #   state   fuzz/state_restore_fuzz.cpp, World::restore (refusals change nothing, accepted bytes are
@@ -22,10 +24,11 @@ build="${DETSIM_FUZZ_BUILD:-build-fuzz}"
 case "$target" in
   replay) fuzzer=replay_reader_fuzz seeds=make_seeds suffix="" max_len=65536 ;;
   packet) fuzzer=net_packet_fuzz seeds=make_packet_seeds suffix=-packet max_len=1300 ;;
+  server) fuzzer=net_server_fuzz seeds=make_server_seeds suffix=-server max_len=4096 ;;
   snapshot) fuzzer=net_snapshot_fuzz seeds=make_snapshot_seeds suffix=-snapshot max_len=65536 ;;
   state) fuzzer=state_restore_fuzz seeds=make_state_seeds suffix=-state max_len=16384 ;;
   api) fuzzer=world_api_fuzz seeds="" suffix=-api max_len=4096 ;;
-  *) echo "usage: scripts/fuzz.sh [SECONDS] [replay|packet|snapshot|state|api]" >&2; exit 2 ;;
+  *) echo "usage: scripts/fuzz.sh [SECONDS] [replay|packet|server|snapshot|state|api]" >&2; exit 2 ;;
 esac
 flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
 cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \

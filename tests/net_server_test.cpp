@@ -3,6 +3,7 @@
 // restarts, bad networks, forged datagrams, and state authority's snapshots.
 #include <gtest/gtest.h>
 
+#include <detsim/core/hash.hpp>
 #include <detsim/net/client.hpp>
 #include <detsim/net/server.hpp>
 #include <detsim/net/server_protocol.hpp>
@@ -288,6 +289,97 @@ TEST(NetServer, StateAuthorityReconstructsTheServersStateThroughLoss) {
     EXPECT_GT(m.client(c)->stats().snapshots_received, 10U);
     EXPECT_GT(m.client(c)->stats().checks_passed, 0U);
   }
+}
+
+/// A game with a public part (frame and an accumulator of every input, 16 bytes) and a large
+/// cosmetic one (2 KiB that churn every frame, a function of the frame alone): what a view can
+/// leave out of the snapshots, since every client computes it alike.
+class Churn final : public net::Game {
+ public:
+  std::uint64_t save(std::vector<std::uint8_t>& state) override {
+    state.assign(16 + cosmetic_.size(), 0);
+    for (int i = 0; i < 8; ++i) {
+      state[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(frame_ >> (8 * i));
+      state[static_cast<std::size_t>(8 + i)] = static_cast<std::uint8_t>(acc_ >> (8 * i));
+    }
+    std::copy(cosmetic_.begin(), cosmetic_.end(), state.begin() + 16);
+    return hash_bytes(state);
+  }
+  void load(std::span<const std::uint8_t> state) override {
+    frame_ = acc_ = 0;
+    for (int i = 0; i < 8; ++i) {
+      frame_ |= std::uint64_t{state[static_cast<std::size_t>(i)]} << (8 * i);
+      acc_ |= std::uint64_t{state[static_cast<std::size_t>(8 + i)]} << (8 * i);
+    }
+    std::copy(state.begin() + 16, state.end(), cosmetic_.begin());
+  }
+  void advance(const net::FrameInputs& inputs, bool) override {
+    for (const std::uint8_t b : inputs.bytes)
+      acc_ = acc_ * 1099511628211ULL + b;
+    ++frame_;
+    std::uint64_t x = frame_ * 0x9E3779B97F4A7C15ULL;
+    for (std::uint8_t& b : cosmetic_) {
+      x ^= x >> 29;
+      x *= 0xBF58476D1CE4E5B9ULL;
+      b = static_cast<std::uint8_t>(x >> 56);
+    }
+  }
+
+ private:
+  std::uint64_t frame_ = 0;
+  std::uint64_t acc_ = 0;
+  std::vector<std::uint8_t> cosmetic_ = std::vector<std::uint8_t>(2048, 0);
+};
+
+TEST(NetServer, AViewSendsEachClientOnlyWhatItSelectsAndStillEndsExact) {
+  ServerMatchOptions o;
+  o.clients = 2;
+  o.frames = 300;
+  o.authority = sp::Authority::state;
+  o.snapshot_interval = 2;
+  o.link.latency_us = 20'000;
+  o.link.loss_ppm = 20'000;
+  o.make_game = [] { return std::make_unique<Churn>(); };
+  ServerMatch whole(o);
+  ASSERT_TRUE(whole.run());
+  expect_all_agree(whole, 2);
+  // The view: the public 16 bytes only; a client puts them into its own state.
+  o.configure_server = [](net::ServerConfig& c) {
+    c.view = [](std::uint32_t, std::span<const std::uint8_t> state,
+                std::vector<std::uint8_t>& out) { out.assign(state.begin(), state.begin() + 16); };
+  };
+  o.configure_client = [](std::uint32_t, net::ClientConfig& c) {
+    c.view = [](std::uint32_t, std::span<const std::uint8_t> state,
+                std::vector<std::uint8_t>& out) { out.assign(state.begin(), state.begin() + 16); };
+    c.merge_view = [](std::span<const std::uint8_t> view, std::vector<std::uint8_t>& state) {
+      std::copy(view.begin(), view.end(), state.begin());
+    };
+  };
+  ServerMatch viewed(o);
+  ASSERT_TRUE(viewed.run());
+  expect_all_agree(viewed, 2);  // the whole states, cosmetic part included, still equal
+  std::uint64_t whole_bytes = 0;
+  std::uint64_t viewed_bytes = 0;
+  for (const net::ServerClientStats& c : whole.server().client_stats())
+    whole_bytes += c.snapshot_bytes_sent;
+  for (const net::ServerClientStats& c : viewed.server().client_stats())
+    viewed_bytes += c.snapshot_bytes_sent;
+  EXPECT_LT(viewed_bytes * 4, whole_bytes) << viewed_bytes << " vs " << whole_bytes;
+  for (std::uint32_t c = 0; c < 2; ++c)
+    EXPECT_GT(viewed.client(c)->stats().snapshots_received, 50U);
+  // A view is for state authority, and a client's view comes with its merge.
+  test::CounterGame game;
+  auto network = net::SimNetwork::create(2, 1).value();
+  net::ServerConfig bad;
+  bad.view = [](std::uint32_t, std::span<const std::uint8_t>, std::vector<std::uint8_t>&) {};
+  auto s = net::Server::create(bad, game, network.endpoint(0));
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("view"), std::string::npos);
+  net::ClientConfig half;
+  half.view = bad.view;
+  auto cl = net::Client::create(half, network.endpoint(1));
+  ASSERT_FALSE(cl.ok());
+  EXPECT_NE(cl.message().find("merge_view"), std::string::npos);
 }
 
 TEST(NetServer, AnArenaMatchOfEightIsRecordedAndTheReplayVerifies) {

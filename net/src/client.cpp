@@ -11,6 +11,7 @@
 // state frame is compared once this client holds its own state of that frame.
 #include <detsim/net/client.hpp>
 
+#include <detsim/core/hash.hpp>
 #include <detsim/fixed/math.hpp>
 
 #include <algorithm>
@@ -41,6 +42,8 @@ Status check_client(const ClientConfig& c) {
   if (c.connect_interval_us == 0) return client_invalid("connect_interval_us", "must be above 0");
   if (c.keepalive_us == 0) return client_invalid("keepalive_us", "must be above 0");
   if (c.timeout_us == 0) return client_invalid("timeout_us", "must be above 0");
+  if (static_cast<bool>(c.view) != static_cast<bool>(c.merge_view))
+    return client_invalid("view", "and merge_view come together: both or neither");
   return Status::success();
 }
 
@@ -147,6 +150,7 @@ struct Client::Impl {
   std::optional<detail::ServerSnapshot> ready;  ///< decoded this poll, applied after the updates
 
   std::vector<std::uint8_t> unit;  ///< scratch
+  std::vector<std::uint8_t> view_scratch;
   std::vector<std::uint8_t> datagram;
   std::vector<Datagram> received;
   std::vector<InputStatus> status;
@@ -437,9 +441,27 @@ struct Client::Impl {
   std::uint64_t ready_hash = 0;
 
   /// Plays from a snapshot: the game takes its state, and frames from there on are predicted.
+  /// What this client loads of a server snapshot's state, given its own state `own`: the
+  /// server's whole state, or (a view: ClientConfig::view) its own with the server's view put in.
+  std::vector<std::uint8_t> to_load(const std::vector<std::uint8_t>& from_server,
+                                    std::vector<std::uint8_t> own_state) const {
+    if (!config.merge_view) return from_server;
+    config.merge_view(from_server, own_state);
+    return own_state;
+  }
+
+  /// What a server snapshot's hash covers, of this client's own state `state` (whose Game::save
+  /// hash is `hash`): the whole state, or this seat's view of it.
+  std::uint64_t snapshot_hash_of(std::span<const std::uint8_t> state, std::uint64_t hash) {
+    if (!config.view) return hash;
+    config.view(player(), state, view_scratch);
+    return hash_bytes(view_scratch);
+  }
+
   void start_from(const detail::ServerSnapshot& s) {
     log_whole = s.frame == 0;  // a late joiner holds no units of the frames before it
-    game->load(s.state);
+    // A view goes into the game's state at frame 0 (what else a late joiner has is the game's).
+    game->load(to_load(s.state, initial_state));
     present = s.frame;
     verified = s.frame;
     auth_end = s.frame;
@@ -458,7 +480,8 @@ struct Client::Impl {
     std::vector<std::uint8_t> scratch;
     if (phase == Phase::waiting) {
       start_from(s);
-      if (game->save(scratch) != ready_hash) {
+      const std::uint64_t saved = game->save(scratch);
+      if (snapshot_hash_of(scratch, saved) != ready_hash) {
         fail("the server's snapshot does not load to its hash here");
         return;
       }
@@ -470,7 +493,8 @@ struct Client::Impl {
     if (s.frame > present) {
       // The server is ahead of this client: its state is simply the one to go on from (frames
       // this client never simulated were never predicted).
-      game->load(s.state);
+      game->save(scratch);
+      game->load(to_load(s.state, scratch));
       present = s.frame;
       verified = s.frame;
       if (auth_end < s.frame) {
@@ -486,7 +510,7 @@ struct Client::Impl {
     if (s.frame + window <= present) return;  // too old to compare
     const std::size_t slot = static_cast<std::size_t>(s.frame % window);
     if (s.frame == present) state_hashes[slot] = game->save(states[slot]);
-    const std::uint64_t mine = state_hashes[slot];
+    const std::uint64_t mine = snapshot_hash_of(states[slot], state_hashes[slot]);
     if (mine == ready_hash) {
       passed(s.frame);
       return;
@@ -495,7 +519,7 @@ struct Client::Impl {
     // server's units have not told yet. Either way the server's state is the one.
     if (s.frame <= verified) diverged(s.frame, mine, ready_hash);
     const std::uint64_t end = present;
-    game->load(s.state);
+    game->load(to_load(s.state, states[slot]));
     state_hashes[slot] = game->save(states[slot]);
     present = s.frame;
     verified = std::min(verified, s.frame);

@@ -13,6 +13,8 @@
 #include <string>
 #include <utility>
 
+#include <detsim/core/hash.hpp>
+
 #include "secure_random.hpp"
 #include "server_snapshot.hpp"
 
@@ -69,6 +71,10 @@ Status check_server(const ServerConfig& c) {
   if (c.history < 16 || c.history > 100'000)
     return server_invalid("history", "must be 16 .. 100000, got " + std::to_string(c.history));
   if (c.client_timeout_us == 0) return server_invalid("client_timeout_us", "must be above 0");
+  if (c.view && c.authority != sp::Authority::state)
+    return server_invalid("view",
+                          "is for Authority::state (input authority sends inputs, which "
+                          "every client simulates)");
   if (c.snapshot_burst < 1 || c.snapshot_burst > 4096)
     return server_invalid("snapshot_burst",
                           "must be 1 .. 4096, got " + std::to_string(c.snapshot_burst));
@@ -139,10 +145,17 @@ struct Server::Impl {
   /// Authority::state: the states of the recent snapshot frames (every snapshot_interval-th),
   /// oldest first: each client's newest acknowledged one is its next snapshot's base.
   std::vector<std::pair<std::uint64_t, std::vector<std::uint8_t>>> snapshot_states;
-  /// This poll's encodings of the newest snapshot, by base frame + 1 (0: full): clients with the
-  /// same base share one.
-  std::vector<std::pair<std::uint32_t, std::vector<std::uint8_t>>> encoded;
+  /// The encodings of the newest snapshot, by (seat, base frame + 1; 0: full), with the hash of
+  /// what they carry: clients with the same base share one (without a view, the seat is any_seat).
+  struct Encoded {
+    std::uint32_t seat = 0;
+    std::uint32_t base = 0;
+    std::uint64_t hash = 0;
+    std::vector<std::uint8_t> bytes;
+  };
+  std::vector<Encoded> encoded;
   std::uint64_t encoded_frame = ~std::uint64_t{0};
+  std::vector<std::uint8_t> base_view_scratch;
   std::uint64_t state_hash = 0;
   std::uint64_t initial_hash = 0;
   std::vector<std::uint8_t> unit;  ///< scratch: the frame being simulated
@@ -458,7 +471,8 @@ struct Server::Impl {
     frame += 1;
     stats.frames += 1;
     if (config.authority == sp::Authority::state && frame % config.snapshot_interval == 0) {
-      if (snapshot_states.size() >= detail::kept_snapshot_states) snapshot_states.erase(snapshot_states.begin());
+      if (snapshot_states.size() >= detail::kept_snapshot_states)
+        snapshot_states.erase(snapshot_states.begin());
       snapshot_states.emplace_back(frame, state);
     }
   }
@@ -536,25 +550,37 @@ struct Server::Impl {
     c.last_update_frame = frame;
   }
 
-  /// The newest snapshot's bytes against base frame + 1 `base` (0: full), encoded once a frame.
-  const std::vector<std::uint8_t>& encoded_against(std::uint32_t base) {
+  /// The newest snapshot for seat `seat` against base frame + 1 `base` (0: full), encoded once a
+  /// frame per seat and base: the whole state, or (ServerConfig::view) the seat's view of it.
+  const Encoded& encoded_against(std::uint32_t seat, std::uint32_t base) {
     const auto& [snapshot_frame, snapshot] = snapshot_states.back();
     if (encoded_frame != snapshot_frame) {
       encoded.clear();
       encoded_frame = snapshot_frame;
     }
-    for (const auto& [b, bytes] : encoded)
-      if (b == base) return bytes;
+    if (!config.view) seat = sp::any_seat;
+    for (const Encoded& e : encoded)
+      if (e.seat == seat && e.base == base) return e;
     const std::vector<std::uint8_t>* base_state = nullptr;
     for (const auto& [f, st] : snapshot_states)
       if (base != 0 && f + 1 == base) base_state = &st;
     detail::ServerSnapshot s;
     s.frame = snapshot_frame;
     s.unit = unit_before(snapshot_frame);
-    s.state = snapshot;
-    encoded.emplace_back(
-        base, detail::encode_server_snapshot(s, config.players, config.input_size, base_state));
-    return encoded.back().second;
+    Encoded e{seat, base, hash_at(snapshot_frame), {}};
+    if (config.view) {
+      config.view(seat, snapshot, s.state);
+      e.hash = hash_bytes(s.state);
+      if (base_state != nullptr) {
+        config.view(seat, *base_state, base_view_scratch);
+        base_state = &base_view_scratch;
+      }
+    } else {
+      s.state = snapshot;
+    }
+    e.bytes = detail::encode_server_snapshot(s, config.players, config.input_size, base_state);
+    encoded.push_back(std::move(e));
+    return encoded.back();
   }
 
   /// Authority::state: the newest snapshot to `c`, against the newest it acknowledged (when the
@@ -565,10 +591,11 @@ struct Server::Impl {
     for (const auto& [f, st] : snapshot_states)
       if (f + 1 == c.snapshot_ack) base = c.snapshot_ack;
     Outgoing& o = c.snapshot;
+    const Encoded& e = encoded_against(c.player, base);
     o.frame = static_cast<std::uint32_t>(newest);
     o.base = base;
-    o.hash = hash_at(newest);
-    o.bytes = encoded_against(base);
+    o.hash = e.hash;
+    o.bytes = e.bytes;
     o.cursor = 0;
     o.rest_until_us = 0;
     c.stats.snapshots_sent += 1;

@@ -17,6 +17,10 @@ net::SimNetwork make_network(const ServerMatchOptions& o) {
 
 ServerMatch::Side ServerMatch::make_side() const {
   Side side;
+  if (options_.make_game) {
+    side.game = options_.make_game();
+    return side;
+  }
   if (options_.scenario.empty()) {
     side.game = std::make_unique<CounterGame>();
     return side;

@@ -26,6 +26,9 @@ struct ServerMatchOptions {
   /// A scenario every side plays (through ScenarioGame; its input size and the scripted bots'
   /// inputs, seeded with `seed`), with `players` seats; empty: CounterGame.
   std::string scenario;
+  /// Another game for every side (neither CounterGame nor a scenario); its input size must be
+  /// input_size.
+  std::function<std::unique_ptr<net::Game>()> make_game;
   /// With a scenario: the server records the match to this replay file.
   std::string record;
   std::uint32_t clients = 2;

@@ -45,6 +45,10 @@ struct ClientConfig {
   std::uint64_t connect_interval_us = 200'000;  ///< connect resend interval
   std::uint64_t keepalive_us = 100'000;         ///< the longest silence towards the server
   std::uint64_t timeout_us = 5'000'000;         ///< server silence before it is lost
+  /// The server's ServerConfig::view (the same function), and how this client puts a view of the
+  /// server's state into its own (server_protocol.hpp). Both or neither.
+  StateView view;
+  MergeView merge_view;
 };
 
 enum class ClientEventType : std::uint8_t {

@@ -66,6 +66,10 @@ struct ServerConfig {
   std::uint64_t client_timeout_us = 3'000'000;
   /// Snapshot slices sent to one client per poll while it has none of the current one.
   std::uint32_t snapshot_burst = 32;
+  /// Authority::state: per-client relevancy (server_protocol.hpp, StateView): each client is sent
+  /// the view of the state this gives for its seat. Empty: the whole state to everyone. Its
+  /// clients need the same function and a MergeView (ClientConfig).
+  StateView view;
 };
 
 /// One client as the server sees it.

@@ -45,12 +45,31 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string_view>
 #include <vector>
 
 #include <detsim/net/protocol.hpp>
 #include <detsim/net/transport.hpp>
+
+namespace detsim::net {
+
+/// Per-client relevancy under Authority::state (ServerConfig::view, ClientConfig::view): the part
+/// of a state (Game::save's bytes) that seat `player` is sent and checked against, written to
+/// `out`. The same function on the server and on that client: the server sends the view of its
+/// state, delta-coded against the view of the client's base, with the view's hash; the client
+/// compares it with the view of its own state, and on a difference merges the server's view into
+/// its own state (ClientConfig::merge_view) and loads that. What a partial state means is the
+/// game's to say (a scene's far parts, a player's hidden cards).
+using StateView = std::function<void(std::uint32_t player, std::span<const std::uint8_t> state,
+                                     std::vector<std::uint8_t>& out)>;
+/// The client's side of a view: `state` (a state this client saved) with `view` (the server's
+/// view of its state at the same frame) put in, in place.
+using MergeView =
+    std::function<void(std::span<const std::uint8_t> view, std::vector<std::uint8_t>& state)>;
+
+}  // namespace detsim::net
 
 namespace detsim::net::server_protocol {
 
