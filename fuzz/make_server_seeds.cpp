@@ -81,8 +81,8 @@ int main(int argc, char** argv) {
   for (const sp::Packet& p : samples()) {
     for (const sp::Sizes sizes : {sp::Sizes{1, 3}, sp::Sizes{3, 4}}) {
       std::vector<std::uint8_t> bytes;
-      if (!sp::encode(p, sizes, bytes)) return 1;
-      for (const std::uint8_t mode : {0, 1}) {
+      if (!sp::encode(p, sizes, bytes)) continue;  // inputs and units of the other size
+      for (const std::uint8_t mode : {std::uint8_t{0}, std::uint8_t{1}}) {
         std::vector<std::uint8_t> seed = {mode};
         seed.insert(seed.end(), bytes.begin(), bytes.end());
         write(dir + "/seed_" + std::to_string(n++), seed);
