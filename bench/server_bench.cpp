@@ -16,7 +16,8 @@
 //                          lockstep (1) sessions, input delay 2: the same figures per peer
 //   server_cost/64         input authority, arena with 64 players, 64 clients, 300 frames: the
 //                          server's CPU time per client per frame beside one step of the scene
-//                          (the server's game timed apart from the rest of the server's work)
+//                          (the server's game timed apart from the rest of the server's work),
+//                          and the bytes per client
 // Bench code is not simulation code: double and the clock are used freely here.
 #include <benchmark/benchmark.h>
 
@@ -378,7 +379,7 @@ void BM_ServerCost(benchmark::State& state) {
   state.counters["server_us_per_client_per_frame"] = per_client_frame * 1e6;
   state.counters["per_client_percent_of_step"] = 100.0 * per_client_frame / step;
   state.counters["save_us"] = (r.game_seconds - r.step_seconds) / frames * 1e6;
-  state.counters["agreed"] = r.agreed ? 1 : 0;
+  report_bandwidth(state, r);  // bytes per client (and agreed)
 }
 BENCHMARK(BM_ServerCost)->Name("server_cost")->Arg(64)->Iterations(1)->Unit(benchmark::kSecond);
 

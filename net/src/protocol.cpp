@@ -255,15 +255,13 @@ bool encode(const Packet& packet, std::size_t input_size, std::vector<std::uint8
 }
 
 DecodeError decode(std::span<const std::uint8_t> bytes, std::size_t input_size, Packet& out) {
-  if (bytes.size() > max_datagram) return DecodeError::too_long;
-  if (bytes.size() < header_size + trailer_size) return DecodeError::too_short;
-  if (bytes[0] != magic0 || bytes[1] != magic1) return DecodeError::bad_magic;
-  if (bytes[2] != version) return DecodeError::bad_version;
-  if (!known_type(bytes[3])) return DecodeError::bad_type;
-  const std::span<const std::uint8_t> signed_part = bytes.first(bytes.size() - trailer_size);
-  Reader trailer(bytes.last(trailer_size));
-  if (trailer.u32() != checksum(signed_part)) return DecodeError::bad_checksum;
+  static_assert(header_size == 14 && trailer_size == 4);  // wire::check_plain's framing
+  const wire::PlainFraming framing{magic0, magic1, version,
+                                   static_cast<std::uint8_t>(PacketType::hello),
+                                   static_cast<std::uint8_t>(PacketType::state_chunk)};
+  if (const DecodeError e = wire::check_plain(bytes, framing); e != DecodeError::none) return e;
   if (input_size == 0 || input_size > max_unit_size) return DecodeError::bad_field;
+  const std::span<const std::uint8_t> signed_part = bytes.first(bytes.size() - trailer_size);
 
   Reader in(signed_part);
   in.get(4);  // magic, version, type: checked above

@@ -82,4 +82,19 @@ bool run_length_decode(Reader& in, std::size_t length, std::vector<std::uint8_t>
   return true;
 }
 
+protocol::DecodeError check_plain(std::span<const std::uint8_t> bytes,
+                                  const PlainFraming& f) noexcept {
+  using protocol::DecodeError;
+  constexpr std::size_t header = 14;
+  constexpr std::size_t trailer = 4;
+  if (bytes.size() > max_datagram) return DecodeError::too_long;
+  if (bytes.size() < header + trailer) return DecodeError::too_short;
+  if (bytes[0] != f.magic0 || bytes[1] != f.magic1) return DecodeError::bad_magic;
+  if (bytes[2] != f.version) return DecodeError::bad_version;
+  if (bytes[3] < f.first_type || bytes[3] > f.last_type) return DecodeError::bad_type;
+  Reader sum(bytes.last(trailer));
+  if (sum.u32() != checksum(bytes.first(bytes.size() - trailer))) return DecodeError::bad_checksum;
+  return DecodeError::none;
+}
+
 }  // namespace detsim::net::wire

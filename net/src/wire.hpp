@@ -10,6 +10,8 @@
 #include <span>
 #include <vector>
 
+#include <detsim/net/protocol.hpp>
+
 namespace detsim::net::wire {
 
 class Reader {
@@ -86,5 +88,22 @@ void run_length_encode(std::span<const std::uint8_t> bytes, std::vector<std::uin
 /// past `length` or a short read (never a write past the buffer).
 [[nodiscard]] bool run_length_decode(Reader& in, std::size_t length,
                                      std::vector<std::uint8_t>& out);
+
+/// A plain framing: magic (2 bytes) | version | type (first_type .. last_type) | the rest of a
+/// 14-byte header | body | the 4-byte checksum trailer. The session protocol's ("DN") and the
+/// server protocol's ("DG").
+struct PlainFraming {
+  std::uint8_t magic0;
+  std::uint8_t magic1;
+  std::uint8_t version;
+  std::uint8_t first_type;
+  std::uint8_t last_type;
+};
+
+/// Checks a datagram's framing: its length (a 14-byte header and the trailer, at most
+/// max_datagram), magic, version, type and checksum, in that order; DecodeError::none when all
+/// hold (the header's other fields and the body are the caller's to read).
+[[nodiscard]] protocol::DecodeError check_plain(std::span<const std::uint8_t> bytes,
+                                                const PlainFraming& framing) noexcept;
 
 }  // namespace detsim::net::wire
