@@ -493,6 +493,40 @@ TEST(NetServer, AFullServerTurnsAClientAwayAndASeatCanBeAskedFor) {
   EXPECT_TRUE(m.client(1)->ended());
 }
 
+TEST(NetServer, ClientsThatComeAndGoCostABoundedRecord) {
+  // 300 clients, one after the other, take the one seat and leave: the server keeps the
+  // statistics of the newest 256 and reuses the slot, so memory does not grow with them.
+  test::CounterGame game;
+  auto network = net::SimNetwork::create(2, 1).value();
+  net::ServerConfig config;
+  config.players = 1;
+  config.game = 9;
+  auto server = net::Server::create(config, game, network.endpoint(0)).value();
+  std::uint64_t now = 0;
+  for (int k = 0; k < 300; ++k) {
+    net::ClientConfig cc;
+    cc.game = 9;
+    auto client = net::Client::create(cc, network.endpoint(1)).value();
+    for (int i = 0; i < 50 && client.welcome() == nullptr; ++i) {
+      now += 1000;
+      network.advance_to(now);
+      client.poll(now);
+      server.poll(now);
+    }
+    ASSERT_NE(client.welcome(), nullptr) << k;
+    client.leave();
+    now += 1000;
+    network.advance_to(now);
+    server.poll(now);
+  }
+  EXPECT_EQ(server.stats().connects, 300U);
+  EXPECT_EQ(server.stats().clients_left, 300U);
+  const std::vector<net::ServerClientStats> stats = server.client_stats();
+  EXPECT_EQ(stats.size(), 256U);
+  for (const net::ServerClientStats& c : stats)
+    EXPECT_FALSE(c.connected);
+}
+
 TEST(NetServer, TheCorrectionSmootherHidesAJumpAndDecaysItsOffset) {
   using namespace detsim::literals;
   net::CorrectionSmoother smoother(2_fx);                   // halves every two frames

@@ -10,6 +10,7 @@
 #include <detsim/net/server.hpp>
 
 #include <algorithm>
+#include <deque>
 #include <string>
 #include <utility>
 
@@ -31,6 +32,8 @@ constexpr std::uint64_t late_window = 64;
 constexpr std::uint64_t keepalive_us = 100'000;
 /// How long a snapshot's slices rest after a full round before they are sent again.
 constexpr std::uint64_t snapshot_resend_us = 100'000;
+/// Gone clients whose statistics a server keeps (client_stats()).
+constexpr std::size_t max_gone_clients = 256;
 /// A connect from the peer of a client heard from within this is not a restart: ignored.
 constexpr std::uint64_t restart_quiet_us = 1'000'000;
 
@@ -131,7 +134,8 @@ struct Server::Impl {
   std::size_t unit_bytes;
   std::size_t mask_bytes;
   std::size_t ring_size;
-  std::vector<Client> clients;
+  std::vector<Client> clients;  ///< by slot; a gone client's slot is reused
+  std::deque<ServerClientStats> gone;
   std::vector<Seat> seats;
   std::uint64_t frame = 0;
   bool started = false;
@@ -326,12 +330,19 @@ struct Server::Impl {
     c.stats.peer = peer;
     c.stats.connected = true;
     c.stats.joined_frame = frame;
-    seats[static_cast<std::size_t>(seat)].client = static_cast<std::int64_t>(clients.size());
+    std::size_t slot = clients.size();  // the first slot a gone client left, or a new one
+    for (std::size_t i = 0; i < clients.size() && slot == clients.size(); ++i)
+      if (!clients[i].connected) slot = i;
+    seats[static_cast<std::size_t>(seat)].client = static_cast<std::int64_t>(slot);
     seats[static_cast<std::size_t>(seat)].last_input.assign(config.input_size, 0);
     stats.connects += 1;
     events.push_back({ServerEventType::joined, c.player, frame, peer, "joined"});
-    clients.push_back(std::move(c));
-    Client& added = clients.back();
+    if (slot == clients.size()) {
+      clients.push_back(std::move(c));
+    } else {
+      clients[slot] = std::move(c);
+    }
+    Client& added = clients[slot];
     welcome(added);
     // Joining a match under way: a snapshot of now (Authority::state sends its own).
     if (started && config.authority == sp::Authority::inputs) cut_snapshot(added, nullptr, 0);
@@ -342,6 +353,13 @@ struct Server::Impl {
     c.stats.connected = false;
     seats[c.player].client = -1;
     events.push_back({ServerEventType::left, c.player, frame, c.peer, reason});
+    // Its statistics are kept (a bounded number of them), its buffers go, and its slot is the
+    // next client's: clients that come and go for days cost a bounded amount of memory.
+    if (gone.size() >= max_gone_clients) gone.pop_front();
+    gone.push_back(c.stats);
+    c.ring = {};
+    c.ring_tag = {};
+    c.snapshot = {};
   }
 
   /// Takes the inputs of `in` into c's ring. A datagram carrying an input beyond the window (no
@@ -703,10 +721,9 @@ const ServerStats& Server::stats() const noexcept {
 }
 
 std::vector<ServerClientStats> Server::client_stats() const {
-  std::vector<ServerClientStats> out;
-  out.reserve(impl_->clients.size());
+  std::vector<ServerClientStats> out(impl_->gone.begin(), impl_->gone.end());
   for (const Impl::Client& c : impl_->clients)
-    out.push_back(c.stats);
+    if (c.connected) out.push_back(c.stats);
   return out;
 }
 

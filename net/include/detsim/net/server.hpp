@@ -154,7 +154,8 @@ class Server {
   /// ended(), and every connected client has acknowledged the last frame.
   [[nodiscard]] bool settled() const noexcept;
   [[nodiscard]] const ServerStats& stats() const noexcept;
-  /// Every client admitted so far (gone ones too), in the order they were admitted.
+  /// The clients that left (the newest 256, oldest first), then those connected now. Without
+  /// comings and goings: every client, in the order they were admitted.
   [[nodiscard]] std::vector<ServerClientStats> client_stats() const;
 
  private:
