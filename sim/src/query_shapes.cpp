@@ -140,7 +140,7 @@ void touches_of(const WorldState& s, const Query& query, const BodyState& b,
 
 /// A cast's motion: the translation, its length and its direction (translation / travel), the
 /// last two once per cast rather than once per body.
-struct Sweep {
+struct CastSweep {
   Vec3 translation;
   Fixed travel;
   Vec3 direction;
@@ -148,8 +148,8 @@ struct Sweep {
 
 /// The earliest fraction at which the cast of `query` along `sweep` meets body b, below `before`,
 /// or nothing.
-std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query, const Sweep& sweep,
-                                     const BodyState& b, Fixed before,
+std::optional<ShapeHit> cast_against(const WorldState& s, const Query& query,
+                                     const CastSweep& sweep, const BodyState& b, Fixed before,
                                      std::vector<SubManifold>& manifolds, std::vector<Gap>& gaps) {
   const Vec3 translation = sweep.translation;
   const Fixed travel = sweep.travel;
@@ -245,7 +245,7 @@ std::optional<ShapeHit> cast_shape(const WorldState& s, const Shape& shape, Vec3
   if (!query || !query->view || travel == Fixed::zero()) return std::nullopt;
   thread_local std::vector<SubManifold> manifolds;  // reused between queries
   thread_local std::vector<Gap> gaps;
-  const Sweep sweep{translation, travel, translation / travel};
+  const CastSweep sweep{translation, travel, translation / travel};
   std::optional<ShapeHit> best;
   for (const BodyState& b : s.bodies) {
     if (!passes(b, filter)) continue;
