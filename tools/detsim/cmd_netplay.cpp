@@ -303,15 +303,11 @@ bool Netplay::handle_events() {
 }
 
 void Netplay::write_desync_report() {
-  // The session keeps this machine's side of the first desync only; that is what is written.
-  const net::DesyncEvidence* evidence = session_->desync_evidence();
-  Status written = Status::error("the session kept no evidence of the desync");
-  if (evidence) {
-    // With the states of every frame between the agreed and the divergent one, re-simulated.
-    auto report = net::desync_report(*initial_fingerprint_, args_.me, *evidence, *game_);
-    written =
-        report ? replay::write_desync_report(args_.desync_report, report.value()) : report.status();
-  }
+  // The session keeps this machine's side of the first desync only; that is what is written,
+  // with the states of every frame between the agreed and the divergent one, re-simulated.
+  const Status written = write_desync_side(args_.desync_report, *initial_fingerprint_, args_.me,
+                                           session_->desync_evidence(), *game_,
+                                           "the session kept no evidence of the desync");
   if (!written) {
     std::fprintf(stderr, "detsim netplay: --desync-report %s: %s\n", args_.desync_report.c_str(),
                  written.message().c_str());

@@ -428,16 +428,11 @@ Status ServerClient::start_game() {
 }
 
 void ServerClient::write_desync_report() {
-  const net::DesyncEvidence* evidence = client_->desync_evidence();
-  Status written = Status::error(
+  const Status written = write_desync_side(
+      args_.desync_report, *initial_fingerprint_, client_->welcome()->player,
+      client_->desync_evidence(), *game_,
       "this client kept no evidence of the desync (it joined the match under way, or the match "
       "has more than 8 seats)");
-  if (evidence != nullptr) {
-    auto report =
-        net::desync_report(*initial_fingerprint_, client_->welcome()->player, *evidence, *game_);
-    written =
-        report ? replay::write_desync_report(args_.desync_report, report.value()) : report.status();
-  }
   if (!written) {
     std::fprintf(stderr, "detsim netplay: --desync-report %s: %s\n", args_.desync_report.c_str(),
                  written.message().c_str());

@@ -8,6 +8,9 @@
 #include <fstream>
 #include <optional>
 
+#include <detsim/replay/desync_report.hpp>
+#include <detsim/scenario_net/scenario_recorder.hpp>
+
 namespace detsim::cli {
 
 namespace {
@@ -259,6 +262,14 @@ std::string milliseconds(std::uint64_t us) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1f ms", static_cast<double>(us) / 1000.0);
   return text;
+}
+
+Status write_desync_side(const std::string& path, const replay::Fingerprint& fingerprint,
+                         std::uint32_t player, const net::DesyncEvidence* evidence,
+                         net::ScenarioGame& game, const char* missing) {
+  if (evidence == nullptr) return Status::error(missing);
+  auto report = net::desync_report(fingerprint, player, *evidence, game);
+  return report ? replay::write_desync_report(path, report.value()) : report.status();
 }
 
 }  // namespace detsim::cli

@@ -13,6 +13,8 @@
 #include <detsim/core/status.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/udp.hpp>
+#include <detsim/replay/replay.hpp>
+#include <detsim/scenario_net/scenario_game.hpp>
 
 #include "commands.hpp"
 
@@ -58,6 +60,13 @@ const char* key_mismatch(std::string_view reason);
 
 /// The line netplay prints about packet protection.
 std::string protection_line(const NetplayPlan& plan);
+
+/// Writes this machine's side of a desync to `path` (a player's or a server client's: `evidence`
+/// from desync_evidence(), with the states between the agreed and the divergent frame
+/// re-simulated by `game`); `missing` is the error when there is no evidence.
+Status write_desync_side(const std::string& path, const replay::Fingerprint& fingerprint,
+                         std::uint32_t player, const net::DesyncEvidence* evidence,
+                         net::ScenarioGame& game, const char* missing);
 
 /// "12.3 ms"
 std::string milliseconds(std::uint64_t us);
