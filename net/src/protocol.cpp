@@ -116,10 +116,8 @@ void put_body(const Packet& packet, std::vector<std::uint8_t>& out) {
       put_varint(out, packet.state_request.offset);
       break;
     case PacketType::state_chunk:
-      put_varint(out, packet.state_chunk.total);
-      put_varint(out, packet.state_chunk.offset);
-      put_varint(out, packet.state_chunk.data.size());
-      out.insert(out.end(), packet.state_chunk.data.begin(), packet.state_chunk.data.end());
+      wire::put_slice(out, packet.state_chunk.total, packet.state_chunk.offset,
+                      packet.state_chunk.data);
       break;
   }
 }
@@ -211,20 +209,9 @@ DecodeError get_body(Reader& in, PacketType type, std::size_t input_size, Packet
     }
     case PacketType::state_chunk: {
       StateChunk& c = out.state_chunk;
-      bool bad = false;
-      const std::uint64_t total = in.varint(bad);
-      const std::uint64_t offset = in.varint(bad);
-      const std::uint64_t length = in.varint(bad);
-      if (!in.ok()) return DecodeError::bad_length;
-      // Every bound before the copy: at most max_state_chunk bytes, inside the snapshot.
-      if (bad || total == 0 || total > max_state_transfer || length == 0 ||
-          length > max_state_chunk || offset + length > total)
-        return DecodeError::bad_field;
-      c.total = static_cast<std::uint32_t>(total);
-      c.offset = static_cast<std::uint32_t>(offset);
-      c.data.resize(static_cast<std::size_t>(length));
-      for (std::uint8_t& b : c.data)
-        b = in.u8();
+      const DecodeError e =
+          wire::read_slice(in, max_state_transfer, max_state_chunk, c.total, c.offset, c.data);
+      if (e != DecodeError::none) return e;
       break;
     }
   }

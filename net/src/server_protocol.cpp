@@ -113,10 +113,7 @@ void put_body(const Packet& p, const Sizes& sizes, std::vector<std::uint8_t>& ou
       put_varint(out, c.frame);
       put_frame(out, c.base, c.frame);
       put(out, c.hash, 8);
-      put_varint(out, c.total);
-      put_varint(out, c.offset);
-      put_varint(out, c.data.size());
-      out.insert(out.end(), c.data.begin(), c.data.end());
+      wire::put_slice(out, c.total, c.offset, c.data);
       break;
     }
     case PacketType::leave:
@@ -202,19 +199,11 @@ DecodeError get_body(Reader& in, PacketType type, const Sizes& sizes, Packet& ou
       c.frame = get_u32_varint(in, bad);
       c.base = in.frame(c.frame, bad);
       c.hash = in.u64();
-      const std::uint64_t total = in.varint(bad);
-      const std::uint64_t offset = in.varint(bad);
-      const std::uint64_t length = in.varint(bad);
       if (!in.ok()) return DecodeError::bad_length;
-      // Every bound before the copy: at most max_snapshot_chunk bytes, inside the snapshot.
-      if (bad || total == 0 || total > max_snapshot_size || length == 0 ||
-          length > max_snapshot_chunk || offset + length > total)
-        return DecodeError::bad_field;
-      c.total = static_cast<std::uint32_t>(total);
-      c.offset = static_cast<std::uint32_t>(offset);
-      c.data.resize(static_cast<std::size_t>(length));
-      for (std::uint8_t& b : c.data)
-        b = in.u8();
+      if (bad) return DecodeError::bad_field;
+      const DecodeError e =
+          wire::read_slice(in, max_snapshot_size, max_snapshot_chunk, c.total, c.offset, c.data);
+      if (e != DecodeError::none) return e;
       break;
     }
     case PacketType::leave:

@@ -82,6 +82,34 @@ bool run_length_decode(Reader& in, std::size_t length, std::vector<std::uint8_t>
   return true;
 }
 
+void put_slice(std::vector<std::uint8_t>& out, std::uint32_t total, std::uint32_t offset,
+               std::span<const std::uint8_t> data) {
+  put_varint(out, total);
+  put_varint(out, offset);
+  put_varint(out, data.size());
+  out.insert(out.end(), data.begin(), data.end());
+}
+
+protocol::DecodeError read_slice(Reader& in, std::size_t max_total, std::size_t max_chunk,
+                                 std::uint32_t& total, std::uint32_t& offset,
+                                 std::vector<std::uint8_t>& data) {
+  using protocol::DecodeError;
+  bool bad = false;
+  const std::uint64_t t = in.varint(bad);
+  const std::uint64_t o = in.varint(bad);
+  const std::uint64_t length = in.varint(bad);
+  if (!in.ok()) return DecodeError::bad_length;
+  // Every bound before the copy: at most max_chunk bytes, inside the transfer.
+  if (bad || t == 0 || t > max_total || length == 0 || length > max_chunk || o + length > t)
+    return DecodeError::bad_field;
+  total = static_cast<std::uint32_t>(t);
+  offset = static_cast<std::uint32_t>(o);
+  data.resize(static_cast<std::size_t>(length));
+  for (std::uint8_t& b : data)
+    b = in.u8();
+  return DecodeError::none;
+}
+
 protocol::DecodeError check_plain(std::span<const std::uint8_t> bytes,
                                   const PlainFraming& f) noexcept {
   using protocol::DecodeError;

@@ -89,6 +89,16 @@ void run_length_encode(std::span<const std::uint8_t> bytes, std::vector<std::uin
 [[nodiscard]] bool run_length_decode(Reader& in, std::size_t length,
                                      std::vector<std::uint8_t>& out);
 
+/// A slice of a larger transfer (a snapshot): total v | offset v | length v | length bytes.
+void put_slice(std::vector<std::uint8_t>& out, std::uint32_t total, std::uint32_t offset,
+               std::span<const std::uint8_t> data);
+/// Reads a slice, every bound checked before the copy: a total of 1 .. max_total, 1 .. max_chunk
+/// bytes, lying inside the total. bad_length for a short read, bad_field for a bound.
+[[nodiscard]] protocol::DecodeError read_slice(Reader& in, std::size_t max_total,
+                                               std::size_t max_chunk, std::uint32_t& total,
+                                               std::uint32_t& offset,
+                                               std::vector<std::uint8_t>& data);
+
 /// A plain framing: magic (2 bytes) | version | type (first_type .. last_type) | the rest of a
 /// 14-byte header | body | the 4-byte checksum trailer. The session protocol's ("DN") and the
 /// server protocol's ("DG").
