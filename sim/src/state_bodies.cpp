@@ -8,6 +8,7 @@
 // table order, then the optional values that are present. The reader accepts only canonical bytes:
 // the shortest vars, sets in first-use order and unique, a presence bit only for a value that is
 // not zero.
+#include <algorithm>
 #include <string_view>
 #include <unordered_map>
 #include <unordered_set>
@@ -408,6 +409,154 @@ bool read_bodies(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState&
   if (sets_used != set_count)
     return failed_at(set_count_at,
                      "property set " + std::to_string(sets_used) + " is used by no body");
+  return true;
+}
+
+// ---- Delta coding (state_delta.cpp) ----
+
+namespace {
+
+/// `v` plus or minus `by`, wrapping: a difference is any 64-bit pattern, and wrapping is undone
+/// exactly by the opposite shift.
+Fixed shifted(Fixed v, Fixed by, bool add) noexcept {
+  const auto a = static_cast<std::uint64_t>(v.raw());
+  const auto b = static_cast<std::uint64_t>(by.raw());
+  return Fixed::from_raw(static_cast<std::int64_t>(add ? a + b : a - b));
+}
+
+void shift_field(const BodyField& f, BodyState& b, const BodyState& by, bool add) noexcept {
+  switch (f.kind) {
+    case FieldKind::fixed:
+      b.*f.fixed = shifted(b.*f.fixed, by.*f.fixed, add);
+      break;
+    case FieldKind::vec3: {
+      Vec3& v = b.*f.vec3;
+      const Vec3 d = by.*f.vec3;
+      v = {shifted(v.x, d.x, add), shifted(v.y, d.y, add), shifted(v.z, d.z, add)};
+      break;
+    }
+    case FieldKind::quat: {
+      Quat& q = b.*f.quat;
+      const Quat d = by.*f.quat;
+      q = {shifted(q.w, d.w, add), shifted(q.x, d.x, add), shifted(q.y, d.y, add),
+           shifted(q.z, d.z, add)};
+      break;
+    }
+    case FieldKind::u32:
+      b.*f.u32 = add ? b.*f.u32 + by.*f.u32 : b.*f.u32 - by.*f.u32;
+      break;
+    case FieldKind::u64:
+      b.*f.u64 = add ? b.*f.u64 + by.*f.u64 : b.*f.u64 - by.*f.u64;
+      break;
+    case FieldKind::flag:
+      break;  // flags are sent as they are
+  }
+}
+
+/// A "bodies" payload read without its semantic checks: the property sets as they are written
+/// (their count first), and every record's motion, ID and set.
+struct BodyRecords {
+  std::span<const std::uint8_t> sets;
+  std::vector<BodyState> bodies;
+  std::vector<std::uint32_t> set_of;
+};
+
+bool read_body_records(std::span<const std::uint8_t> bytes, const StateSection& section,
+                       BodyRecords& out, std::string& error) {
+  ByteReader r(bytes.first(section.payload_offset + section.payload.size()),
+               section.payload_offset);
+  const std::uint32_t set_count = r.u32("property set count");
+  if (r.ok() && set_count > r.remaining() / kMinPropertyBytes)
+    r.fail_at(section.payload_offset, "property set count", "what the data can hold");
+  for (std::uint32_t i = 0; i < set_count && r.ok(); ++i) {
+    BodyState p;
+    read_properties(r, p);
+  }
+  out.sets = bytes.subspan(section.payload_offset, r.offset() - section.payload_offset);
+  const std::size_t body_count_at = r.offset();
+  const std::uint32_t body_count = r.u32("body count");
+  if (r.ok() && body_count > r.remaining() / kMinBodyBytes)
+    r.fail_at(body_count_at, "body count", "what the data can hold");
+  if (r.ok()) {
+    out.bodies.reserve(body_count);
+    out.set_of.reserve(body_count);
+  }
+  std::uint32_t previous_id = 0;
+  for (std::uint32_t i = 0; i < body_count && r.ok(); ++i) {
+    const std::size_t at = r.offset();
+    BodyState b;
+    std::uint32_t id_step = 0;
+    std::uint32_t set = 0;
+    read_record(r, b, id_step, set);
+    if (r.ok() && (id_step == 0 || id_step > 0xFFFFFFFFU - previous_id))
+      r.fail_at(at, "body id step", "IDs unique, ascending and below 2^32");
+    previous_id += id_step;
+    b.id = BodyId{previous_id};
+    out.bodies.push_back(b);
+    out.set_of.push_back(set);
+  }
+  if (r.ok() && !r.at_end())
+    r.fail_at(r.offset(), "bodies", "the section's end after the last body");
+  if (!r.ok()) error = r.error();
+  return r.ok();
+}
+
+/// Shifts `b`'s motion by its prediction from `base` (the same body `ahead` seconds before):
+/// velocities and every other field as they were; the sleep timer counting on while it runs; the
+/// pose carried on at the mean of the base's velocities and b's (the trapezoid rule, which a step's
+/// integration follows closely). So the pose is shifted after the velocities, whose values (b's
+/// before a shift that takes them away, after one that gives them back) it needs.
+void shift_motion(const GroupLayout& layout, BodyState& b, const BodyState& base, Fixed ahead,
+                  bool add) {
+  const auto pose = [](const BodyField& f) {
+    return f.vec3 == &BodyState::position || f.quat == &BodyState::orientation;
+  };
+  Vec3 linear = b.linear_velocity;  // b's own, while b holds them
+  Vec3 angular = b.angular_velocity;
+  BodyState by = base;
+  if (base.awake && base.sleep_time > Fixed::zero())
+    by.sleep_time = min(base.sleep_time + ahead, Fixed::from_int(1000));
+  for (const std::vector<const BodyField*>* list : {&layout.values, &layout.optional})
+    for (const BodyField* f : *list)
+      if (!pose(*f)) shift_field(*f, b, by, add);
+  if (add) {
+    linear = b.linear_velocity;
+    angular = b.angular_velocity;
+  }
+  const Fixed half = ahead >> 1;
+  by.position = base.position + (base.linear_velocity + linear) * half;
+  by.orientation =
+      integrate(base.orientation,
+                (base.angular_velocity + angular) * Fixed::from_raw(std::int64_t{1} << 31), ahead);
+  for (const BodyField* f : layout.values)
+    if (pose(*f)) shift_field(*f, b, by, add);
+}
+
+}  // namespace
+
+bool shift_bodies(std::span<const std::uint8_t> bytes, const StateSection& section,
+                  std::span<const std::uint8_t> base_bytes, const StateSection& base, Fixed ahead,
+                  bool add, ByteWriter& out, std::string& error) {
+  BodyRecords in;
+  BodyRecords from;
+  if (!read_body_records(bytes, section, in, error)) return false;
+  if (!read_body_records(base_bytes, base, from, error)) {
+    error = "base: " + error;
+    return false;
+  }
+  const GroupLayout& layout = motion_layout();
+  out.raw(in.sets);
+  out.u32(static_cast<std::uint32_t>(in.bodies.size()));
+  std::uint32_t previous_id = 0;
+  for (std::size_t i = 0; i < in.bodies.size(); ++i) {
+    BodyState& b = in.bodies[i];
+    const auto it =
+        std::lower_bound(from.bodies.begin(), from.bodies.end(), b.id.value,
+                         [](const BodyState& x, std::uint32_t id) { return x.id.value < id; });
+    if (it != from.bodies.end() && it->id == b.id) shift_motion(layout, b, *it, ahead, add);
+    write_record(b, previous_id, in.set_of[i], out);
+    previous_id = b.id.value;
+  }
   return true;
 }
 

@@ -423,6 +423,85 @@ bool read_state(std::span<const std::uint8_t> bytes, WorldState& s, std::string&
 
 }  // namespace
 
+// ---- Delta coding (state_delta.cpp) ----
+
+namespace {
+
+/// A "contacts" payload read without its semantic checks.
+bool read_contact_list(std::span<const std::uint8_t> bytes, const StateSection& section,
+                       std::vector<Contact>& out, std::string& error) {
+  ByteReader r(bytes.first(section.payload_offset + section.payload.size()),
+               section.payload_offset);
+  const std::uint32_t count = r.u32("contact count");
+  if (r.ok() && count > r.remaining() / kMinContactBytes)
+    r.fail_at(section.payload_offset, "contact count", "what the data can hold");
+  if (r.ok()) out.reserve(count);
+  std::uint32_t previous_a = 0;
+  for (std::uint32_t i = 0; i < count && r.ok(); ++i) {
+    out.push_back(read_contact(r, previous_a));
+    previous_a = out.back().a;
+  }
+  if (r.ok() && !r.at_end())
+    r.fail_at(r.offset(), "contacts", "the section's end after the last contact");
+  if (!r.ok()) error = r.error();
+  return r.ok();
+}
+
+Fixed shifted_impulse(Fixed v, Fixed by, bool add) noexcept {
+  const auto a = static_cast<std::uint64_t>(v.raw());
+  const auto b = static_cast<std::uint64_t>(by.raw());
+  return Fixed::from_raw(static_cast<std::int64_t>(add ? a + b : a - b));
+}
+
+}  // namespace
+
+bool shift_contacts(std::span<const std::uint8_t> bytes, const StateSection& section,
+                    std::span<const std::uint8_t> base_bytes, const StateSection& base, bool add,
+                    ByteWriter& out, std::string& error) {
+  std::vector<Contact> in;
+  std::vector<Contact> from;
+  if (!read_contact_list(bytes, section, in, error)) return false;
+  if (!read_contact_list(base_bytes, base, from, error)) {
+    error = "base: " + error;
+    return false;
+  }
+  out.u32(static_cast<std::uint32_t>(in.size()));
+  std::uint32_t previous_a = 0;
+  for (Contact& c : in) {
+    // The prediction: the base's impulses at the same feature of the same pair of sub-shapes.
+    const auto it = std::lower_bound(from.begin(), from.end(), c, contact_before);
+    if (it != from.end() && !contact_before(c, *it)) {
+      for (std::size_t p = 0; p < c.point_count; ++p) {
+        for (std::size_t q = 0; q < it->point_count; ++q) {
+          const CachedPoint& by = it->cached[q];
+          if (by.feature != c.cached[p].feature) continue;
+          CachedPoint& point = c.cached[p];
+          point.normal_impulse = shifted_impulse(point.normal_impulse, by.normal_impulse, add);
+          point.tangent_impulse_1 =
+              shifted_impulse(point.tangent_impulse_1, by.tangent_impulse_1, add);
+          point.tangent_impulse_2 =
+              shifted_impulse(point.tangent_impulse_2, by.tangent_impulse_2, add);
+          break;
+        }
+      }
+    }
+    write_contact(c, previous_a, out);
+    previous_a = c.a;
+  }
+  return true;
+}
+
+bool read_frame_and_step(std::span<const std::uint8_t> bytes, const StateSection& globals,
+                         std::uint64_t& frame, Fixed& dt, std::string& error) {
+  ByteReader r(bytes.first(globals.payload_offset + globals.payload.size()),
+               globals.payload_offset);
+  frame = r.u64("frame");
+  (void)r.u32("next body id");
+  dt = read_def(r).dt;
+  if (!r.ok()) error = r.error();
+  return r.ok();
+}
+
 }  // namespace sim_detail
 
 bool valid_section_name(std::string_view name) noexcept {
@@ -437,8 +516,14 @@ std::uint64_t section_hash(const StateSection& section) noexcept {
 }
 
 Expected<std::vector<StateSection>> read_state_sections(std::span<const std::uint8_t> bytes) {
+  return sim_detail::read_sections(bytes, sim_detail::kMagic, "\"DSIM\" (not a detsim state)");
+}
+
+Expected<std::vector<StateSection>> sim_detail::read_sections(std::span<const std::uint8_t> bytes,
+                                                              std::uint32_t magic,
+                                                              const char* expected) {
   ByteReader r(bytes);
-  if (r.u32("magic") != sim_detail::kMagic) r.fail_at(0, "magic", "\"DSIM\" (not a detsim state)");
+  if (r.u32("magic") != magic) r.fail_at(0, "magic", expected);
   const std::uint32_t version = r.u32("version");
   if (r.ok() && version != sim_detail::kVersion) {
     return Status::error("byte 4: state encoding version " + std::to_string(version) +

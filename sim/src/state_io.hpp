@@ -8,6 +8,8 @@
 #include <string>
 
 #include <detsim/core/bytes.hpp>
+#include <detsim/core/status.hpp>
+#include <detsim/sim/state_sections.hpp>
 
 #include "world_state.hpp"
 
@@ -54,5 +56,28 @@ void clear_characters(WorldState& s);
 [[nodiscard]] std::string check_particle_record(const WorldState& s, const ParticleGroup& g);
 /// The checks restore() makes of a body's motion fields ("" when valid): what --inject must keep.
 [[nodiscard]] std::string check_body_record(const BodyState& b);
+
+// ---- Delta coding (state_delta.cpp) ----
+
+/// The sections of `bytes` whose first four bytes are `magic` (a state's "DSIM", a delta's
+/// "DSDL"); `expected` names the magic in the error.
+[[nodiscard]] Expected<std::vector<StateSection>> read_sections(std::span<const std::uint8_t> bytes,
+                                                                std::uint32_t magic,
+                                                                const char* expected);
+/// The frame and the step time in a "globals" section.
+bool read_frame_and_step(std::span<const std::uint8_t> bytes, const StateSection& globals,
+                         std::uint64_t& frame, Fixed& dt, std::string& error);
+/// Writes the "bodies" payload `section` of `bytes` with every body's motion values moved by
+/// (`add`) or less (not `add`) its prediction from the body of the same ID in the base's payload
+/// `base`: the base's values, its position carried on for `ahead` seconds at its velocity. A body
+/// the base lacks is written as it is. The payloads are read without their semantic checks.
+bool shift_bodies(std::span<const std::uint8_t> bytes, const StateSection& section,
+                  std::span<const std::uint8_t> base_bytes, const StateSection& base, Fixed ahead,
+                  bool add, ByteWriter& out, std::string& error);
+/// The same for the "contacts" payload: each point's impulses against the base's at the same
+/// feature of the same pair of sub-shapes.
+bool shift_contacts(std::span<const std::uint8_t> bytes, const StateSection& section,
+                    std::span<const std::uint8_t> base_bytes, const StateSection& base, bool add,
+                    ByteWriter& out, std::string& error);
 
 }  // namespace detsim::sim_detail

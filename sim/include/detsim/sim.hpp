@@ -11,6 +11,7 @@
 #include <detsim/sim/mass.hpp>
 #include <detsim/sim/shape.hpp>
 #include <detsim/sim/shape_outline.hpp>
+#include <detsim/sim/state_delta.hpp>
 #include <detsim/sim/state_diff.hpp>
 #include <detsim/sim/state_sections.hpp>
 #include <detsim/sim/vehicle.hpp>
