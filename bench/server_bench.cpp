@@ -9,9 +9,12 @@
 //                          per client, corrections per client
 //   slow_client/8/MS       the same match, 1200 frames, with client 7 MS ms away each way (the
 //                          others 25 ms): the most any other client re-simulated, and client 7's
-//   state_cubes/1          state authority, the cubes scene (900 cubes), one client driving the
-//                          large cube, 60 snapshots per second, 60 s: kbit/s down, bit-exact (its
-//                          final state hashes as the server's, no desync)
+//   state_cubes/MODE       state authority, the cubes scene (900 cubes), one client driving the
+//                          large cube, 60 snapshots per second, 60 s, 50 ms each way, 1% loss:
+//                          kbit/s down, bit-exact (its final state hashes as the server's, no
+//                          desync); snapshots coded as the state against the newest acknowledged
+//                          (MODE 0), as the game's delta against it (1), as the game's delta
+//                          chained to the one sent before (2, the default)
 //   p2p_arena/8/MODE       the inputs_arena match played peer to peer instead, rollback (0) or
 //                          lockstep (1) sessions, input delay 2: the same figures per peer
 //   server_cost/64         input authority, arena with 64 players, 64 clients, 300 frames: the
@@ -67,8 +70,22 @@ class TimedGame final : public net::Game {
     seconds += t;
     step_seconds += t;
   }
-  double seconds = 0;       ///< in advance and save
-  double step_seconds = 0;  ///< in advance alone
+  bool encode_delta(std::span<const std::uint8_t> state, std::span<const std::uint8_t> base,
+                    std::vector<std::uint8_t>& delta) override {
+    const double t0 = thread_seconds();
+    const bool coded = code_deltas && inner_.encode_delta(state, base, delta);
+    delta_seconds += thread_seconds() - t0;
+    return coded;
+  }
+  bool decode_delta(std::span<const std::uint8_t> delta, std::span<const std::uint8_t> base,
+                    std::vector<std::uint8_t>& state) override {
+    return inner_.decode_delta(delta, base, state);
+  }
+  double seconds = 0;        ///< in advance and save
+  double step_seconds = 0;   ///< in advance alone
+  double delta_seconds = 0;  ///< in encode_delta
+  bool code_deltas = true;
+
  private:
   net::Game& inner_;
 };
@@ -101,6 +118,8 @@ struct MatchSetup {
   std::optional<std::pair<std::uint32_t, std::uint32_t>> slow;  ///< (client, latency us)
   /// Client c's bot: scripted input (seed c + 1); `drive_only_first` leaves the others idle.
   bool drive_only_first = false;
+  bool chain_snapshots = true;  ///< ServerConfig::chain_snapshots
+  bool game_deltas = true;      ///< the server's game codes deltas (Game::encode_delta)
 };
 
 struct MatchResult {
@@ -110,6 +129,7 @@ struct MatchResult {
   double server_seconds = 0;  ///< the server's CPU time, its game included
   double game_seconds = 0;    ///< its game's (advance and save)
   double step_seconds = 0;    ///< its game's advance alone
+  double delta_seconds = 0;   ///< its game's encode_delta
   std::uint64_t frames = 0;
 };
 
@@ -123,6 +143,7 @@ MatchResult play(const MatchSetup& m) {
   }
   Side server_side = make_side(m.scenario, m.clients, m.count);
   TimedGame timed(*server_side.game);
+  timed.code_deltas = m.game_deltas;
   net::ServerConfig config;
   config.players = m.clients;
   config.input_size = server_side.game->input_size();
@@ -131,6 +152,7 @@ MatchResult play(const MatchSetup& m) {
   config.authority = m.authority;
   config.update_interval = m.update_interval;
   config.snapshot_interval = m.snapshot_interval;
+  config.chain_snapshots = m.chain_snapshots;
   config.start_clients = m.clients;
   net::Server server = net::Server::create(config, timed, network.endpoint(0)).value();
   std::vector<Side> sides;
@@ -184,6 +206,7 @@ MatchResult play(const MatchSetup& m) {
   r.frames = server.current_frame();
   r.game_seconds = timed.seconds;
   r.step_seconds = timed.step_seconds;
+  r.delta_seconds = timed.delta_seconds;
   r.server_side = server.client_stats();
   for (std::uint32_t c = 0; c < m.clients; ++c) {
     std::vector<std::uint8_t> state;
@@ -266,16 +289,43 @@ void BM_StateCubes(benchmark::State& state) {
   m.link.latency_us = 50'000;
   m.link.jitter_us = 5'000;
   m.link.loss_ppm = 10'000;
+  m.game_deltas = state.range(0) >= 1;
+  m.chain_snapshots = state.range(0) >= 2;
   MatchResult r;
   for (auto _ : state)
     r = play(m);
   report_bandwidth(state, r);
-  double snapshots = 0;
-  for (const net::ClientStats& c : r.clients)
-    snapshots += static_cast<double>(c.snapshots_received);
-  state.counters["snapshots_received"] = snapshots;
+  double received = 0;
+  double received_bytes = 0;
+  for (const net::ClientStats& c : r.clients) {
+    received += static_cast<double>(c.snapshots_received);
+    received_bytes += static_cast<double>(c.snapshot_bytes_received);
+  }
+  double sent = 0;
+  double coded = 0;
+  double chained = 0;
+  for (const net::ServerClientStats& c : r.server_side) {
+    sent += static_cast<double>(c.snapshots_sent);
+    coded += static_cast<double>(c.snapshots_game_coded);
+    chained += static_cast<double>(c.snapshots_chained);
+  }
+  state.counters["snapshots_sent"] = sent;
+  state.counters["snapshots_received"] = received;
+  state.counters["snapshots_game_coded"] = coded;
+  state.counters["snapshots_chained"] = chained;
+  // Every snapshot that arrived whole, decodable or not.
+  state.counters["bytes_per_snapshot"] = sent > 0 ? received_bytes / sent : 0;
+  // The server's own work per snapshot (its game's step and save apart): coding and compressing.
+  state.counters["server_ms_per_snapshot"] =
+      sent > 0 ? (r.server_seconds - r.game_seconds) / sent * 1e3 : 0;
+  state.counters["delta_ms_per_snapshot"] = sent > 0 ? r.delta_seconds / sent * 1e3 : 0;
+  state.counters["step_ms"] = r.step_seconds / static_cast<double>(r.frames) * 1e3;
 }
-BENCHMARK(BM_StateCubes)->Name("state_cubes/1")->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(BM_StateCubes)
+    ->Name("state_cubes")
+    ->DenseRange(0, 2)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 
 /// The inputs_arena match, peer to peer: 8 sessions over the same links, each with its own game
 /// and bot, in virtual time; per peer what it sends and receives, its rollbacks and stalls.

@@ -291,6 +291,48 @@ TEST(NetServer, StateAuthorityReconstructsTheServersStateThroughLoss) {
   }
 }
 
+/// A scenario's game codes its snapshots as state deltas (ScenarioGame::encode_delta), each
+/// against the one sent before it; the clients rebuild them through loss and duplication, load
+/// them when they mispredicted, and end on the server's state. Without the chain, every snapshot
+/// is coded against the newest the client acknowledged, and every one that arrives decodes.
+TEST(NetServer, StateDeltasChainedOrAgainstTheAcknowledgedRebuildTheServersState) {
+  for (const bool chain : {true, false}) {
+    SCOPED_TRACE(chain ? "chained" : "against the acknowledged");
+    ServerMatchOptions o;
+    o.scenario = "arena";
+    o.clients = 3;
+    o.frames = 360;
+    o.seed = 5;
+    o.authority = sp::Authority::state;
+    o.snapshot_interval = 1;
+    o.update_interval = 1;
+    o.link.latency_us = 30'000;
+    o.link.jitter_us = 5'000;
+    o.link.loss_ppm = 30'000;
+    o.link.duplicate_ppm = 20'000;
+    o.configure_server = [chain](net::ServerConfig& c) { c.chain_snapshots = chain; };
+    ServerMatch m(o);
+    ASSERT_TRUE(m.run());
+    expect_all_agree(m, 3);
+    const auto stats = m.server().client_stats();
+    ASSERT_EQ(stats.size(), 3U);
+    for (std::uint32_t c = 0; c < 3; ++c) {
+      SCOPED_TRACE("client " + std::to_string(c));
+      const net::ServerClientStats& sent = stats[c];
+      const net::ClientStats& got = m.client(c)->stats();
+      // All but the first (full) snapshot and any full one after a long silence are deltas.
+      EXPECT_GT(sent.snapshots_game_coded, sent.snapshots_sent * 9 / 10);
+      if (chain) {
+        EXPECT_GT(sent.snapshots_chained, sent.snapshots_sent / 2);
+      } else {
+        EXPECT_EQ(sent.snapshots_chained, 0U);
+      }
+      EXPECT_GT(got.snapshots_received, sent.snapshots_sent / 2);
+      EXPECT_GT(got.corrections, 0U);  // mispredictions, put right by the server's states
+    }
+  }
+}
+
 /// A game with a public part (frame and an accumulator of every input, 16 bytes) and a large
 /// cosmetic one (2 KiB that churn every frame, a function of the frame alone): what a view can
 /// leave out of the snapshots, since every client computes it alike.

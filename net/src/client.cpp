@@ -426,7 +426,7 @@ struct Client::Impl {
     }
     Expected<detail::ServerSnapshot> s =
         detail::decode_server_snapshot(a.bytes, static_cast<std::uint32_t>(sizes.players),
-                                       static_cast<std::uint32_t>(sizes.input_size), base);
+                                       static_cast<std::uint32_t>(sizes.input_size), base, *game);
     if (!s || s->frame != a.frame) {
       stats.dropped += 1;
       return;

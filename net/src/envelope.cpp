@@ -39,7 +39,7 @@ std::vector<std::uint8_t> stored(const EnvelopeMagic& magic,
 
 std::vector<std::uint8_t> seal_envelope(const EnvelopeMagic& magic,
                                         std::span<const std::uint8_t> payload, bool compress,
-                                        std::span<const std::uint8_t> prefix) {
+                                        std::span<const std::uint8_t> prefix, int level) {
 #if DETSIM_WITH_ZSTD
   if (!compress) return stored(magic, payload);
   std::vector<std::uint8_t> out(magic.begin(), magic.end());
@@ -47,12 +47,12 @@ std::vector<std::uint8_t> seal_envelope(const EnvelopeMagic& magic,
   put(out, payload.size(), 8);
   const std::size_t bound = ZSTD_compressBound(payload.size());
   out.resize(envelope_size + bound);
-  // Level 3 (zstd's default): a 100 KB world state compresses in about a millisecond. With the
-  // frame's checksum, so an envelope altered on the way fails to decompress instead of loading.
+  // With the frame's checksum, so an envelope altered on the way fails to decompress instead of
+  // loading.
   ZSTD_CCtx* context = ZSTD_createCCtx();
   std::size_t written = 1;
   if (context != nullptr) {
-    ZSTD_CCtx_setParameter(context, ZSTD_c_compressionLevel, 3);
+    ZSTD_CCtx_setParameter(context, ZSTD_c_compressionLevel, level);
     ZSTD_CCtx_setParameter(context, ZSTD_c_checksumFlag, 1);
     if (!prefix.empty()) ZSTD_CCtx_refPrefix(context, prefix.data(), prefix.size());
     written =
@@ -67,6 +67,7 @@ std::vector<std::uint8_t> seal_envelope(const EnvelopeMagic& magic,
 #else
   (void)compress;
   (void)prefix;
+  (void)level;
 #endif
   return stored(magic, payload);
 }

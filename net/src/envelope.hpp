@@ -4,9 +4,9 @@
 //     magic (4 bytes, the caller's) | compression u8 (0: none, 1: zstd) | size u64 (of the payload
 //     uncompressed) | payload, compressed or not
 //
-// zstd (Debian's libzstd) at level 3 with its frame checksum, so bytes altered on the way fail to
-// decompress instead of loading; a build without zstd writes the payload as it is and refuses a
-// compressed one with a clear error.
+// zstd (Debian's libzstd) at the caller's level (3 by default) with its frame checksum, so bytes
+// altered on the way fail to decompress instead of loading; a build without zstd writes the payload
+// as it is and refuses a compressed one with a clear error.
 #pragma once
 
 #include <array>
@@ -25,10 +25,12 @@ using EnvelopeMagic = std::array<std::uint8_t, 4>;
 /// (and compression succeeds), else stored. With a `prefix` (bytes the reader holds too, such as
 /// an earlier state), zstd refers to it as to bytes just before the payload: what the payload
 /// repeats of it costs a few bytes a run, wherever it moved to (a delta that survives shifts).
+/// `level`: zstd's compression level (3, its default: about a millisecond for a 100 KB state).
 [[nodiscard]] std::vector<std::uint8_t> seal_envelope(const EnvelopeMagic& magic,
                                                       std::span<const std::uint8_t> payload,
                                                       bool compress = true,
-                                                      std::span<const std::uint8_t> prefix = {});
+                                                      std::span<const std::uint8_t> prefix = {},
+                                                      int level = 3);
 
 /// The payload of an envelope with `magic`, at most `max_payload` bytes uncompressed whatever the
 /// header says; errors say what is wrong ("not a ... (no DSNP header)", "corrupt", ...), with

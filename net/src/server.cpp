@@ -120,6 +120,13 @@ struct Server::Impl {
     Outgoing snapshot;
     std::uint32_t snapshot_ack = 0;         ///< the newest snapshot it holds whole, + 1
     std::uint64_t last_snapshot_frame = 0;  ///< Authority::state: the last one sent, + 1
+    /// Authority::state: the snapshots sent since the newest it acknowledged (frame, when sent).
+    std::vector<std::pair<std::uint32_t, std::uint64_t>> unacknowledged;
+    /// The first snapshot of the present chain: from it on, each is coded against the one sent
+    /// before it; it against the newest acknowledged one.
+    std::uint32_t chain_from = 0;
+    /// From a snapshot's sending to its acknowledgement, smoothed (0: none acknowledged yet).
+    std::uint64_t snapshot_rtt_us = 0;
     ServerClientStats stats;
   };
 
@@ -276,7 +283,7 @@ struct Server::Impl {
     o.frame = static_cast<std::uint32_t>(frame);
     o.base = base == nullptr ? 0 : base_frame + 1;
     o.hash = state_hash;
-    o.bytes = detail::encode_server_snapshot(s, config.players, config.input_size, base);
+    o.bytes = detail::encode_server_snapshot(s, config.players, config.input_size, base, *game);
     o.cursor = 0;
     o.rest_until_us = 0;
     c.stats.snapshots_sent += 1;
@@ -405,8 +412,10 @@ struct Server::Impl {
     }
     // The newest snapshot it holds: its next one's base. Units go on from its own ack: a client
     // predicts with them, whatever state it holds.
-    if (in.snapshot_ack > c.snapshot_ack && in.snapshot_ack <= frame + 1)
+    if (in.snapshot_ack > c.snapshot_ack && in.snapshot_ack <= frame + 1) {
       c.snapshot_ack = in.snapshot_ack;
+      acknowledged_snapshot(c);
+    }
     take_inputs(c, in);
   }
 
@@ -596,20 +605,63 @@ struct Server::Impl {
     } else {
       s.state = snapshot;
     }
-    e.bytes = detail::encode_server_snapshot(s, config.players, config.input_size, base_state);
+    e.bytes =
+        detail::encode_server_snapshot(s, config.players, config.input_size, base_state, *game);
     encoded.push_back(std::move(e));
     return encoded.back();
   }
 
   /// Authority::state: the newest snapshot to `c`, against the newest it acknowledged (when the
   /// server still keeps that state), all its slices at once.
+  /// Authority::state: the snapshots the client now holds are no longer awaited; the newest of
+  /// them times the round trip.
+  void acknowledged_snapshot(Client& c) {
+    const std::uint32_t held = c.snapshot_ack - 1;
+    std::size_t n = 0;
+    for (; n < c.unacknowledged.size() && c.unacknowledged[n].first <= held; ++n) {
+      if (c.unacknowledged[n].first != held) continue;
+      const std::uint64_t sample = now_us - c.unacknowledged[n].second;
+      c.snapshot_rtt_us = c.snapshot_rtt_us == 0 ? sample : (7 * c.snapshot_rtt_us + sample) / 8;
+    }
+    c.unacknowledged.erase(c.unacknowledged.begin(),
+                           c.unacknowledged.begin() + static_cast<std::ptrdiff_t>(n));
+  }
+
+  /// Whether the server still keeps the snapshot state of frame `f`.
+  [[nodiscard]] bool keeps_snapshot(std::uint64_t f) const {
+    for (const auto& [kept, st] : snapshot_states)
+      if (kept == f) return true;
+    return false;
+  }
+
+  /// The base (its frame + 1; 0: none) of the snapshot of frame `next` to `c`. The newest one
+  /// sent: the client holds it a round trip before it can say so, and a state one snapshot
+  /// apart codes smaller than one a round trip apart. Unless a snapshot of the present chain is
+  /// overdue (lost, so everything coded after it is undecodable), or no acknowledgement has timed
+  /// the round trip yet: then the newest acknowledged one, and a new chain starts.
+  std::uint32_t snapshot_base(Client& c, std::uint32_t next) {
+    const std::uint64_t overdue_us = c.snapshot_rtt_us + c.snapshot_rtt_us / 4 + config.frame_us;
+    bool chained = config.chain_snapshots && c.snapshot_rtt_us != 0 && !c.unacknowledged.empty() &&
+                   c.unacknowledged.size() < detail::kept_snapshot_states &&
+                   c.unacknowledged.back().first >= c.chain_from &&
+                   keeps_snapshot(c.unacknowledged.back().first);
+    for (const auto& [f, sent] : c.unacknowledged)
+      chained = chained && (f < c.chain_from || now_us - sent <= overdue_us);
+    if (chained) return c.unacknowledged.back().first + 1;
+    c.chain_from = next;
+    return c.snapshot_ack != 0 && keeps_snapshot(c.snapshot_ack - 1U) ? c.snapshot_ack : 0;
+  }
+
   void send_state_snapshot(Client& c) {
     const std::uint64_t newest = snapshot_states.back().first;
-    std::uint32_t base = 0;
-    for (const auto& [f, st] : snapshot_states)
-      if (f + 1 == c.snapshot_ack) base = c.snapshot_ack;
+    const std::uint32_t base = snapshot_base(c, static_cast<std::uint32_t>(newest));
+    if (c.unacknowledged.size() >= 2 * detail::kept_snapshot_states)  // a client gone quiet
+      c.unacknowledged.erase(c.unacknowledged.begin());
+    c.unacknowledged.emplace_back(static_cast<std::uint32_t>(newest), now_us);
     Outgoing& o = c.snapshot;
     const Encoded& e = encoded_against(c.player, base);
+    if (detail::is_game_delta(e.bytes)) c.stats.snapshots_game_coded += 1;
+    if (base != 0 && base != c.snapshot_ack) c.stats.snapshots_chained += 1;
     o.frame = static_cast<std::uint32_t>(newest);
     o.base = base;
     o.hash = e.hash;

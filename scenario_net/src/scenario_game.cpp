@@ -1,6 +1,8 @@
 // The Game adapter for detsim scenarios (scenario_game.hpp).
 #include <detsim/scenario_net/scenario_game.hpp>
 
+#include <detsim/sim/state_delta.hpp>
+
 namespace detsim::net {
 
 std::uint64_t ScenarioGame::save(std::vector<std::uint8_t>& state) {
@@ -18,6 +20,24 @@ std::uint64_t ScenarioGame::save(std::vector<std::uint8_t>& state) {
 
 void ScenarioGame::load(std::span<const std::uint8_t> state) {
   if (!scenario_->world().restore(state)) ++failed_loads_;
+}
+
+bool ScenarioGame::encode_delta(std::span<const std::uint8_t> state,
+                                std::span<const std::uint8_t> base,
+                                std::vector<std::uint8_t>& delta) {
+  Expected<std::vector<std::uint8_t>> coded = encode_state_delta(state, base);
+  if (!coded) return false;
+  delta = std::move(*coded);
+  return true;
+}
+
+bool ScenarioGame::decode_delta(std::span<const std::uint8_t> delta,
+                                std::span<const std::uint8_t> base,
+                                std::vector<std::uint8_t>& state) {
+  Expected<std::vector<std::uint8_t>> decoded = decode_state_delta(delta, base);
+  if (!decoded) return false;
+  state = std::move(*decoded);
+  return true;
 }
 
 void ScenarioGame::advance(const FrameInputs& inputs, bool resimulating) {

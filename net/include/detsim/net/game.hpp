@@ -47,6 +47,29 @@ class Game {
   /// Simulates one frame with every player's input. `resimulating` is true when the frame is
   /// being simulated again after a rollback: a game skips sounds and effects it already played.
   virtual void advance(const FrameInputs& inputs, bool resimulating) = 0;
+
+  /// Optional, for a server's state snapshots (docs/SERVER.md, "Snapshots"): writes to `delta`
+  /// the state `state` coded against an earlier state `base` that the receiver holds (both save()
+  /// bytes, or both a StateView's), in a form that compresses better, and returns true. The
+  /// default returns false, and the state goes as it is (compressed against the base). A World's
+  /// game returns detsim::encode_state_delta's bytes (ScenarioGame does). Both ends of a match
+  /// must code alike: the server's game encodes, each client's game decodes.
+  virtual bool encode_delta(std::span<const std::uint8_t> state, std::span<const std::uint8_t> base,
+                            std::vector<std::uint8_t>& delta) {
+    (void)state;
+    (void)base;
+    (void)delta;
+    return false;
+  }
+  /// The state that encode_delta coded as `delta` against `base`, written to `state`, bit for bit;
+  /// false when `delta` is not a delta this game reads (the snapshot is then dropped).
+  virtual bool decode_delta(std::span<const std::uint8_t> delta, std::span<const std::uint8_t> base,
+                            std::vector<std::uint8_t>& state) {
+    (void)delta;
+    (void)base;
+    (void)state;
+    return false;
+  }
 };
 
 }  // namespace detsim::net

@@ -74,7 +74,7 @@ using MergeView =
 namespace detsim::net::server_protocol {
 
 /// Changes whenever the layout above changes; a client of another version is dropped.
-inline constexpr std::uint8_t version = 1;
+inline constexpr std::uint8_t version = 2;
 inline constexpr std::uint8_t magic0 = 'D';
 inline constexpr std::uint8_t magic1 = 'G';
 inline constexpr std::size_t header_size = 14;

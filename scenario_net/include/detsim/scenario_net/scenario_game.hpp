@@ -40,6 +40,12 @@ class ScenarioGame final : public Game {
   void load(std::span<const std::uint8_t> state) override;
   /// Steps the scenario with every player's input; a disconnected player's is all zero (neutral).
   void advance(const FrameInputs& inputs, bool resimulating) override;
+  /// A server's state snapshots: detsim::encode_state_delta and decode_state_delta
+  /// (<detsim/sim/state_delta.hpp>); false for bytes that are not states (a StateView's).
+  bool encode_delta(std::span<const std::uint8_t> state, std::span<const std::uint8_t> base,
+                    std::vector<std::uint8_t>& delta) override;
+  bool decode_delta(std::span<const std::uint8_t> delta, std::span<const std::uint8_t> base,
+                    std::vector<std::uint8_t>& state) override;
 
   /// A debug hook run after each step, before the state is saved or hashed: a fault injection
   /// (<detsim/sim/inject.hpp>) that makes this machine's game differ, for tests and demos. It runs
