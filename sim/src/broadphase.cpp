@@ -1,4 +1,8 @@
 // Broadphase: sort and sweep along x, then the contact list is merged with the new pair list.
+// While most of a scene is at rest, only the bodies whose box (or anything else the broadphase
+// reads) changed since the last step are tested, against every body, and the other pairs are the
+// last step's (WorldState::broadphase_pairs): the same pairs, found in time proportional to what
+// moved.
 //
 // Determinism: the sweep order is a total order (min x, then ID), so any correct sort gives the
 // same sequence; pairs are emitted as (lower ID, higher ID) and sorted the same way; the merge with
@@ -220,9 +224,8 @@ void keep_within_budget(const WorldState& s, std::vector<std::uint64_t>& pairs) 
   pairs.resize(kept);
 }
 
-}  // namespace
-
-void update_contacts(WorldState& s) {
+// Every overlapping pair of bodies that may interact, by a sort and sweep along x.
+std::vector<std::uint64_t> sweep_pairs(WorldState& s) {
   std::vector<std::uint32_t> planes;
   const std::vector<SweepItem> items = sorted_sweep_items(s, planes);
 
@@ -251,6 +254,91 @@ void update_contacts(WorldState& s) {
     }
   }
   std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+// What the broadphase reads of body i.
+WorldState::BroadphaseEntry broadphase_entry(const WorldState& s, std::size_t i) {
+  const BodyState& b = s.bodies[i];
+  const Derived& d = s.derived[i];
+  WorldState::BroadphaseEntry e;
+  e.infinite = d.infinite;
+  e.min = d.infinite ? b.position : d.aabb_min;
+  e.max = d.infinite ? d.pose.rotation.column(1) : d.aabb_max;
+  e.id = b.id.value;
+  e.layer = b.layer;
+  e.mask = b.mask;
+  e.type = b.type;
+  e.sensor = b.sensor;
+  return e;
+}
+
+// The pairs sweep_pairs would find, from the last step's: a pair of two bodies whose entries are
+// unchanged is kept as it was (it overlapped then, so it does now), and every body whose entry
+// changed is tested against every other body as the sweep tests them (boxes overlapping on every
+// axis, ends included; a plane against a box below it). The same set, in the same order.
+std::vector<std::uint64_t> update_pairs(const WorldState& s, const std::vector<bool>& changed,
+                                        const std::vector<std::uint32_t>& moved) {
+  std::vector<std::uint64_t> pairs;
+  pairs.reserve(s.broadphase_pairs.size() + moved.size() * 8);
+  for (const std::uint64_t pair : s.broadphase_pairs) {
+    if (!changed[pair >> 32] && !changed[pair & 0xFFFFFFFFU]) pairs.push_back(pair);
+  }
+  const auto item = [&s](std::size_t i) {
+    return SweepItem{s.derived[i].aabb_min, s.derived[i].aabb_max, static_cast<std::uint32_t>(i)};
+  };
+  for (const std::uint32_t i : moved) {
+    for (std::uint32_t j = 0; j < s.bodies.size(); ++j) {
+      if (j == i || (changed[j] && j < i)) continue;  // a pair of two changed ones: once
+      const Derived& di = s.derived[i];
+      const Derived& dj = s.derived[j];
+      if (di.infinite && dj.infinite) continue;
+      bool touch = false;
+      if (di.infinite || dj.infinite) {
+        const std::uint32_t plane = di.infinite ? i : j;
+        touch = below_plane(item(di.infinite ? j : i), s.bodies[plane].position,
+                            s.derived[plane].pose.rotation.column(1));
+      } else {
+        const SweepItem a = item(i);
+        const SweepItem b = item(j);
+        touch = a.min.x <= b.max.x && b.min.x <= a.max.x && overlap_yz(a, b);
+      }
+      if (!touch || !may_interact(s.bodies[i], s.bodies[j])) continue;
+      pairs.push_back((std::uint64_t{std::min(i, j)} << 32) | std::max(i, j));
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+}  // namespace
+
+void update_contacts(WorldState& s) {
+  // The bodies whose broadphase entry changed since the last step (all of them after a restore,
+  // or when bodies came or went): few, while most of a scene sleeps.
+  const std::size_t n = s.bodies.size();
+  const bool cached = s.broadphase_entries.size() == n;
+  std::vector<bool> changed(n, !cached);
+  std::vector<std::uint32_t> moved;
+  if (!cached) {
+    s.broadphase_entries.clear();
+    s.broadphase_entries.reserve(n);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const WorldState::BroadphaseEntry e = broadphase_entry(s, i);
+    if (cached && s.broadphase_entries[i] == e) continue;
+    changed[i] = true;
+    moved.push_back(static_cast<std::uint32_t>(i));
+    if (cached) {
+      s.broadphase_entries[i] = e;
+    } else {
+      s.broadphase_entries.push_back(e);
+    }
+  }
+  // Testing m changed bodies against all n costs m n; the sweep about n times its active list.
+  std::vector<std::uint64_t> pairs =
+      cached && moved.size() * 16 <= n ? update_pairs(s, changed, moved) : sweep_pairs(s);
+  s.broadphase_pairs = pairs;
   // Bodies joined without collide_connected never collide (nor use up each other's budget).
   if (!s.joints.empty()) {
     const std::vector<std::uint64_t> joined = joined_pairs(s);

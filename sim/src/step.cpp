@@ -35,8 +35,26 @@ namespace sim_detail {
 
 void prepare_bodies(WorldState& s) {
   s.derived.resize(s.bodies.size());
-  for (std::size_t i = 0; i < s.bodies.size(); ++i)
+  s.prepared_from.resize(s.bodies.size());
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    // A body at rest whose derived data came from what it holds now keeps it (the solver moves
+    // only awake bodies); everything else is prepared again.
+    const BodyState& b = s.bodies[i];
+    WorldState::PreparedFrom from;
+    if (!b.awake) {
+      from = {b.position, b.orientation, b.angular_velocity, b.center_of_mass, b.shape,
+              b.id.value, b.type};
+      if (s.prepared_from[i] == from) {
+        Derived& d = s.derived[i];
+        d.delta_position = {};
+        d.delta_angle = {};
+        d.pushed_out = {};
+        continue;
+      }
+    }
     prepare_body(s, i);
+    s.prepared_from[i] = from;  // id 0 for an awake body: nothing kept
+  }
   s.joint_bodies.resize(s.joints.size());
   for (std::size_t j = 0; j < s.joints.size(); ++j) {
     const JointDef& def = s.joints[j].def;
@@ -46,6 +64,8 @@ void prepare_bodies(WorldState& s) {
 }
 
 void prepare_body(WorldState& s, std::size_t i) {
+  // Whoever prepares a body (a wake, a teleport) replaces what prepare_bodies kept.
+  if (i < s.prepared_from.size()) s.prepared_from[i].id = 0;
   const Vec3 margin{s.def.speculative_distance, s.def.speculative_distance,
                     s.def.speculative_distance};
   const BodyState& b = s.bodies[i];

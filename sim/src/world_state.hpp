@@ -138,6 +138,37 @@ struct WorldState {
   /// starts. Not saved: the order sorted to is total, so stale or empty content changes nothing
   /// but the time the sort takes.
   std::vector<std::uint32_t> sweep_order;
+  /// What the broadphase read of each body at the last step, and the pairs it found then (body
+  /// indices, before the joints' and the budget's filters): the next step sweeps only the bodies
+  /// whose entry changed and keeps the pairs of the others (broadphase.cpp). Not saved: the pairs
+  /// are a function of these entries, so an empty cache (after restore) finds the same ones.
+  struct BroadphaseEntry {
+    Vec3 min;  ///< the box; a plane's point
+    Vec3 max;  ///< the box; a plane's normal
+    std::uint32_t id = 0;
+    std::uint32_t layer = 0;
+    std::uint32_t mask = 0;
+    BodyType type = BodyType::static_body;
+    bool sensor = false;
+    bool infinite = false;
+    friend bool operator==(const BroadphaseEntry&, const BroadphaseEntry&) = default;
+  };
+  std::vector<BroadphaseEntry> broadphase_entries;
+  /// Of each body at rest (asleep or static), what its derived data was computed from at the
+  /// last step: while they are the same, prepare_bodies keeps the derived data (step.cpp), so
+  /// that a sleeping body costs no rotation matrix or box. Not saved, like `derived`.
+  struct PreparedFrom {
+    Vec3 position;
+    Quat orientation;
+    Vec3 angular_velocity;
+    Vec3 center_of_mass;
+    Shape shape;
+    std::uint32_t id = 0;  ///< 0: nothing kept
+    BodyType type = BodyType::static_body;
+    friend bool operator==(const PreparedFrom&, const PreparedFrom&) = default;
+  };
+  std::vector<PreparedFrom> prepared_from;
+  std::vector<std::uint64_t> broadphase_pairs;
   /// Output of the last step (and of destroy_body since); not saved, cleared by restore.
   std::vector<ContactEvent> events;
   /// The same for joints: breaks in the last step, then joints destroy_body removed since.

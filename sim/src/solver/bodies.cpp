@@ -71,6 +71,9 @@ SolverBodies::SolverBodies(WorldState& state) : s(state) {
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
     const BodyState& b = s.bodies[i];
     velocities[i] = {b.linear_velocity, b.angular_velocity};
+    // No stage of the solve wakes or puts to sleep a body: the lists hold for the whole step.
+    if (solvable(b)) solvable_bodies.push_back(static_cast<std::uint32_t>(i));
+    if (awake_dynamic(b)) awake_dynamic_bodies.push_back(static_cast<std::uint32_t>(i));
   }
 }
 
@@ -90,9 +93,8 @@ BodyPair SolverBodies::pair(std::size_t a, std::size_t b) const {
 
 void SolverBodies::integrate_velocities() {
   const WorldDef& def = s.def;
-  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+  for (const std::uint32_t i : awake_dynamic_bodies) {
     const BodyState& b = s.bodies[i];
-    if (!awake_dynamic(b)) continue;
     const Derived& d = s.derived[i];
     Velocity& v = velocities[i];
     // Locked axes (BodyDef::lock_translation, lock_rotation): a velocity the game set along them
@@ -129,8 +131,7 @@ Vec3 limit_speed(Vec3 v, Fixed limit) {
 }
 
 void SolverBodies::clamp_speeds() {
-  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
-    if (!awake_dynamic(s.bodies[i])) continue;
+  for (const std::uint32_t i : awake_dynamic_bodies) {
     Velocity& v = velocities[i];
     v.linear = clamp_speed(v.linear, s.def.max_linear_speed);
     v.angular = clamp_speed(v.angular, s.def.max_angular_speed);
@@ -138,9 +139,8 @@ void SolverBodies::clamp_speeds() {
 }
 
 void SolverBodies::integrate_positions() {
-  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+  for (const std::uint32_t i : solvable_bodies) {
     BodyState& b = s.bodies[i];
-    if (!solvable(b)) continue;
     Derived& d = s.derived[i];
     const Velocity& v = velocities[i];
     // In free flight, x += h (v - a h / 2): with v already including this sub-step's a h, the
@@ -177,9 +177,8 @@ void SolverBodies::integrate_positions() {
 }
 
 void SolverBodies::store_velocities() {
-  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+  for (const std::uint32_t i : solvable_bodies) {
     BodyState& b = s.bodies[i];
-    if (!solvable(b)) continue;
     b.linear_velocity = velocities[i].linear;
     b.angular_velocity = velocities[i].angular;
   }

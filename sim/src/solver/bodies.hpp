@@ -57,6 +57,11 @@ struct SolverBodies {
   /// The body has contact points or solved joints this step (set by the contact and joint kinds'
   /// prepare): it moves by plain semi-implicit Euler.
   std::vector<bool> in_contact;
+  /// The bodies the per-body stages visit, in ascending index (ID) order, so that a sleeping
+  /// body costs them nothing: awake non-static ones (positions, stored velocities) and of those
+  /// the dynamic ones (gravity, forces, speed limits).
+  std::vector<std::uint32_t> solvable_bodies;
+  std::vector<std::uint32_t> awake_dynamic_bodies;
 };
 
 }  // namespace detsim::sim_detail
