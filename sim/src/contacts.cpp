@@ -235,6 +235,8 @@ void collide_contacts(WorldState& s) {
 }
 
 void wake_touched_islands(WorldState& s) {
+  // Only a moving body wakes anything: a scene at rest builds no islands.
+  if (std::none_of(s.bodies.begin(), s.bodies.end(), moving)) return;
   UnionFind uf = islands(s);
   std::vector<bool> wake(s.bodies.size(), false);
   for (std::size_t i = 0; i < s.bodies.size(); ++i) {
@@ -358,6 +360,10 @@ void update_sleep(WorldState& s) {
     b.sleep_time = slow ? min(b.sleep_time + s.def.dt, Fixed::from_int(1000)) : Fixed::zero();
   }
   if (!s.def.enable_sleep) return;
+  // Only an awake dynamic body falls asleep: a scene at rest builds no islands.
+  if (std::none_of(s.bodies.begin(), s.bodies.end(),
+                   [](const BodyState& b) { return b.type == BodyType::dynamic && b.awake; }))
+    return;
   UnionFind uf = islands(s);
   // An island sleeps when every body in it has been slow long enough and nothing moving that is
   // outside the island (a kinematic body) touches it.
