@@ -9,12 +9,13 @@
 //                          per client, corrections per client
 //   slow_client/8/MS       the same match, 1200 frames, with client 7 MS ms away each way (the
 //                          others 25 ms): the most any other client re-simulated, and client 7's
-//   state_cubes/MODE       state authority, the cubes scene (900 cubes), one client driving the
+//   state_cubes/MODE/U     state authority, the cubes scene (900 cubes), one client driving the
 //                          large cube, 60 snapshots per second, 60 s, 50 ms each way, 1% loss:
 //                          kbit/s down, bit-exact (its final state hashes as the server's, no
 //                          desync); snapshots coded as the state against the newest acknowledged
 //                          (MODE 0), as the game's delta against it (1), as the game's delta
-//                          chained to the one sent before (2, the default)
+//                          chained to the one sent before (2, the default); units and hashes every
+//                          U frames
 //   p2p_arena/8/MODE       the inputs_arena match played peer to peer instead, rollback (0) or
 //                          lockstep (1) sessions, input delay 2: the same figures per peer
 //   server_cost/64         input authority, arena with 64 players, 64 clients, 300 frames: the
@@ -285,7 +286,7 @@ void BM_StateCubes(benchmark::State& state) {
   m.clients = 1;
   m.authority = sp::Authority::state;
   m.snapshot_interval = 1;
-  m.update_interval = 1;
+  m.update_interval = static_cast<std::uint32_t>(state.range(1));
   m.link.latency_us = 50'000;
   m.link.jitter_us = 5'000;
   m.link.loss_ppm = 10'000;
@@ -323,7 +324,8 @@ void BM_StateCubes(benchmark::State& state) {
 }
 BENCHMARK(BM_StateCubes)
     ->Name("state_cubes")
-    ->DenseRange(0, 2)
+    ->ArgsProduct({{0, 1, 2}, {1}})
+    ->Args({2, 3})
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 
