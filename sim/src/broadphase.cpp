@@ -307,7 +307,8 @@ std::vector<std::uint64_t> update_pairs(const WorldState& s, const std::vector<b
       pairs.push_back((std::uint64_t{std::min(i, j)} << 32) | std::max(i, j));
     }
   }
-  std::sort(pairs.begin(), pairs.end());
+  // The kept pairs are in order already (a subset of a sorted list); only added ones need a sort.
+  if (!moved.empty()) std::sort(pairs.begin(), pairs.end());
   return pairs;
 }
 
