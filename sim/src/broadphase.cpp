@@ -282,7 +282,9 @@ std::vector<std::uint64_t> update_pairs(const WorldState& s, const std::vector<b
   std::vector<std::uint64_t> pairs;
   pairs.reserve(s.broadphase_pairs.size() + moved.size() * 8);
   for (const std::uint64_t pair : s.broadphase_pairs) {
-    if (!changed[pair >> 32] && !changed[pair & 0xFFFFFFFFU]) pairs.push_back(pair);
+    const auto a = static_cast<std::uint32_t>(pair >> 32);
+    const auto b = static_cast<std::uint32_t>(pair & 0xFFFFFFFFU);
+    if (!changed[a] && !changed[b]) pairs.push_back(pair);
   }
   const auto item = [&s](std::size_t i) {
     return SweepItem{s.derived[i].aabb_min, s.derived[i].aabb_max, static_cast<std::uint32_t>(i)};
