@@ -416,30 +416,23 @@ bool read_bodies(std::span<const std::uint8_t> bytes, ByteReader& r, WorldState&
 
 namespace {
 
-/// `v` plus or minus `by`, wrapping: a difference is any 64-bit pattern, and wrapping is undone
-/// exactly by the opposite shift.
-Fixed shifted(Fixed v, Fixed by, bool add) noexcept {
-  const auto a = static_cast<std::uint64_t>(v.raw());
-  const auto b = static_cast<std::uint64_t>(by.raw());
-  return Fixed::from_raw(static_cast<std::int64_t>(add ? a + b : a - b));
-}
-
 void shift_field(const BodyField& f, BodyState& b, const BodyState& by, bool add) noexcept {
   switch (f.kind) {
     case FieldKind::fixed:
-      b.*f.fixed = shifted(b.*f.fixed, by.*f.fixed, add);
+      b.*f.fixed = shifted_value(b.*f.fixed, by.*f.fixed, add);
       break;
     case FieldKind::vec3: {
       Vec3& v = b.*f.vec3;
       const Vec3 d = by.*f.vec3;
-      v = {shifted(v.x, d.x, add), shifted(v.y, d.y, add), shifted(v.z, d.z, add)};
+      v = {shifted_value(v.x, d.x, add), shifted_value(v.y, d.y, add),
+           shifted_value(v.z, d.z, add)};
       break;
     }
     case FieldKind::quat: {
       Quat& q = b.*f.quat;
       const Quat d = by.*f.quat;
-      q = {shifted(q.w, d.w, add), shifted(q.x, d.x, add), shifted(q.y, d.y, add),
-           shifted(q.z, d.z, add)};
+      q = {shifted_value(q.w, d.w, add), shifted_value(q.x, d.x, add), shifted_value(q.y, d.y, add),
+           shifted_value(q.z, d.z, add)};
       break;
     }
     case FieldKind::u32:

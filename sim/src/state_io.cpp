@@ -447,12 +447,6 @@ bool read_contact_list(std::span<const std::uint8_t> bytes, const StateSection& 
   return r.ok();
 }
 
-Fixed shifted_impulse(Fixed v, Fixed by, bool add) noexcept {
-  const auto a = static_cast<std::uint64_t>(v.raw());
-  const auto b = static_cast<std::uint64_t>(by.raw());
-  return Fixed::from_raw(static_cast<std::int64_t>(add ? a + b : a - b));
-}
-
 }  // namespace
 
 bool shift_contacts(std::span<const std::uint8_t> bytes, const StateSection& section,
@@ -476,11 +470,11 @@ bool shift_contacts(std::span<const std::uint8_t> bytes, const StateSection& sec
           const CachedPoint& by = it->cached[q];
           if (by.feature != c.cached[p].feature) continue;
           CachedPoint& point = c.cached[p];
-          point.normal_impulse = shifted_impulse(point.normal_impulse, by.normal_impulse, add);
+          point.normal_impulse = shifted_value(point.normal_impulse, by.normal_impulse, add);
           point.tangent_impulse_1 =
-              shifted_impulse(point.tangent_impulse_1, by.tangent_impulse_1, add);
+              shifted_value(point.tangent_impulse_1, by.tangent_impulse_1, add);
           point.tangent_impulse_2 =
-              shifted_impulse(point.tangent_impulse_2, by.tangent_impulse_2, add);
+              shifted_value(point.tangent_impulse_2, by.tangent_impulse_2, add);
           break;
         }
       }

@@ -59,6 +59,14 @@ void clear_characters(WorldState& s);
 
 // ---- Delta coding (state_delta.cpp) ----
 
+/// `v` plus (`add`) or minus `by`, wrapping: a delta's difference is any 64-bit pattern, and the
+/// opposite shift undoes it exactly.
+[[nodiscard]] inline Fixed shifted_value(Fixed v, Fixed by, bool add) noexcept {
+  const auto a = static_cast<std::uint64_t>(v.raw());
+  const auto b = static_cast<std::uint64_t>(by.raw());
+  return Fixed::from_raw(static_cast<std::int64_t>(add ? a + b : a - b));
+}
+
 /// The sections of `bytes` whose first four bytes are `magic` (a state's "DSIM", a delta's
 /// "DSDL"); `expected` names the magic in the error.
 [[nodiscard]] Expected<std::vector<StateSection>> read_sections(std::span<const std::uint8_t> bytes,
