@@ -133,7 +133,7 @@ TEST(Cli, BadUsageAndBadInputExitWithTwoAndSayWhatIsWrong) {
       {"run --scenario stack --frames 1 --record /nonexistent-dir/x.dsr",
        "/nonexistent-dir/x.dsr: cannot create"},
       {"synctest --scenario stack --check-distance 0", "--check-distance must be 1 to 600"},
-      {"verify", "FILE is required"},
+      {"verify", "nothing to verify: give replay FILEs or --manifest LIST"},
       {"verify " + junk.path(), junk.path() + ": byte 0: expected the magic"},
       {"verify /nonexistent-file.dsr", "/nonexistent-file.dsr: cannot open"},
       {"info " + junk.path(), "this is not a detsim replay"},

@@ -138,6 +138,13 @@ TEST(ExamplePushball, ItsToolRecordsVerifiesAndSyncTestsItsRuns) {
   EXPECT_EQ(json_value(verify.out, "ok"), "true");
   EXPECT_EQ(json_value(verify.out, "frames"), "900");
   EXPECT_EQ(json_value(verify.out, "final_hash"), json_value(run.out, "final_hash"));
+  // Bulk verification knows the game too: its replay and its golden one, on two workers.
+  const test::CliResult bulk =
+      tool("verify " + replay.path() + " " + std::string(DETSIM_SOURCE_DIR) +
+           "/golden/games/pushball.dsr --jobs 2");
+  EXPECT_EQ(bulk.exit_code, 0) << bulk.out << bulk.err;
+  EXPECT_TRUE(has(bulk.out, replay.path() + ": ok: 900 frames of pushball")) << bulk.out;
+  EXPECT_TRUE(has(bulk.out, "2 replays: 2 ok, 0 desync, 0 invalid, 0 incomplete")) << bulk.out;
   const test::CliResult sync = tool("synctest --scenario pushball --frames 300 --json");
   EXPECT_EQ(sync.exit_code, 0) << sync.err;
   EXPECT_EQ(json_value(sync.out, "ok"), "true");

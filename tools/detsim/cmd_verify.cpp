@@ -24,6 +24,8 @@ std::string hashes_json(const StateHashes& h) {
   return json.text();
 }
 
+}  // namespace
+
 std::string describe(const replay::Fingerprint& f) {
   std::string out = f.scenario + " (seed " + std::to_string(f.params.seed);
   if (f.params.players != 0) out += ", " + std::to_string(f.params.players) + " players";
@@ -31,15 +33,15 @@ std::string describe(const replay::Fingerprint& f) {
   return out + ")";
 }
 
-}  // namespace
-
 int verify_command(const VerifyArgs& args) {
+  if (args.bulk()) return verify_many_command(args);
+  const std::string& file = args.files.front();
   if (args.at != 0 && args.report.empty())
     return usage_error("verify",
                        "--at needs --report FILE (where to write the state of that frame)");
   auto injections = parse_injections(args.injections);
   if (!injections) return usage_error("verify", injections.message());
-  auto reader = replay::ReplayReader::open(args.file);
+  auto reader = replay::ReplayReader::open(file);
   if (!reader) return usage_error("verify", reader.message());
   const replay::Fingerprint& fp = reader->fingerprint();
   for (const Injection& i : injections.value())
@@ -48,7 +50,7 @@ int verify_command(const VerifyArgs& args) {
                                        " is beyond the replay's " +
                                        std::to_string(reader->frame_count()) + " frames");
   if (args.at > reader->frame_count())
-    return usage_error("verify", "--at " + std::to_string(args.at) + ": " + args.file +
+    return usage_error("verify", "--at " + std::to_string(args.at) + ": " + file +
                                      " holds frames 1 to " + std::to_string(reader->frame_count()));
   Progress progress("verify");
   replay::VerifyOptions options;
@@ -93,7 +95,7 @@ int verify_command(const VerifyArgs& args) {
     j.boolean("ok", v.ok)
         .num("frames", v.frames)
         .frame("first_mismatch", v.first_mismatch)
-        .str("file", args.file)
+        .str("file", file)
         .str("scenario", fp.scenario)
         .num("recorded_frames", reader->frame_count())
         .boolean("complete", reader->complete())
@@ -119,12 +121,12 @@ int verify_command(const VerifyArgs& args) {
   }
   if (v.ok) {
     std::printf("%s: ok: %llu frames of %s reproduce every recorded hash; final hash %s\n",
-                args.file.c_str(), static_cast<unsigned long long>(v.frames), describe(fp).c_str(),
+                file.c_str(), static_cast<unsigned long long>(v.frames), describe(fp).c_str(),
                 hex(v.final_hash).c_str());
     std::printf("%.2f s, %.0f frames/s (%.0fx real time)\n", seconds, fps, realtime);
   } else if (v.first_mismatch) {
     const std::uint64_t f = *v.first_mismatch;
-    std::printf("%s: MISMATCH at frame %llu of %s\n", args.file.c_str(),
+    std::printf("%s: MISMATCH at frame %llu of %s\n", file.c_str(),
                 static_cast<unsigned long long>(f), describe(fp).c_str());
     std::printf("  recorded hash %s, this machine computes %s\n", hex(v.expected.total).c_str(),
                 hex(v.actual.total).c_str());
@@ -134,7 +136,7 @@ int verify_command(const VerifyArgs& args) {
     if (!list.empty()) std::printf("  differing parts: %s\n", list.c_str());
     if (f > 0) std::printf("  last agreed frame: %llu\n", static_cast<unsigned long long>(f - 1));
   } else {
-    std::printf("%s: FAILED after %llu frames\n", args.file.c_str(),
+    std::printf("%s: FAILED after %llu frames\n", file.c_str(),
                 static_cast<unsigned long long>(v.frames));
   }
   if (!v.note.empty()) std::printf("  note: %s\n", v.note.c_str());

@@ -33,13 +33,23 @@ struct RunArgs {
 int run_command(const RunArgs& args);
 
 struct VerifyArgs {
-  std::string file;
+  std::vector<std::string> files;       ///< replay files named on the command line
   std::vector<std::string> injections;  ///< --inject FRAME:BODY:FIELD:DELTA, each
   std::string report;                   ///< desync report to write, or empty
   std::uint64_t at = 0;                 ///< --at FRAME: report this frame; 0: the first mismatch
   bool json = false;
+  // Bulk verification (cmd_verify_many.cpp): any of these, or more than one file.
+  std::string manifest;           ///< --manifest LIST: a file of replay paths, one a line
+  std::uint32_t jobs = 0;         ///< --jobs N: worker threads; 0: the machine's cores
+  std::string shard;              ///< --shard I | auto | env:NAME, or empty
+  std::uint64_t shard_count = 0;  ///< --of N
+  [[nodiscard]] bool bulk() const {
+    return files.size() != 1 || !manifest.empty() || jobs != 0 || !shard.empty() ||
+           shard_count != 0;
+  }
 };
 int verify_command(const VerifyArgs& args);
+int verify_many_command(const VerifyArgs& args);
 
 struct BisectArgs {
   std::string a;  ///< a replay or a desync report

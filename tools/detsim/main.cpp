@@ -349,7 +349,27 @@ the same arguments give the same final hash on every machine.
 
   c = app.add_subcommand(
       "verify", "Re-simulate a replay and compare every frame's hash with the recorded one");
-  c->add_option("FILE", verify.file, "Replay file")->required();
+  c->add_option("FILE", verify.files,
+                "Replay file(s); more than one, or any of --manifest, --jobs, --shard, verifies "
+                "in bulk (below)");
+  c->add_option("--manifest", verify.manifest,
+                "Verify the replays listed in LIST, one path a line (relative paths are relative "
+                "to LIST's directory; blank lines and lines starting with # are skipped)")
+      ->type_name("LIST");
+  c->add_option("--jobs", verify.jobs,
+                "Worker threads (default: the machine's cores); the output's order is the "
+                "entries' order whatever N")
+      ->type_name("N")
+      ->check(CLI::Range(1U, 1024U));
+  c->add_option("--shard", verify.shard,
+                "Verify only the entries whose index (from 0: the FILEs, then the manifest's "
+                "lines) modulo --of is I; I is a number, auto (the first set of "
+                "JOB_COMPLETION_INDEX, SLURM_ARRAY_TASK_ID, AWS_BATCH_JOB_ARRAY_INDEX) or "
+                "env:NAME")
+      ->type_name("I|auto|env:NAME");
+  c->add_option("--of", verify.shard_count, "With --shard: the number of shards")
+      ->type_name("N")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000}));
   c->add_option("--report", verify.report,
                 "On a mismatch, write this machine's side as a desync report to FILE: its states "
                 "at the first mismatching frame and the one before, the inputs so far (for "
@@ -362,13 +382,27 @@ the same arguments give the same final hash on every machine.
       ->check(CLI::Range(std::uint64_t{1}, detsim::cli::max_frames));
   add_inject_option(c, verify.injections);
   c->add_flag("--json", verify.json,
-              "Print one JSON object: ok, frames, first_mismatch (null or a frame), report, ...");
+              "Print one JSON object: ok, frames, first_mismatch (null or a frame), report, ...; "
+              "in bulk, one object a replay and a summary (below)");
   c->footer(std::string(R"(
 Prints the first frame whose hash differs, both hashes, which parts of the state differ (globals,
 rng, bodies, contacts) and the last frame both agreed on; also the speed in frames/s. A replay
 without its end marker (a recording that stopped early) verifies up to its last complete chunk.
+
+Bulk verification (several FILEs, --manifest, --jobs or --shard): one line a replay, in the
+entries' order, each with its result: ok, desync (a frame's hash differs: first_bad_frame),
+invalid (unreadable, corrupt, or recorded by a build this one cannot reproduce) or incomplete (no
+end marker: the frames it holds reproduce). A bad replay is a result, not a stop. Then a summary.
+With --json each line is a JSON object: index, path, result, frames, first_bad_frame (a frame or
+null), seconds, scenario, final_hash, message; the last is {"summary": {replays, ok, desync,
+invalid, incomplete, frames, seconds, ...}}. The shards of --shard I --of N together are exactly
+the entries, each once; results are deterministic, so a scheduler should not retry exit status 1
+or 2 (docs/SCALE.md).
 )") + inject_footer +
-            exit_footer);
+            "\nExit status: 0 every replay reproduced (incomplete ones included); 1 a hash "
+            "mismatch (any replay desynced); 2 bad usage, or (with no desync) any replay "
+            "unreadable or invalid (the message names what is wrong). --json prints one JSON "
+            "object on stdout (in bulk: one a line).");
   c->callback([&exit_code] { exit_code = cli::verify_command(verify); });
 
   static cli::SeekArgs seek;

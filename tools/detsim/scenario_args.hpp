@@ -7,6 +7,7 @@
 
 #include <detsim/core/status.hpp>
 #include <detsim/net/session.hpp>
+#include <detsim/replay/replay.hpp>
 #include <detsim/scenes/scenario.hpp>
 #include <detsim/sim/inject.hpp>
 
@@ -30,6 +31,8 @@ Expected<std::vector<Injection>> parse_injections(const std::vector<std::string>
 
 /// "arena (seed 1, 2 players)" / "pile_boxes (seed 1, 1000 bodies)".
 std::string describe(const Scenario& scenario);
+/// The same for the scenario a replay's fingerprint names.
+std::string describe(const replay::Fingerprint& fingerprint);
 
 /// Every scenario's name, comma-separated.
 std::string scenario_names();
