@@ -195,6 +195,7 @@ Expected<RecordResult> record(Scenario& scenario, const std::string& path,
   std::vector<std::uint8_t> bytes(players * size);
   HashChain chain;
   RecordResult result;
+  std::vector<std::uint8_t> state;  // every frame's encoding, in one reused buffer
   for (std::uint64_t f = 1; f <= frames; ++f) {
     if (options.input_bytes) {
       options.input_bytes(f, bytes);
@@ -209,14 +210,14 @@ Expected<RecordResult> record(Scenario& scenario, const std::string& path,
     if (options.after_step) {
       if (Status s = options.after_step(scenario); !s) return s;
     }
-    const StateHashes hashes = scenario.world().hashes();
+    const StateHashes hashes = scenario.world().save(state);
     chain.add(hashes.total);
     result.final_hash = hashes.total;
     result.frames = f;
     if (writer) {
       if (Status s = writer->frame(bytes, hashes); !s) return s;
       if (f % options.keyframe_interval == 0) {
-        if (Status s = writer->keyframe(f, scenario.world().save()); !s) return s;
+        if (Status s = writer->keyframe(f, state); !s) return s;  // this frame's, just saved
       }
     }
     if (options.progress && !options.progress(f, frames)) break;
@@ -261,6 +262,7 @@ Expected<VerifyResult> verify(const ReplayReader& reader, const VerifyOptions& o
   std::size_t next_keyframe = 0;
   HashChain chain;
   Status stop_error;
+  std::vector<std::uint8_t> encoded;  // every frame's state, in one reused buffer
   const Status read = reader.for_each_frame(1, total, [&](const FrameRecord& record) {
     scenario.step_encoded(record.inputs);
     if (options.after_step) {
@@ -270,7 +272,7 @@ Expected<VerifyResult> verify(const ReplayReader& reader, const VerifyOptions& o
       }
     }
     const StateHashes hashes =
-        reporting ? report.step(scenario.world(), record.inputs) : scenario.world().hashes();
+        reporting ? report.step(scenario.world(), record.inputs) : scenario.world().save(encoded);
     if (options.report_at && record.frame == *options.report_at)
       result.report = report.build(record.frame, hashes.total, record.hashes.total);
     if (result.first_mismatch) return !options.report_at || record.frame < *options.report_at;

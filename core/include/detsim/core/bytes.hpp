@@ -10,8 +10,10 @@
 // record, then check `ok()` once — and check counts against `remaining()` before allocating.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <span>
 #include <string>
 #include <utility>
@@ -27,10 +29,11 @@ class ByteWriter {
  public:
   ByteWriter() = default;
   /// Writes into `buffer` from its start, reusing its capacity (a session saves every frame).
-  explicit ByteWriter(std::vector<std::uint8_t> buffer) noexcept : bytes_(std::move(buffer)) {
-    bytes_.clear();
+  explicit ByteWriter(std::vector<std::uint8_t> buffer) noexcept : bytes_(std::move(buffer)) {}
+  void u8(std::uint8_t v) {
+    *room(1) = v;
+    ++size_;
   }
-  void u8(std::uint8_t v) { bytes_.push_back(v); }
   void u16(std::uint16_t v) { put(v, 2); }
   void u32(std::uint32_t v) { put(v, 4); }
   void u64(std::uint64_t v) { put(v, 8); }
@@ -50,14 +53,14 @@ class ByteWriter {
   }
   /// Unsigned LEB128: 1 byte below 2^7, 2 below 2^14, ..., 10 for the top of the 64-bit range.
   void var(std::uint64_t v) {
-    std::uint8_t buf[10];
+    std::uint8_t* out = room(10);
     std::size_t n = 0;
     while (v >= 0x80U) {
-      buf[n++] = static_cast<std::uint8_t>(v | 0x80U);
+      out[n++] = static_cast<std::uint8_t>(v | 0x80U);
       v >>= 7;
     }
-    buf[n++] = static_cast<std::uint8_t>(v);
-    bytes_.insert(bytes_.end(), buf, buf + n);
+    out[n++] = static_cast<std::uint8_t>(v);
+    size_ += n;
   }
   void var_fixed(Fixed v) { var(zigzag(v.raw())); }
   void var_vec3(Vec3 v) {
@@ -75,7 +78,9 @@ class ByteWriter {
     return (static_cast<std::uint64_t>(v) << 1) ^ static_cast<std::uint64_t>(v >> 63);
   }
   void raw(std::span<const std::uint8_t> data) {
-    bytes_.insert(bytes_.end(), data.begin(), data.end());
+    if (data.empty()) return;
+    std::memcpy(room(data.size()), data.data(), data.size());
+    size_ += data.size();
   }
 
   /// Overwrites the four bytes at `at` (written before) with `v`: a length known only after what
@@ -85,23 +90,39 @@ class ByteWriter {
       bytes_[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
   }
 
-  [[nodiscard]] const std::vector<std::uint8_t>& bytes() const noexcept { return bytes_; }
-  [[nodiscard]] std::vector<std::uint8_t> take() noexcept { return std::move(bytes_); }
-  [[nodiscard]] std::size_t size() const noexcept { return bytes_.size(); }
-  void clear() noexcept { bytes_.clear(); }
+  /// What was written (valid until the next write).
+  [[nodiscard]] const std::vector<std::uint8_t>& bytes() const {
+    bytes_.resize(size_);  // never more than it holds: no allocation
+    return bytes_;
+  }
+  [[nodiscard]] std::vector<std::uint8_t> take() noexcept {
+    bytes_.resize(size_);
+    size_ = 0;
+    return std::move(bytes_);
+  }
+  [[nodiscard]] std::size_t size() const noexcept { return size_; }
+  void clear() noexcept { size_ = 0; }
   void reserve(std::size_t n) { bytes_.reserve(n); }
 
  private:
-  // One resize per field, then byte stores the compiler merges into one store on little-endian
-  // hosts (a push_back per byte re-checked the capacity eight times per Fixed).
+  // The vector's size is how far it has been grown (its bytes past size_ are scratch), so a field
+  // is a bounds check and plain stores: no insert() or resize() call per field, which cost more
+  // than the encoding itself when a state is hashed every frame.
+  std::uint8_t* room(std::size_t n) {
+    if (bytes_.size() - size_ < n) grow(n);
+    return bytes_.data() + size_;
+  }
+  void grow(std::size_t n) {
+    bytes_.resize(std::max({size_ + n, bytes_.capacity(), 2 * bytes_.size(), std::size_t{64}}));
+  }
   void put(std::uint64_t v, int n) {
-    const std::size_t at = bytes_.size();
-    bytes_.resize(at + static_cast<std::size_t>(n));
-    std::uint8_t* out = bytes_.data() + at;
+    std::uint8_t* out = room(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i)
       out[i] = static_cast<std::uint8_t>(v >> (8 * i));
+    size_ += static_cast<std::size_t>(n);
   }
-  std::vector<std::uint8_t> bytes_;
+  mutable std::vector<std::uint8_t> bytes_;
+  std::size_t size_ = 0;
 };
 
 class ByteReader {
