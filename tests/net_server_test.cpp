@@ -78,6 +78,41 @@ TEST(NetServer, RejectsInvalidConfigsNamingTheField) {
   EXPECT_NE(client.message().find("max_prediction"), std::string::npos);
 }
 
+TEST(NetServer, TickLatenessCountsHowLateEachFrameWasSimulated) {
+  test::CounterGame game;
+  auto network = net::SimNetwork::create(2, 1);
+  ASSERT_TRUE(network.ok());
+  net::ServerConfig c;
+  c.players = 1;
+  c.start_clients = 0;  // starts at the first advance
+  c.frame_us = 10'000;
+  c.frames = 100;
+  auto server = net::Server::create(c, game, network->endpoint(0));
+  ASSERT_TRUE(server.ok()) << server.message();
+  // Frame F is due at start + F × 10 ms. On time: frames 0..9 at their times exactly.
+  EXPECT_EQ(server->stats().tick_lateness_percentile_us(990), 0U) << "no frame yet";
+  for (std::uint64_t f = 0; f < 10; ++f)
+    EXPECT_EQ(server->advance(f * 10'000), 1U);
+  // Then the loop wakes 25 ms late: frames 10, 11 and 12 at once, 25, 15 and 5 ms late.
+  EXPECT_EQ(server->advance(9 * 10'000 + 35'000), 3U);
+  const net::ServerStats& st = server->stats();
+  const std::uint64_t bucket = net::ServerStats::tick_lateness_bucket_us;
+  EXPECT_EQ(st.tick_lateness[0], 10U);
+  EXPECT_EQ(st.tick_lateness[5'000 / bucket], 1U);
+  EXPECT_EQ(st.tick_lateness[15'000 / bucket], 1U);
+  EXPECT_EQ(st.tick_lateness[25'000 / bucket], 1U);
+  EXPECT_EQ(st.tick_lateness_max_us, 25'000U);
+  // 13 frames: the median is on time (the first bucket's upper edge), the 99th percentile the
+  // latest frame's bucket, 80 % (the 11th of 13 in order) the 5 ms one.
+  EXPECT_EQ(st.tick_lateness_percentile_us(500), bucket);
+  EXPECT_EQ(st.tick_lateness_percentile_us(990), 25'000 + bucket);
+  EXPECT_EQ(st.tick_lateness_percentile_us(800), 5'000 + bucket);
+  // Later than the histogram holds: the last bucket, and the percentile is the maximum.
+  EXPECT_EQ(server->advance(13 * 10'000 + 900'000, 1), 1U);
+  EXPECT_EQ(st.tick_lateness.back(), 1U);
+  EXPECT_EQ(st.tick_lateness_percentile_us(1000), 900'000U);
+}
+
 TEST(NetServer, ClientsOnAPerfectNetworkEndOnTheServersState) {
   ServerMatchOptions o;
   o.clients = 3;

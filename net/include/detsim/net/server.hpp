@@ -117,6 +117,15 @@ struct ServerStats {
   std::uint64_t dropped_unknown = 0;
   std::uint64_t clients_timed_out = 0;
   std::uint64_t clients_left = 0;
+  /// How late frames were simulated: frame F is due at the match's start + F × frame_us, and a
+  /// frame whose advance() came later (the loop woke late, or the machine is too busy) counts
+  /// the delay, in buckets of tick_lateness_bucket_us (the last: that much or more).
+  static constexpr std::uint64_t tick_lateness_bucket_us = 100;
+  std::array<std::uint64_t, 512> tick_lateness{};
+  std::uint64_t tick_lateness_max_us = 0;
+  /// The lateness (a bucket's upper edge, µs) that at least per_mille / 1000 of the frames
+  /// simulated were within; 0 before any frame. per_mille 990: the 99th percentile.
+  [[nodiscard]] std::uint64_t tick_lateness_percentile_us(std::uint32_t per_mille) const noexcept;
 };
 
 enum class ServerEventType : std::uint8_t {
