@@ -199,6 +199,12 @@ TEST(CliServe, FourClientsOverBadLinksWithALateJoinerAndARestartEndOnTheServersH
     const std::string hash = json_field(server.out(), "final_hash");
     ASSERT_EQ(hash.size(), 16U) << server.out();
     EXPECT_EQ(json_field(server.out(), "frames"), "900");
+    // How late it simulated its frames (a bucket's upper edge: 100 us at least), and its CPU.
+    const std::string p99 = json_field(server.out(), "p99");
+    ASSERT_FALSE(p99.empty()) << server.out();
+    EXPECT_GE(std::stoull(p99), 100U);
+    EXPECT_LE(std::stoull(p99), std::stoull(json_field(server.out(), "max")) + 100);
+    EXPECT_GT(std::stod(json_field(server.out(), "cpu_seconds")), 0.0) << server.out();
     for (Process* c : {c0.get(), c2.get(), c1_again.get(), c3.get()}) {
       ASSERT_EQ(c->exit_code(), 0) << c->out() << c->err();
       EXPECT_EQ(json_field(c->out(), "final_hash"), hash) << c->out();

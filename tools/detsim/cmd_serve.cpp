@@ -12,6 +12,8 @@
 // frames ahead of the server (Client::recommended_frame_adjust: one frame extra or skipped, one
 // tick in three), and stops once it has simulated the last frame with the server's inputs and
 // compared the server's hash of the last state.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -102,6 +104,16 @@ Expected<Scenario> build(const Description& d) {
   params.players = d.players;
   params.count = d.count;
   return Scenario::create(d.scenario, params);
+}
+
+/// This process's CPU time so far (user and system), in seconds.
+double cpu_seconds() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+  const auto seconds = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) / 1e6;
+  };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
 std::uint64_t micros_since(Clock::time_point start) {
@@ -318,7 +330,13 @@ int Serve::report(double match_seconds) {
         .real("bytes_sent_per_client_per_second", per_client)
         .num("dropped_malformed", malformed)
         .num("dropped_unknown", st.dropped_unknown)
-        .real("match_seconds", match_seconds);
+        .real("match_seconds", match_seconds)
+        .raw("tick_lateness_us", Json()
+                                     .num("p50", st.tick_lateness_percentile_us(500))
+                                     .num("p99", st.tick_lateness_percentile_us(990))
+                                     .num("max", st.tick_lateness_max_us)
+                                     .text())
+        .real("cpu_seconds", cpu_seconds());
     if (args_.record.empty()) {
       j.null("record");
     } else {
@@ -342,6 +360,11 @@ int Serve::report(double match_seconds) {
   std::printf("down         %.0f bytes/s per client; dropped %llu malformed, %llu unknown\n",
               per_client, static_cast<unsigned long long>(malformed),
               static_cast<unsigned long long>(st.dropped_unknown));
+  std::printf(
+      "ticks        late by %llu us or less for 99%% of frames (at most %llu us); %.2f s "
+      "of CPU\n",
+      static_cast<unsigned long long>(st.tick_lateness_percentile_us(990)),
+      static_cast<unsigned long long>(st.tick_lateness_max_us), cpu_seconds());
   if (!args_.record.empty()) std::printf("replay       %s\n", args_.record.c_str());
   return exit_ok;
 }
