@@ -76,6 +76,10 @@ class Process {
     waitpid(pid_, &status, 0);
     pid_ = -1;
   }
+  /// Sends `sig` to the process (this one, by its id) if it still runs.
+  void signal(int sig) {
+    if (pid_ >= 0) ::kill(pid_, sig);
+  }
   [[nodiscard]] int exit_code() const { return exit_code_; }
   [[nodiscard]] std::string out() const { return read_text(out_.path()); }
   [[nodiscard]] std::string err() const { return read_text(err_.path()); }

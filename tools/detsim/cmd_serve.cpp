@@ -12,10 +12,16 @@
 // frames ahead of the server (Client::recommended_frame_adjust: one frame extra or skipped, one
 // tick in three), and stops once it has simulated the last frame with the server's inputs and
 // compared the server's hash of the last state.
+//
+// SIGTERM ends the server's match where it is: the replay is closed, the report printed, exit 0.
+// With --agones the server also speaks to the Agones SDK sidecar (agones.hpp): ready once bound,
+// health while it makes progress, the outcome as annotations, then shutdown.
+#include <signal.h>
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <optional>
 #include <set>
@@ -36,6 +42,9 @@
 
 #include "commands.hpp"
 #include "netplay_plan.hpp"
+#if DETSIM_WITH_AGONES
+#include "agones.hpp"
+#endif
 #include "output.hpp"
 #include "scenario_args.hpp"
 
@@ -123,6 +132,37 @@ std::uint64_t micros_since(Clock::time_point start) {
 
 // ---- the server --------------------------------------------------------------------------------
 
+/// The longest pause between a server's polls while no frame is due: 4 ms, or 1 ms under state
+/// authority (whose snapshots go out as slices a few per poll).
+std::uint64_t serve_idle_us(const ServeArgs& args) {
+  return args.authority == "state" ? netplay_idle_sleep_us : 4 * netplay_idle_sleep_us;
+}
+
+volatile std::sig_atomic_t sigterm_received = 0;
+
+void on_sigterm(int) {
+  sigterm_received = 1;
+}
+
+/// SIGTERM sets sigterm_received while the server runs; the previous handler comes back after.
+class SigtermFlag {
+ public:
+  SigtermFlag() {
+    sigterm_received = 0;
+    struct sigaction action {};
+    action.sa_handler = on_sigterm;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESTART;
+    sigaction(SIGTERM, &action, &previous_);
+  }
+  ~SigtermFlag() { sigaction(SIGTERM, &previous_, nullptr); }
+  SigtermFlag(const SigtermFlag&) = delete;
+  SigtermFlag& operator=(const SigtermFlag&) = delete;
+
+ private:
+  struct sigaction previous_ {};
+};
+
 class Serve {
  public:
   explicit Serve(const ServeArgs& args) : args_(args) {}
@@ -138,6 +178,14 @@ class Serve {
   /// peer that stayed a stranger for two sweeps in a row.
   void sweep_peers();
   void handle_events();
+  /// --agones: the client, and ready (the socket is bound).
+  void agones_start();
+  /// --agones: what the loop tells the client each time round (see AgonesClient).
+  void agones_progress();
+  /// --agones: the outcome as annotations, then shutdown (at most 5 s).
+  void agones_finish(const std::string& outcome);
+  /// --agones: the report's "agones" object, or its text line when `json` is false.
+  [[nodiscard]] std::string agones_report(bool json) const;
   int report(double match_seconds);
 
   const ServeArgs& args_;
@@ -149,6 +197,11 @@ class Serve {
   std::optional<net::Server> server_;
   std::set<net::PeerId> strangers_;
   std::string failure_;
+  bool stopped_ = false;  ///< SIGTERM ended the match
+#if DETSIM_WITH_AGONES
+  std::optional<AgonesClient> agones_;
+  AgonesStats agones_stats_;
+#endif
 };
 
 Status Serve::start() {
@@ -227,8 +280,66 @@ void Serve::handle_events() {
   }
 }
 
+#if DETSIM_WITH_AGONES
+void Serve::agones_start() {
+  if (!args_.agones) return;
+  AgonesOptions options;
+  options.port = agones_port_from_environment().value();  // serve_command checked it
+  options.note = [](const std::string& line) {
+    std::fprintf(stderr, "%s serve: agones: %s\n", program_name().c_str(), line.c_str());
+  };
+  agones_.emplace(std::move(options));
+  agones_->ready();
+}
+
+void Serve::agones_progress() {
+  if (!agones_) return;
+  if (server_->current_frame() > 0 && !server_->ended()) {
+    agones_->advanced(server_->current_frame());
+  } else {
+    agones_->heartbeat();  // waiting for players, or for the last acknowledgements
+  }
+}
+
+void Serve::agones_finish(const std::string& outcome) {
+  if (!agones_) return;
+  agones_->annotation("detsim.final-hash", hex(server_->current_hash()));
+  agones_->annotation("detsim.frames", std::to_string(server_->current_frame()));
+  agones_->annotation("detsim.outcome", outcome);
+  agones_->shutdown();
+  agones_stats_ = agones_->stats();
+  agones_.reset();
+}
+
+std::string Serve::agones_report(bool json) const {
+  const AgonesStats& a = agones_stats_;
+  if (json)
+    return Json()
+        .boolean("ready", a.ready)
+        .num("health_pings", a.health_pings)
+        .boolean("shutdown", a.shutdown)
+        .num("calls_sent", a.calls_sent)
+        .num("calls_failed", a.calls_failed)
+        .num("calls_dropped", a.calls_dropped)
+        .text();
+  return std::string(a.ready ? "ready" : "never ready") + ", " + std::to_string(a.health_pings) +
+         " health pings, " + (a.shutdown ? "shut down" : "shutdown not delivered") + "; " +
+         std::to_string(a.calls_sent) + " calls sent, " + std::to_string(a.calls_failed) +
+         " failed, " + std::to_string(a.calls_dropped) + " dropped";
+}
+#else
+void Serve::agones_start() {}
+void Serve::agones_progress() {}
+void Serve::agones_finish(const std::string&) {}
+std::string Serve::agones_report(bool) const {
+  return {};
+}
+#endif
+
 int Serve::run() {
+  const SigtermFlag sigterm;
   if (Status s = start(); !s) return usage_error(serve_name, s.message());
+  agones_start();
   say(args_.scenario + " (seed " + std::to_string(args_.seed) + ", " +
       std::to_string(args_.players) + " seats) served on " +
       transport_->local_endpoint().to_string() + ", authority " + args_.authority + ", " +
@@ -240,11 +351,16 @@ int Serve::run() {
   std::uint64_t next_sweep = 1'000'000;
   const std::uint64_t frame_us = 1'000'000 / args_.fps;
   for (;;) {
+    if (sigterm_received != 0) {
+      stopped_ = true;
+      break;
+    }
     const std::uint64_t now = micros_since(start_);
     server_->poll(now);
     server_->advance(now);
     server_->poll(now);
     handle_events();
+    agones_progress();
     if (now >= next_sweep) {
       sweep_peers();
       next_sweep = now + 1'000'000;
@@ -276,12 +392,18 @@ int Serve::run() {
     }
     const std::uint64_t next = started_at ? *started_at + server_->current_frame() * frame_us : 0;
     const std::uint64_t after = micros_since(start_);
-    std::this_thread::sleep_for(std::chrono::microseconds(
-        next > after ? std::min(next - after, netplay_idle_sleep_us) : netplay_idle_sleep_us));
+    // Until the next frame is due, polling at least every serve_idle_us meanwhile: a server wakes
+    // a few hundred times a second rather than a thousand, which is what lets one machine hold
+    // dozens of matches (docs/SCALE.md, "Density"). Inputs that arrive in between wait in the
+    // socket until the frame's poll, which stamps them no later than polling every millisecond.
+    const std::uint64_t idle = serve_idle_us(args_);
+    std::this_thread::sleep_for(
+        std::chrono::microseconds(next > after ? std::min(next - after, idle) : idle));
   }
   if (recorder_) {
     if (Status s = recorder_->finish(); !s && failure_.empty()) failure_ = s.message();
   }
+  agones_finish(stopped_ ? "stopped" : started_at ? "ended" : "no-match");
   if (!failure_.empty()) return usage_error(serve_name, failure_);
   const std::uint64_t end = micros_since(start_);
   return report(static_cast<double>(ended_at.value_or(end) - started_at.value_or(end)) / 1e6);
@@ -342,6 +464,8 @@ int Serve::report(double match_seconds) {
     } else {
       j.str("record", args_.record);
     }
+    if (stopped_) j.str("stopped", "SIGTERM");
+    if (args_.agones) j.raw("agones", agones_report(true));
     j.print();
     return exit_ok;
   }
@@ -366,6 +490,11 @@ int Serve::report(double match_seconds) {
       static_cast<unsigned long long>(st.tick_lateness_percentile_us(990)),
       static_cast<unsigned long long>(st.tick_lateness_max_us), cpu_seconds());
   if (!args_.record.empty()) std::printf("replay       %s\n", args_.record.c_str());
+  if (stopped_)
+    std::printf("stopped      by SIGTERM at frame %llu of %llu\n",
+                static_cast<unsigned long long>(server_->current_frame()),
+                static_cast<unsigned long long>(args_.frames));
+  if (args_.agones) std::printf("agones       %s\n", agones_report(false).c_str());
   return exit_ok;
 }
 
@@ -614,6 +743,16 @@ int serve_command(const ServeArgs& args) {
     return usage_error(serve_name, "--snapshot-rate must be above 0 and at most --fps");
   if (!(args.timeout_seconds > 0 && args.timeout_seconds <= 86'400))
     return usage_error(serve_name, "--timeout must be more than 0 and at most 86400 seconds");
+#if DETSIM_WITH_AGONES
+  if (args.agones) {
+    if (auto port = agones_port_from_environment(); !port)
+      return usage_error(serve_name, "--agones: " + port.message());
+  }
+#else
+  if (args.agones)
+    return usage_error(serve_name,
+                       "--agones: built without cpp-httplib (Debian libcpp-httplib-dev)");
+#endif
   Serve serve(args);
   return serve.run();
 }

@@ -163,6 +163,8 @@ struct ServeArgs {
   double timeout_seconds = 30;
   std::string record;
   bool json = false;
+  /// Talk to the Agones SDK sidecar at 127.0.0.1:$AGONES_SDK_HTTP_PORT (agones.hpp).
+  bool agones = false;
 };
 int serve_command(const ServeArgs& args);
 

@@ -243,10 +243,25 @@ Packets are not encrypted: the server takes a client's inputs only from the addr
 admitted, for that client's seat, within a window of frames; anything else is counted and
 dropped. docs/SERVER.md explains when to pick a server over rollback or lockstep.
 
-Exit status: 0 the match ran to its end; 2 bad usage, a port in use, or no match (fewer than
---wait-for clients within --timeout). --json prints exactly one JSON object on stdout: frames,
-final_hash, clients (player, bytes_sent, bytes_received, inputs_late, packets_rejected, ...),
-bytes_sent_per_client_per_second.)";
+SIGTERM ends the match at the frame it has reached: the replay of --record is closed (complete up
+to that frame: detsim verify checks it), the report says "stopped by SIGTERM at frame N" (--json:
+"stopped":"SIGTERM"), and the exit status is 0.
+
+--agones (a game server under Agones, docs/SCALE.md): the server talks to the Agones SDK
+sidecar over HTTP at 127.0.0.1:$AGONES_SDK_HTTP_PORT (default 9358). It sends ready once its
+socket is bound; health every 2 s while the server makes progress (its loop waits for players or
+acknowledgements, or the match simulates new frames: a stalled match sends none and Agones marks
+it Unhealthy); when the match ends (or stops), the annotations detsim.final-hash,
+detsim.frames and detsim.outcome (ended, stopped, no-match); then shutdown. A call the sidecar
+does not take is retried with backoff (100 ms doubling to 2 s) from a thread of its own: the
+match never waits for the sidecar, and a sidecar that is not up yet or goes away costs failed
+calls, noted on stderr, never a frame. At the end the server waits at most 5 s for the
+annotations and shutdown to be delivered. The report gains agones (--json: an "agones" object).
+
+Exit status: 0 the match ran to its end, or SIGTERM stopped it; 2 bad usage, a port in use, or no
+match (fewer than --wait-for clients within --timeout). --json prints exactly one JSON object on
+stdout: frames, final_hash, clients (player, bytes_sent, bytes_received, inputs_late,
+packets_rejected, ...), bytes_sent_per_client_per_second.)";
 
 #if DETSIM_WITH_UDP
 void add_serve(CLI::App& app, int& exit_code) {
@@ -293,6 +308,10 @@ void add_serve(CLI::App& app, int& exit_code) {
   c->add_flag("--json", serve.json,
               "Print one JSON object: frames, final_hash, clients, "
               "bytes_sent_per_client_per_second, ...");
+  c->add_flag("--agones", serve.agones,
+              "Run under Agones: ready, health and shutdown to the SDK sidecar at "
+              "127.0.0.1:$AGONES_SDK_HTTP_PORT (default 9358), the final hash and frames as "
+              "annotations (below)");
   c->footer(serve_footer);
   c->callback([&exit_code, wait] {
     if (wait->count() == 0) serve.wait_for = serve.players;
