@@ -10,9 +10,10 @@ packages=(
   libxxhash-dev libcli11-dev                                   # state hashing, the CLI
   libsodium-dev pkg-config                                     # net/: session ids, challenges
   libzstd-dev                                                  # net/: rejoin snapshots
+  libcpp-httplib-dev                                           # detsim serve --agones (HTTP)
   libmpfr-dev libgmp-dev                                       # reference for the accuracy tests
   libbenchmark-dev libfixmath-dev libbullet-dev               # benchmarks and their peers
-  python3                                                      # docs/ table generation
+  python3 python3-yaml                                         # docs/ tables; tests/deploy_test.py
   "$@"  # what the caller needs besides (scripts/matrix.sh: its legs' cross compilers, qemu-user)
 )
 
