@@ -516,11 +516,7 @@ struct Server::Impl {
     }
     std::uint32_t n = 0;
     while (n < max_frames && !ended() && start_us + frame * config.frame_us <= now_us) {
-      const std::uint64_t late = now_us - (start_us + frame * config.frame_us);
-      const std::uint64_t bucket = std::min<std::uint64_t>(
-          late / ServerStats::tick_lateness_bucket_us, stats.tick_lateness.size() - 1);
-      ++stats.tick_lateness[static_cast<std::size_t>(bucket)];
-      stats.tick_lateness_max_us = std::max(stats.tick_lateness_max_us, late);
+      stats.count_tick_lateness(now_us - (start_us + frame * config.frame_us));
       simulate();
       ++n;
     }
@@ -736,23 +732,6 @@ Server::~Server() = default;
 
 void Server::poll(std::uint64_t now_us) {
   impl_->poll(now_us);
-}
-
-std::uint64_t ServerStats::tick_lateness_percentile_us(std::uint32_t per_mille) const noexcept {
-  std::uint64_t total = 0;
-  for (const std::uint64_t n : tick_lateness)
-    total += n;
-  if (total == 0) return 0;
-  // The first bucket by which the count reaches ceil(total × per_mille / 1000).
-  const std::uint64_t want = (total * std::min(per_mille, 1000U) + 999) / 1000;
-  std::uint64_t seen = 0;
-  for (std::size_t i = 0; i < tick_lateness.size(); ++i) {
-    seen += tick_lateness[i];
-    if (seen >= want && seen != 0)
-      return i + 1 == tick_lateness.size() ? tick_lateness_max_us
-                                           : (i + 1) * tick_lateness_bucket_us;
-  }
-  return tick_lateness_max_us;
 }
 
 std::uint32_t Server::advance(std::uint64_t now_us, std::uint32_t max_frames) {

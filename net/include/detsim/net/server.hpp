@@ -126,6 +126,8 @@ struct ServerStats {
   /// The lateness (a bucket's upper edge, µs) that at least per_mille / 1000 of the frames
   /// simulated were within; 0 before any frame. per_mille 990: the 99th percentile.
   [[nodiscard]] std::uint64_t tick_lateness_percentile_us(std::uint32_t per_mille) const noexcept;
+  /// Counts one frame simulated `late_us` after its time (Server::advance does, per frame).
+  void count_tick_lateness(std::uint64_t late_us) noexcept;
 };
 
 enum class ServerEventType : std::uint8_t {
