@@ -11,6 +11,7 @@ packages=(
   libsodium-dev pkg-config                                     # net/: session ids, challenges
   libzstd-dev                                                  # net/: rejoin snapshots
   libcpp-httplib-dev                                           # detsim serve --agones (HTTP)
+  zlib1g-dev libjs-three chromium                              # detsim view; its browser test
   libmpfr-dev libgmp-dev                                       # reference for the accuracy tests
   libbenchmark-dev libfixmath-dev libbullet-dev               # benchmarks and their peers
   python3 python3-yaml                                         # docs/ tables; tests/deploy_test.py

@@ -21,62 +21,14 @@
 #include <detsim/replay/replay.hpp>
 #include <detsim/replay/scenario_replay.hpp>
 
+#include "record.hpp"
 #include "replay_detail.hpp"
 
 namespace detsim::replay {
 namespace {
 
-using State = std::vector<std::uint8_t>;
-
-struct Side {
-  std::string path;
-  std::string kind;
-  std::string label;  ///< "A" or "B"
-  Fingerprint fp;
-  std::uint64_t last = 0;                 ///< state frames 0 .. last
-  std::vector<StateHashes> hashes;        ///< by frame
-  std::vector<std::uint8_t> known;        ///< 1 where hashes[frame] was recorded
-  std::vector<std::uint8_t> inputs;       ///< steps 0 .. last - 1, players * input_size bytes each
-  std::vector<std::uint8_t> gone;         ///< a report's "disconnected" byte per step; else empty
-  std::map<std::uint64_t, State> states;  ///< a report's states by frame
-  std::optional<ReplayReader> replay;     ///< for keyframes
-
-  // Frames index vectors: a frame count is bounded by the bytes read, so it fits size_t.
-  [[nodiscard]] static std::size_t at(std::uint64_t f) { return static_cast<std::size_t>(f); }
-  [[nodiscard]] bool has(std::uint64_t f) const { return f <= last && known[at(f)] != 0; }
-  [[nodiscard]] const StateHashes& hash(std::uint64_t f) const { return hashes[at(f)]; }
-  void set_hash(std::uint64_t f, const StateHashes& h) {
-    hashes[at(f)] = h;
-    known[at(f)] = 1;
-  }
-  /// The "disconnected" byte of a report's step (0 for a replay).
-  [[nodiscard]] std::uint8_t gone_at(std::uint64_t step) const {
-    return gone.empty() ? std::uint8_t{0} : gone[at(step)];
-  }
-  [[nodiscard]] std::size_t unit() const { return std::size_t{fp.players} * fp.input_size; }
-
-  /// The state this side stored at frame f (a report's, or a replay's keyframe), if any.
-  [[nodiscard]] std::optional<State> stored(std::uint64_t f) const {
-    if (auto it = states.find(f); it != states.end()) return it->second;
-    if (!replay) return std::nullopt;
-    for (const KeyframeInfo& k : replay->keyframes()) {
-      if (k.frame != f) continue;
-      auto s = replay->keyframe_state(k);
-      if (s) return std::move(s).value();
-    }
-    return std::nullopt;
-  }
-  /// Frames with a stored state, ascending.
-  [[nodiscard]] std::vector<std::uint64_t> stored_frames() const {
-    std::vector<std::uint64_t> out;
-    for (const auto& [f, s] : states)
-      out.push_back(f);
-    if (replay)
-      for (const KeyframeInfo& k : replay->keyframes())
-        out.push_back(k.frame);
-    return out;
-  }
-};
+using detail::State;
+using Side = detail::Record;
 
 std::string hex_bytes(std::span<const std::uint8_t> bytes) {
   static constexpr char digits[] = "0123456789abcdef";
@@ -86,84 +38,6 @@ std::string hex_bytes(std::span<const std::uint8_t> bytes) {
     out += digits[b & 15];
   }
   return out;
-}
-
-bool is_report(const std::string& path) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> in(std::fopen(path.c_str(), "rb"), &std::fclose);
-  char magic[8] = {};
-  return in && std::fread(magic, 1, 8, in.get()) == 8 && std::equal(magic, magic + 8, "DSDESYNC");
-}
-
-Status load_replay(Side& side) {
-  auto reader = ReplayReader::open(side.path);
-  if (!reader) return reader.status();
-  side.kind = "replay";
-  side.fp = reader->fingerprint();
-  side.last = reader->frame_count();
-  side.hashes.assign(Side::at(side.last) + 1, StateHashes{});
-  side.known.assign(Side::at(side.last) + 1, 1);
-  side.hashes[0].total = side.fp.initial_hash;
-  side.inputs.reserve(Side::at(side.last) * side.unit());
-  Status read = reader->for_each_frame(1, side.last, [&](const FrameRecord& r) {
-    side.hashes[Side::at(r.frame)] = r.hashes;
-    side.inputs.insert(side.inputs.end(), r.inputs.begin(), r.inputs.end());
-    return true;
-  });
-  if (!read) return read;
-  side.replay.emplace(std::move(reader.value()));
-  return Status::success();
-}
-
-/// A world holding the geometry of the record's scenario (what its states are restored against:
-/// a state names its geometry by hash, World::restore needs the world to hold it); a world without
-/// geometry when this build cannot create the scenario (its states restore if they name none).
-World geometry_world(const Fingerprint& fp, const std::string& path) {
-  auto scenario = scenario_of(fp, path);
-  return scenario ? scenario.value().world() : World();
-}
-
-Status load_report(Side& side) {
-  auto read = read_desync_report(side.path);
-  if (!read) return read.status();
-  DesyncReport& r = read.value();
-  side.kind = "desync report";
-  side.fp = r.fingerprint;
-  side.last = r.divergent_frame;  // the reader checked: one confirmed frame per step before it
-  side.hashes.assign(Side::at(side.last) + 1, StateHashes{});
-  side.known.assign(Side::at(side.last) + 1, 0);
-  side.hashes[0].total = side.fp.initial_hash;
-  side.known[0] = 1;
-  const std::size_t unit = side.unit();
-  for (std::size_t at = 0; at < r.confirmed_frames.size(); at += 1 + unit) {
-    side.gone.push_back(r.confirmed_frames[at]);
-    side.inputs.insert(side.inputs.end(),
-                       r.confirmed_frames.begin() + static_cast<std::ptrdiff_t>(at) + 1,
-                       r.confirmed_frames.begin() + static_cast<std::ptrdiff_t>(at + 1 + unit));
-  }
-  side.states[r.agreed_frame] = std::move(r.agreed_state);
-  for (FrameState& f : r.intermediate_states)
-    side.states[f.frame] = std::move(f.state);
-  side.states[r.divergent_frame] = std::move(r.divergent_state);
-  World world = geometry_world(side.fp, side.path);
-  for (const auto& [frame, state] : side.states) {
-    if (Status s = world.restore(state); !s)
-      return Status::error("desync report " + side.path + ": the state of frame " +
-                           std::to_string(frame) + ": " + s.message());
-    if (world.frame() != frame)
-      return Status::error("desync report " + side.path + ": the state stored for frame " +
-                           std::to_string(frame) + " is of frame " + std::to_string(world.frame()));
-    side.set_hash(frame, world.hashes());
-  }
-  return Status::success();
-}
-
-Expected<Side> load(const std::string& path, const char* label) {
-  Side side;
-  side.path = path;
-  side.label = label;
-  const Status s = is_report(path) ? load_report(side) : load_replay(side);
-  if (!s) return Status::error(std::string("side ") + label + ": " + s.message());
-  return side;
 }
 
 std::vector<std::string> fingerprint_differences(const Fingerprint& a, const Fingerprint& b) {
@@ -282,9 +156,9 @@ std::vector<ScenePose> scene_of(const World& geometry, const State& state,
 
 Expected<BisectResult> bisect(const std::string& path_a, const std::string& path_b,
                               const BisectOptions& options) {
-  auto loaded_a = load(path_a, "A");
+  auto loaded_a = detail::load_record(path_a, "A");
   if (!loaded_a) return loaded_a.status();
-  auto loaded_b = load(path_b, "B");
+  auto loaded_b = detail::load_record(path_b, "B");
   if (!loaded_b) return loaded_b.status();
   const Side& a = loaded_a.value();
   const Side& b = loaded_b.value();

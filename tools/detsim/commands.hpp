@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,16 @@ struct BisectArgs {
   bool json = false;
 };
 int bisect_command(const BisectArgs& args);
+
+struct ViewArgs {
+  std::vector<std::string> files;   ///< one record, or two records of the same match
+  std::string out;                  ///< the page; empty: the first file with .html
+  std::uint64_t from = 0;           ///< the first frame shown
+  std::optional<std::uint64_t> to;  ///< the last (default: the records' end)
+  std::string three = "/usr/share/javascript/three";  ///< Debian libjs-three's directory
+  bool json = false;
+};
+int view_command(const ViewArgs& args);
 
 struct DiffArgs {
   std::string a;  ///< a saved state (World::save() bytes)

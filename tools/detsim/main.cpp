@@ -335,6 +335,7 @@ void add_scenario_commands(CLI::App& app, int& exit_code) {
   static cli::InfoArgs info;
   static cli::DiffArgs diff;
   static cli::BisectArgs bisect;
+  static cli::ViewArgs view;
   static cli::SynctestArgs synctest;
   static cli::GoldenArgs golden_check;
   static cli::GoldenArgs golden_update;
@@ -474,6 +475,31 @@ is taken at the first later frame where both are, and the verify command that wo
 frame is printed. Exit 0 when the records agree.)") +
             exit_footer);
   c->callback([&exit_code] { exit_code = cli::bisect_command(bisect); });
+
+  c = app.add_subcommand("view", "Write a 3D replay viewer: one HTML page that plays a match");
+  c->add_option("RECORD", view.files,
+                "A replay or desync report; a second record of the same match overlays both")
+      ->required()
+      ->expected(1, 2);
+  c->add_option("-o,--out", view.out, "The page to write (default: RECORD with .html)")
+      ->type_name("PAGE");
+  c->add_option("--from", view.from, "The first frame shown (default 0)")->type_name("FRAME");
+  c->add_option("--to", view.to, "The last frame shown (default: the end)")->type_name("FRAME");
+  c->add_option("--three", view.three,
+                "Where three.js is (Debian libjs-three; default /usr/share/javascript/three)")
+      ->type_name("DIR");
+  c->add_flag("--json", view.json, "Print one JSON object: page, bytes, frames, bodies, ...");
+  c->footer(std::string(R"(
+The page is one self-contained file (three.js and the match inlined; it opens offline in any
+browser with WebGL): bodies drawn by shape, play/pause, a frame slider, speed, the frame's state
+hash and every player's input. The records are re-simulated here, each with its own inputs, and
+each is shown with its own stored states where it has them (keyframes, a desync report's states).
+Two records of one match are drawn overlaid: from the first frame where they diverge, the bodies
+that differ are drawn red and side B's bodies as an orange ghost. Keys: space plays or pauses,
+left and right step a frame (with shift: a second), home and end jump. A page URL ending in
+#frame=N opens at frame N. docs/VIEWER.md describes the page and its data.)") +
+            exit_footer);
+  c->callback([&exit_code] { exit_code = cli::view_command(view); });
 
   c = app.add_subcommand("diff", "Compare two saved states field by field");
   c->add_option("STATE_A", diff.a, "A saved World state (e.g. from synctest --dump)")->required();

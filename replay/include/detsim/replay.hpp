@@ -5,3 +5,4 @@
 #include <detsim/replay/desync_report.hpp>
 #include <detsim/replay/replay.hpp>
 #include <detsim/replay/scenario_replay.hpp>
+#include <detsim/replay/view.hpp>
