@@ -82,7 +82,7 @@
   scene.background = new THREE.Color(0x1c2129);
   const camera = new THREE.PerspectiveCamera(50, 1, 0.05, 5000);
   const target = new THREE.Vector3().fromArray(meta.camera.target);
-  const distance = Math.max(3, meta.camera.radius * 2.2);
+  const distance = Math.max(3, meta.camera.radius * 1.7);
   camera.position.copy(target).add(new THREE.Vector3(0.55, 0.6, 1).normalize().multiplyScalar(distance));
   camera.lookAt(target);
   const controls = new THREE.OrbitControls(camera, renderer.domElement);
@@ -179,7 +179,11 @@
       if (s === 1) {
         material = ghost;
       } else {
-        material = new THREE.MeshLambertMaterial({ color: color, flatShading: b.type !== 'static' });
+        // Static solids are see-through where the scene has particles (a tank's fluid, a cloth
+        // behind a wall).
+        const seeThrough = b.type === 'static' && meta.groups.length > 0 && !b.outline.half_space;
+        material = new THREE.MeshLambertMaterial({ color: color, flatShading: b.type !== 'static',
+          transparent: seeThrough, opacity: seeThrough ? 0.35 : 1, depthWrite: !seeThrough });
         material.userData.painted = new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors });
       }
       const object = outlineObject(b.outline, color, material);
@@ -193,8 +197,8 @@
     particleObjects.push(meta.groups.map((g, k) => {
       const geometry = new THREE.BufferGeometry();
       const points = new THREE.Points(geometry, new THREE.PointsMaterial({
-        color: s === 1 ? 0xff9a3c : new THREE.Color().setHSL(0.55 + 0.08 * k, 0.6, 0.6),
-        size: Math.max(0.01, 2 * g.radius), sizeAttenuation: true }));
+        color: s === 1 ? 0xff9a3c : new THREE.Color().setHSL(0.6 + 0.07 * k, 0.85, 0.45),
+        size: Math.max(0.06, 2 * g.radius), sizeAttenuation: true }));
       points.visible = false;
       points.frustumCulled = false;
       scene.add(points);
@@ -357,7 +361,8 @@
   function describe(c, frame) {
     const i = frame - c.first;
     const t = (frame * meta.dt).toFixed(2);
-    let html = `<h1>${escapeHtml(meta.scenario)} · seed ${meta.seed} · ${meta.players} player${meta.players === 1 ? '' : 's'}</h1>`;
+    const who = meta.players === 0 ? '' : ` · ${meta.players} player${meta.players === 1 ? '' : 's'}`;
+    let html = `<h1>${escapeHtml(meta.scenario)} · seed ${meta.seed}${who}</h1>`;
     html += `<div class="files">${meta.records.map((r, s) => (sides === 2 ? 'ABCD'[s] + ': ' : '') + escapeHtml(r.path) + ' <span class="dim">(' + escapeHtml(r.kind) + ')</span>').join('<br>')}</div>`;
     html += `<div>frame <b>${frame}</b> of ${meta.last} · t = ${t} s</div>`;
     for (let s = 0; s < sides; s++) {
