@@ -30,7 +30,8 @@ root=$PWD
 
 # name | compiler | optimisation and code-generation flags | emulator ("" = run natively) | ci
 # The "ci" legs give the most independent evidence per minute: the gcc -O2 build of the test suite
-# (free) and 32-bit without __int128 (i686, run on the real CPU). Every other leg, big-endian ones
+# (free), 32-bit without __int128 (i686, run on the real CPU) and WebAssembly (wasm32: Debian's
+# emscripten, the CLI run by node, the way a browser game runs detsim). Every other leg, big-endian ones
 # included, costs 6-15 minutes on two cores (docs/MATRIX.md): DETSIM_MATRIX=full in scripts/test.sh.
 # In order of evidence per minute, so that a time budget cuts the least informative legs: the
 # other CPU architectures first (big-endian 64-bit, ARM, 32-bit big-endian, ...), then the other
@@ -38,6 +39,7 @@ root=$PWD
 legs=(
   "x86_64-gcc-O2|g++|-O2||ci"
   "i686|i686-linux-gnu-g++-12|-O2|qemu-i386|ci"
+  "wasm32|em++|-O2|node|ci"
   "aarch64|aarch64-linux-gnu-g++-12|-O2|qemu-aarch64|"
   "s390x|s390x-linux-gnu-g++-12|-O2|qemu-s390x|"
   "armhf|arm-linux-gnueabihf-g++-12|-O2|qemu-arm|"
@@ -107,9 +109,10 @@ for name in "${selected[@]}" "${!prebuilt[@]}"; do
   find_leg "$name" >/dev/null || { echo "matrix: unknown leg '$name' (--list shows them)" >&2; exit 2; }
 done
 for name in "${!prebuilt[@]}"; do
-  [ -x "${prebuilt[$name]}/tools/detsim" ] ||
+  [ -x "${prebuilt[$name]}/tools/detsim" ] || [ -f "${prebuilt[$name]}/tools/detsim.js" ] ||
     { echo "matrix: leg $name: no detsim in ${prebuilt[$name]}/tools" >&2; exit 2; }
   [ -x "${prebuilt[$name]}/examples/pushball/pushball-tool" ] ||
+    [ -f "${prebuilt[$name]}/examples/pushball/pushball-tool.js" ] ||
     { echo "matrix: leg $name: no pushball-tool in ${prebuilt[$name]}/examples/pushball" >&2; exit 2; }
 done
 
@@ -118,7 +121,11 @@ packages=()
 for name in "${selected[@]}"; do
   [ -n "${prebuilt[$name]:-}" ] && continue
   IFS='|' read -r _ cxx _ emu _ <<<"$(find_leg "$name")"
-  if [ -n "$emu" ]; then packages+=("g++-12-${cxx%-g++-12}" qemu-user); fi
+  if [ "$cxx" = em++ ]; then
+    packages+=(emscripten)
+  elif [ -n "$emu" ]; then
+    packages+=("g++-12-${cxx%-g++-12}" qemu-user)
+  fi
 done
 bash scripts/install-deps.sh "${packages[@]}"
 
@@ -133,6 +140,10 @@ broken=0
 build_leg() {
   local name=$1 cxx=$2 flags=$3 emu=$4 dir=$5
   local cross=()
+  if [ "$cxx" = em++ ]; then
+    build_wasm_leg "$flags" "$dir"
+    return
+  fi
   if [ -n "$emu" ]; then
     # Statically linked, so qemu-user needs no target C library; xxHash and CLI11 come from the
     # host's headers (a cross build has no target libraries of them).
@@ -153,6 +164,25 @@ build_leg() {
     cmake --build "$dir" -j "$jobs" --target detsim pushball-tool >>"$dir.log" 2>&1
 }
 
+# build_wasm_leg FLAGS DIR: the WebAssembly leg, with Debian's emscripten (emcmake sets its CMake
+# toolchain). The project's defaults under Emscripten do the rest: no sockets (DETSIM_WITH_UDP
+# off), no tests or MPFR, xxHash and CLI11 from the host's headers as in the cross legs, and each
+# tool linked into one .js file with its .wasm inside, for node (tools/CMakeLists.txt). Emscripten's
+# JavaScript optimiser needs the acorn module from Debian's node-acorn, which a node not from
+# Debian does not look for. The C API's library is built too (a browser game's engine binds to it),
+# though no check runs it.
+build_wasm_leg() {
+  local flags=$1 dir=$2
+  emcmake cmake -S "$root" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    "-DCMAKE_CXX_FLAGS_RELEASE=$flags" \
+    -DDETSIM_BUILD_TESTS=OFF -DDETSIM_BUILD_EXAMPLES=ON -DDETSIM_INSTALL=OFF \
+    -DDETSIM_WITH_MPFR=OFF -DDETSIM_WERROR=ON \
+    -DDETSIM_HEADER_ONLY_DEPS=ON -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=0 \
+    -DDETSIM_CLI_PARSER_OPTIONS=-O0 >"$dir.log" 2>&1 &&
+    NODE_PATH="/usr/share/nodejs${NODE_PATH:+:$NODE_PATH}" \
+      cmake --build "$dir" -j "$jobs" --target detsim pushball-tool detsim_c >>"$dir.log" 2>&1
+}
+
 # check_leg EMULATOR BUILD_DIR: the golden check and the golden replays' verification, and the
 # example games' golden replays through their own tools (a game's own input bytes and game state
 # section). A cross binary that this machine runs itself (i686 on an x86-64 kernel with 32-bit
@@ -161,7 +191,10 @@ build_leg() {
 check_leg() {
   local emu=$1 dir=$2 bin=$2/tools/detsim game=$2/examples/pushball/pushball-tool
   local run=("$bin") run_game=("$game")
-  if [ -n "$emu" ] && ! "$bin" --version >/dev/null 2>&1; then
+  if [ -f "$bin.js" ]; then  # WebAssembly: the program is JavaScript, run by $emu (node)
+    run=("$emu" "$bin.js")
+    run_game=("$emu" "$game.js")
+  elif [ -n "$emu" ] && ! "$bin" --version >/dev/null 2>&1; then
     run=("$emu" "$bin")
     run_game=("$emu" "$game")
   fi

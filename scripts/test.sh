@@ -4,9 +4,9 @@
 #   2. clang with AddressSanitizer + UndefinedBehaviorSanitizer and checked invariants
 #      (DETSIM_CHECKS), warnings as errors: the whole suite.
 #   3. clang-format: every C++ file is formatted.
-#   4. The determinism matrix (scripts/matrix.sh): every compiler, optimisation level and CPU
-#      architecture that fits in what remains of the CI budget (at least the gcc -O2 build of step 1
-#      and i686) reproduces golden/ bit for bit; DETSIM_MATRIX=full runs every leg.
+#   4. The determinism matrix (scripts/matrix.sh): every compiler, optimisation level, CPU
+#      architecture that fits in what remains of the CI budget (at least the gcc -O2 build of step 1,
+#      i686 and wasm32) reproduces golden/ bit for bit; DETSIM_MATRIX=full runs every leg.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh

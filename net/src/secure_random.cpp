@@ -31,6 +31,20 @@ std::uint64_t secure_random_u64() noexcept {
 #else
 
 namespace {
+#ifdef __EMSCRIPTEN__
+// WebAssembly: Emscripten's getentropy draws from the host's crypto.getRandomValues (a browser)
+// or crypto.randomFillSync (node); it has no getrandom.
+bool fill(void* out, std::size_t size) noexcept {
+  auto* bytes = static_cast<unsigned char*>(out);
+  while (size > 0) {
+    const std::size_t n = size < 256 ? size : 256;  // getentropy's most per call
+    if (getentropy(bytes, n) != 0) return false;
+    bytes += n;
+    size -= n;
+  }
+  return true;
+}
+#else
 bool fill(void* out, std::size_t size) noexcept {
   auto* bytes = static_cast<unsigned char*>(out);
   while (size > 0) {
@@ -44,6 +58,7 @@ bool fill(void* out, std::size_t size) noexcept {
   }
   return true;
 }
+#endif
 }  // namespace
 
 Status secure_random_ready() {

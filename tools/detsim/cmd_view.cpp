@@ -31,6 +31,8 @@
 
 namespace detsim::cli {
 
+#if DETSIM_WITH_ZLIB
+
 extern const char* const view_page_js;
 
 namespace {
@@ -436,7 +438,6 @@ class PageData final : public replay::ViewSink {
     }
     frames_in_chunk_ = 0;
     raw_bytes_ += w.bytes().size();
-#if DETSIM_WITH_ZLIB
     uLongf size = compressBound(static_cast<uLong>(w.bytes().size()));
     std::vector<std::uint8_t> packed(size);
     if (compress2(packed.data(), &size, w.bytes().data(), static_cast<uLong>(w.bytes().size()),
@@ -445,9 +446,6 @@ class PageData final : public replay::ViewSink {
     packed.resize(size);
     chunks_.push_back(base64(packed));
     return Status::success();
-#else
-    return Status::error("this build has no zlib (DETSIM_WITH_ZLIB=OFF): it cannot write pages");
-#endif
   }
 
   replay::ViewInfo info_;
@@ -488,10 +486,6 @@ bool read_text(const std::string& path, std::string& out) {
 
 int view_command(const ViewArgs& args) {
   const auto start = std::chrono::steady_clock::now();
-#if !DETSIM_WITH_ZLIB
-  return usage_error("view",
-                     "this build has no zlib (DETSIM_WITH_ZLIB=OFF): it cannot write pages");
-#else
   // three.js and the two helpers the viewer uses, as Debian's libjs-three installs them.
   static constexpr const char* three_files[] = {"three.min.js", "examples/js/math/ConvexHull.js",
                                                 "examples/js/geometries/ConvexGeometry.js",
@@ -599,7 +593,15 @@ int view_command(const ViewArgs& args) {
       std::printf("note: %s\n", n.c_str());
   }
   return exit_ok;
-#endif
 }
+
+#else
+
+int view_command(const ViewArgs&) {
+  return usage_error("view",
+                     "this build has no zlib (DETSIM_WITH_ZLIB=OFF): it cannot write pages");
+}
+
+#endif
 
 }  // namespace detsim::cli

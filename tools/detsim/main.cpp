@@ -64,7 +64,7 @@ void add_scenario_options(CLI::App* cmd, detsim::cli::ScenarioArgs& a) {
       ->type_name("N");
 }
 
-constexpr const char* netplay_footer = R"(
+[[maybe_unused]] constexpr const char* netplay_footer = R"(
 Every player runs this command with the same --players, --seed and --mode and its own --me, --bind
 and one --peer for each other player, e.g. for two players on one machine:
   detsim netplay --players 2 --me 0 --bind 127.0.0.1:7000 --peer 1=127.0.0.1:7001 --bot 1
@@ -229,7 +229,7 @@ void add_netplay(CLI::App& app, int& exit_code) {
 }
 #endif
 
-constexpr const char* serve_footer = R"(
+[[maybe_unused]] constexpr const char* serve_footer = R"(
 The server owns the match: clients (detsim netplay --server IP:PORT --bind IP:PORT) connect,
 take a seat, and learn the scenario, seed, players and frames from it. It simulates on its own
 clock and never waits for a client: an input that arrives late goes to the next frame not yet
