@@ -1,8 +1,9 @@
 /* The C API from C11 (<detsim/detsim.h>): a ball dropped on a plane comes to rest on it, a saved
  * world restores into a second one that then steps to the same hashes, refusals name the field
  * and change nothing, NULL pointers are refused, queries hit where the geometry says, and two
- * rollback sessions driving the game through C callbacks over a lossy, jittery simulated network
- * agree on every confirmed frame's hash. Exit
+ * rollback sessions driving the game through C callbacks agree on every confirmed frame's hash
+ * over a lossy, jittery simulated network, over UDP on 127.0.0.1, and over the game's own
+ * transport (callbacks) that drops one datagram in ten; bad transports are refused. Exit
  * status 0 when every check holds; each failure is printed with its line. */
 #include <detsim/detsim.h>
 
@@ -305,6 +306,136 @@ static void a_rollback_match_ends_with_equal_confirmed_hashes(void) {
   detsim_network_destroy(network);
 }
 
+/* ---- The same match over UDP on this machine, and over the game's own transport ---- */
+
+/* Plays `ticks` 60 Hz ticks of two sessions on a virtual clock (the last 60 without new input),
+ * then checks that both confirmed at least `min_confirmed` frames and hashed the 300 before the
+ * last 10 alike. */
+static void play_and_compare(detsim_session* sessions[2], uint64_t ticks, uint64_t min_confirmed) {
+  for (uint64_t tick = 0; tick < ticks; ++tick) {
+    const uint64_t now = tick * 16667;
+    for (uint32_t p = 0; p < 2; ++p) {
+      CHECK(detsim_session_poll(sessions[p], now) == DETSIM_OK);
+      if (tick + 60 >= ticks) continue;
+      uint8_t input[4] = {input_of(detsim_session_current_frame(sessions[p]), p), 0, 0, 0};
+      uint32_t what = 99;
+      CHECK(detsim_session_advance_frame(sessions[p], input, sizeof input, &what) == DETSIM_OK);
+    }
+  }
+  const uint64_t confirmed_a = detsim_session_confirmed_frame(sessions[0]);
+  const uint64_t confirmed_b = detsim_session_confirmed_frame(sessions[1]);
+  const uint64_t confirmed = confirmed_a < confirmed_b ? confirmed_a : confirmed_b;
+  CHECK(confirmed >= min_confirmed);
+  if (confirmed < 310) return;
+  uint64_t equal = 0;
+  for (uint64_t frame = confirmed - 310; frame < confirmed - 10; ++frame) {
+    uint64_t ha = 0;
+    uint64_t hb = 1;
+    CHECK(detsim_session_confirmed_hash(sessions[0], frame, &ha) == DETSIM_OK);
+    CHECK(detsim_session_confirmed_hash(sessions[1], frame, &hb) == DETSIM_OK);
+    equal += ha == hb;
+  }
+  CHECK(equal == 300);
+}
+
+/* Two players' games and their sessions, player p's over transports[p]. */
+static void start_match(ball_game games[2], detsim_game callbacks[2],
+                        detsim_transport* transports[2], detsim_session* sessions[2]) {
+  for (uint32_t p = 0; p < 2; ++p) {
+    games[p].world = two_ball_world();
+    games[p].resimulated = 0;
+    callbacks[p].context = &games[p];
+    callbacks[p].save = game_save;
+    callbacks[p].free_buffer = game_free;
+    callbacks[p].load = game_load;
+    callbacks[p].advance = game_advance;
+    detsim_session_config config;
+    detsim_session_config_init(&config);
+    config.local_player = p;
+    config.fingerprint = 0xC0FFEE;
+    CHECK(detsim_session_create_on(&config, &callbacks[p], transports[p], &sessions[p]) ==
+          DETSIM_OK);
+  }
+}
+
+static void a_match_over_udp_on_this_machine_ends_with_equal_hashes(void) {
+  detsim_transport* udp[2] = {NULL, NULL};
+  uint16_t ports[2] = {0, 0};
+  for (uint32_t p = 0; p < 2; ++p) {
+    CHECK(detsim_udp_open("127.0.0.1:0", &udp[p]) == DETSIM_OK);
+    CHECK(detsim_udp_local_port(udp[p], &ports[p]) == DETSIM_OK && ports[p] != 0);
+  }
+  for (uint32_t p = 0; p < 2; ++p) {
+    char address[32];
+    snprintf(address, sizeof address, "127.0.0.1:%u", (unsigned)ports[1 - p]);
+    CHECK(detsim_udp_add_peer(udp[p], 1 - p, address) == DETSIM_OK);
+  }
+  ball_game games[2];
+  detsim_game callbacks[2];
+  detsim_session* sessions[2] = {NULL, NULL};
+  start_match(games, callbacks, udp, sessions);
+  play_and_compare(sessions, 660, 500);
+  /* Refusals: a bad address, a second peer at the same player, a UDP call on another transport. */
+  detsim_transport* bad = NULL;
+  CHECK(detsim_udp_open("127.0.0.1:99999", &bad) == DETSIM_INVALID_ARGUMENT && bad == NULL);
+  CHECK(strstr(detsim_last_error(), "99999") != NULL);
+  CHECK(detsim_udp_add_peer(udp[0], 1, "127.0.0.1:9") == DETSIM_INVALID_ARGUMENT);
+  for (uint32_t p = 0; p < 2; ++p) {
+    detsim_session_destroy(sessions[p]);
+    detsim_transport_destroy(udp[p]);
+    detsim_world_destroy(games[p].world);
+  }
+}
+
+/* The game's own network: each player's datagrams are delivered to the other player's
+ * transport, one in ten dropped. */
+typedef struct wire {
+  detsim_transport* transports[2];
+  uint32_t sent;
+  uint32_t dropped;
+} wire;
+typedef struct wire_end {
+  wire* wire;
+  uint32_t player;
+} wire_end;
+
+static void wire_send(void* context, uint32_t player, const uint8_t* bytes, size_t size) {
+  wire_end* end = context;
+  CHECK(player == 1 - end->player);
+  CHECK(size <= DETSIM_MAX_DATAGRAM);
+  if (++end->wire->sent % 10 == 0) {
+    ++end->wire->dropped;
+    return;
+  }
+  CHECK(detsim_transport_deliver(end->wire->transports[player], end->player, bytes, size) ==
+        DETSIM_OK);
+}
+
+static void a_match_over_the_games_own_transport_ends_with_equal_hashes(void) {
+  wire w = {{NULL, NULL}, 0, 0};
+  wire_end ends[2] = {{&w, 0}, {&w, 1}};
+  for (uint32_t p = 0; p < 2; ++p)
+    CHECK(detsim_transport_create(wire_send, &ends[p], &w.transports[p]) == DETSIM_OK);
+  ball_game games[2];
+  detsim_game callbacks[2];
+  detsim_session* sessions[2] = {NULL, NULL};
+  start_match(games, callbacks, w.transports, sessions);
+  play_and_compare(sessions, 660, 500);
+  CHECK(w.dropped > 0);
+  /* Refusals: an oversized datagram, a UDP call on a callback transport, no send function. */
+  static uint8_t big[DETSIM_MAX_DATAGRAM + 1];
+  CHECK(detsim_transport_deliver(w.transports[0], 1, big, sizeof big) == DETSIM_INVALID_ARGUMENT);
+  CHECK(strstr(detsim_last_error(), "1201") != NULL);
+  CHECK(detsim_udp_add_peer(w.transports[0], 1, "127.0.0.1:7000") == DETSIM_INVALID_ARGUMENT);
+  detsim_transport* none = NULL;
+  CHECK(detsim_transport_create(NULL, NULL, &none) == DETSIM_INVALID_ARGUMENT && none == NULL);
+  for (uint32_t p = 0; p < 2; ++p) {
+    detsim_session_destroy(sessions[p]);
+    detsim_transport_destroy(w.transports[p]);
+    detsim_world_destroy(games[p].world);
+  }
+}
+
 int main(void) {
   numbers();
   a_ball_comes_to_rest_on_the_plane();
@@ -312,6 +443,8 @@ int main(void) {
   refusals_name_the_field_and_change_nothing();
   queries_hit_where_the_geometry_says();
   a_rollback_match_ends_with_equal_confirmed_hashes();
+  a_match_over_udp_on_this_machine_ends_with_equal_hashes();
+  a_match_over_the_games_own_transport_ends_with_equal_hashes();
   if (failures > 0) {
     fprintf(stderr, "%d check(s) failed\n", failures);
     return 1;

@@ -9,6 +9,8 @@
 #include <exception>
 #include <memory>
 #include <new>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -17,7 +19,11 @@
 #include <detsim/net/game.hpp>
 #include <detsim/net/session.hpp>
 #include <detsim/net/sim_network.hpp>
+#include <detsim/net/transport.hpp>
 #include <detsim/sim/world.hpp>
+#if DETSIM_WITH_UDP
+#include <detsim/net/udp.hpp>
+#endif
 
 struct detsim_world {
   detsim::World world;
@@ -25,6 +31,46 @@ struct detsim_world {
 
 struct detsim_network {
   detsim::net::SimNetwork network;
+};
+
+namespace detsim_c {
+
+// The game's own network as a net::Transport: send() calls the game's function; what the game
+// delivers waits in a bounded queue for the session's next receive().
+class CallbackTransport final : public detsim::net::Transport {
+ public:
+  static constexpr std::size_t max_waiting = 4096;
+
+  CallbackTransport(detsim_send_fn send_fn, void* context) : send_(send_fn), context_(context) {}
+  void send(detsim::net::PeerId to, std::span<const std::uint8_t> bytes) override {
+    send_(context_, to, bytes.data(), bytes.size());
+  }
+  void receive(std::vector<detsim::net::Datagram>& out) override {
+    for (detsim::net::Datagram& d : waiting_)
+      out.push_back(std::move(d));
+    waiting_.clear();
+  }
+  /// False when the queue is full (the datagram is dropped).
+  bool deliver(std::uint32_t from, std::span<const std::uint8_t> bytes) {
+    if (waiting_.size() >= max_waiting) return false;
+    waiting_.push_back({from, std::vector<std::uint8_t>(bytes.begin(), bytes.end())});
+    return true;
+  }
+
+ private:
+  detsim_send_fn send_;
+  void* context_;
+  std::vector<detsim::net::Datagram> waiting_;
+};
+
+}  // namespace detsim_c
+
+struct detsim_transport {
+  std::unique_ptr<detsim::net::Transport> transport;
+  detsim_c::CallbackTransport* callbacks = nullptr;  ///< when made by detsim_transport_create
+#if DETSIM_WITH_UDP
+  detsim::net::UdpTransport* udp = nullptr;  ///< when made by detsim_udp_open
+#endif
 };
 
 namespace detsim_c {
@@ -445,54 +491,177 @@ detsim_result detsim_network_advance_to(detsim_network* network, uint64_t now_us
   });
 }
 
+namespace {
+
+/// A session over `transport`, player p at peer p; `nodes` (a simulated network's size) bounds the
+/// players when given. `name` names the entry point in messages.
+detsim_result create_session(const char* name, const detsim_session_config* config,
+                             const detsim_game* game, detsim::net::Transport* transport,
+                             std::optional<std::uint32_t> nodes, detsim_session** out) {
+  if (config == nullptr) return null_argument(name, "config");
+  if (game == nullptr) return null_argument(name, "game");
+  if (out == nullptr) return null_argument(name, "out");
+  if (game->save == nullptr || game->load == nullptr || game->advance == nullptr)
+    return fail(DETSIM_INVALID_ARGUMENT,
+                std::string(name) + ": the game's save, load and advance must all be set");
+  if (config->mode > DETSIM_MODE_LOCKSTEP) {
+    return fail(DETSIM_INVALID_ARGUMENT, "session config: mode " + std::to_string(config->mode) +
+                                             " is not 0 (rollback) or 1 (lockstep)");
+  }
+  if (nodes && (config->players > *nodes || config->local_player >= *nodes)) {
+    return fail(DETSIM_INVALID_ARGUMENT, "session config: " + std::to_string(config->players) +
+                                             " players need as many network nodes, the network "
+                                             "has " +
+                                             std::to_string(*nodes));
+  }
+  detsim::net::SessionConfig c;
+  c.mode = static_cast<detsim::net::SessionMode>(config->mode);
+  c.players = config->players;
+  c.local_player = config->local_player;
+  c.input_size = config->input_size;
+  c.input_delay = config->input_delay;
+  c.max_prediction = config->max_prediction;
+  c.fingerprint = config->fingerprint;
+  for (std::uint32_t p = 0; p < config->players; ++p) {
+    if (p != config->local_player) c.remotes.push_back({p, p});
+  }
+  auto wrapper = std::make_unique<detsim_session>();
+  wrapper->game = std::make_unique<detsim_c::CallbackGame>(*game);
+  auto session = detsim::net::Session::create(c, *wrapper->game, *transport);
+  if (!session.ok()) return fail(DETSIM_INVALID_ARGUMENT, session.message());
+  wrapper->session = std::make_unique<detsim::net::Session>(std::move(session.value()));
+  detsim_session* self = wrapper.get();
+  self->session->set_confirmed_listener([self](const detsim::net::ConfirmedFrame& f) {
+    const std::size_t slot = f.frame % detsim_session::kept_hashes;
+    self->frames[slot] = f.frame;
+    self->hashes[slot] = f.hash;
+    self->kept[slot] = true;
+  });
+  *out = wrapper.release();
+  return ok();
+}
+
+}  // namespace
+
 detsim_result detsim_session_create(const detsim_session_config* config, const detsim_game* game,
                                     detsim_network* network, detsim_session** out) {
   return guarded("detsim_session_create", [&] {
-    if (config == nullptr) return null_argument("detsim_session_create", "config");
-    if (game == nullptr) return null_argument("detsim_session_create", "game");
     if (network == nullptr) return null_argument("detsim_session_create", "network");
-    if (out == nullptr) return null_argument("detsim_session_create", "out");
-    if (game->save == nullptr || game->load == nullptr || game->advance == nullptr)
+    const std::uint32_t nodes = network->network.nodes();
+    if (config != nullptr && config->local_player >= nodes)
       return fail(DETSIM_INVALID_ARGUMENT,
-                  "detsim_session_create: the game's save, load and advance must all be set");
-    if (config->mode > DETSIM_MODE_LOCKSTEP) {
-      return fail(DETSIM_INVALID_ARGUMENT, "session config: mode " + std::to_string(config->mode) +
-                                               " is not 0 (rollback) or 1 (lockstep)");
-    }
-    if (config->players > network->network.nodes() ||
-        config->local_player >= network->network.nodes()) {
+                  "session config: local player " + std::to_string(config->local_player) +
+                      " is not a node of the network, which has " + std::to_string(nodes));
+    return create_session(
+        "detsim_session_create", config, game,
+        config == nullptr ? nullptr : &network->network.endpoint(config->local_player), nodes, out);
+  });
+}
+
+detsim_result detsim_session_create_on(const detsim_session_config* config, const detsim_game* game,
+                                       detsim_transport* transport, detsim_session** out) {
+  return guarded("detsim_session_create_on", [&] {
+    if (transport == nullptr) return null_argument("detsim_session_create_on", "transport");
+    return create_session("detsim_session_create_on", config, game, transport->transport.get(),
+                          std::nullopt, out);
+  });
+}
+
+detsim_result detsim_udp_open(const char* bind, detsim_transport** out) {
+  return guarded("detsim_udp_open", [&] {
+    if (bind == nullptr) return null_argument("detsim_udp_open", "bind");
+    if (out == nullptr) return null_argument("detsim_udp_open", "out");
+#if DETSIM_WITH_UDP
+    auto endpoint = detsim::net::parse_endpoint(bind);
+    if (!endpoint.ok()) return fail(DETSIM_INVALID_ARGUMENT, "bind: " + endpoint.message());
+    auto udp = detsim::net::UdpTransport::open(endpoint.value(), {});
+    if (!udp.ok()) return fail(DETSIM_INVALID_ARGUMENT, udp.message());
+    auto t = std::make_unique<detsim_transport>();
+    auto owned = std::make_unique<detsim::net::UdpTransport>(std::move(udp.value()));
+    t->udp = owned.get();
+    t->transport = std::move(owned);
+    *out = t.release();
+    return ok();
+#else
+    return fail(DETSIM_INVALID_ARGUMENT,
+                "detsim_udp_open: this build has no sockets (DETSIM_WITH_UDP=OFF); bring the "
+                "network with detsim_transport_create");
+#endif
+  });
+}
+
+detsim_result detsim_udp_add_peer(detsim_transport* transport, uint32_t player,
+                                  const char* address) {
+  return guarded("detsim_udp_add_peer", [&] {
+    if (transport == nullptr) return null_argument("detsim_udp_add_peer", "transport");
+    if (address == nullptr) return null_argument("detsim_udp_add_peer", "address");
+#if DETSIM_WITH_UDP
+    if (transport->udp == nullptr)
       return fail(DETSIM_INVALID_ARGUMENT,
-                  "session config: " + std::to_string(config->players) +
-                      " players need as many network nodes, the network has " +
-                      std::to_string(network->network.nodes()));
-    }
-    detsim::net::SessionConfig c;
-    c.mode = static_cast<detsim::net::SessionMode>(config->mode);
-    c.players = config->players;
-    c.local_player = config->local_player;
-    c.input_size = config->input_size;
-    c.input_delay = config->input_delay;
-    c.max_prediction = config->max_prediction;
-    c.fingerprint = config->fingerprint;
-    for (std::uint32_t p = 0; p < config->players; ++p) {
-      if (p != config->local_player) c.remotes.push_back({p, p});
-    }
-    auto wrapper = std::make_unique<detsim_session>();
-    wrapper->game = std::make_unique<detsim_c::CallbackGame>(*game);
-    auto session = detsim::net::Session::create(c, *wrapper->game,
-                                                network->network.endpoint(config->local_player));
-    if (!session.ok()) return fail(DETSIM_INVALID_ARGUMENT, session.message());
-    wrapper->session = std::make_unique<detsim::net::Session>(std::move(session.value()));
-    detsim_session* self = wrapper.get();
-    self->session->set_confirmed_listener([self](const detsim::net::ConfirmedFrame& f) {
-      const std::size_t slot = f.frame % detsim_session::kept_hashes;
-      self->frames[slot] = f.frame;
-      self->hashes[slot] = f.hash;
-      self->kept[slot] = true;
-    });
-    *out = wrapper.release();
+                  "detsim_udp_add_peer: the transport is not a UDP one (detsim_udp_open)");
+    auto endpoint = detsim::net::parse_endpoint(address);
+    if (!endpoint.ok())
+      return fail(DETSIM_INVALID_ARGUMENT,
+                  "player " + std::to_string(player) + "'s address: " + endpoint.message());
+    if (detsim::Status s = transport->udp->add_peer({player, endpoint.value()}); !s)
+      return fail(DETSIM_INVALID_ARGUMENT, s.message());
+    return ok();
+#else
+    (void)player;
+    return fail(DETSIM_INVALID_ARGUMENT, "detsim_udp_add_peer: this build has no sockets");
+#endif
+  });
+}
+
+detsim_result detsim_udp_local_port(const detsim_transport* transport, uint16_t* port) {
+  return guarded("detsim_udp_local_port", [&] {
+    if (transport == nullptr) return null_argument("detsim_udp_local_port", "transport");
+    if (port == nullptr) return null_argument("detsim_udp_local_port", "port");
+#if DETSIM_WITH_UDP
+    if (transport->udp == nullptr)
+      return fail(DETSIM_INVALID_ARGUMENT,
+                  "detsim_udp_local_port: the transport is not a UDP one (detsim_udp_open)");
+    *port = transport->udp->local_endpoint().port;
+    return ok();
+#else
+    return fail(DETSIM_INVALID_ARGUMENT, "detsim_udp_local_port: this build has no sockets");
+#endif
+  });
+}
+
+detsim_result detsim_transport_create(detsim_send_fn send, void* context, detsim_transport** out) {
+  return guarded("detsim_transport_create", [&] {
+    if (send == nullptr) return null_argument("detsim_transport_create", "send");
+    if (out == nullptr) return null_argument("detsim_transport_create", "out");
+    auto t = std::make_unique<detsim_transport>();
+    auto owned = std::make_unique<detsim_c::CallbackTransport>(send, context);
+    t->callbacks = owned.get();
+    t->transport = std::move(owned);
+    *out = t.release();
     return ok();
   });
+}
+
+detsim_result detsim_transport_deliver(detsim_transport* transport, uint32_t from,
+                                       const uint8_t* bytes, size_t size) {
+  return guarded("detsim_transport_deliver", [&] {
+    if (transport == nullptr) return null_argument("detsim_transport_deliver", "transport");
+    if (bytes == nullptr && size != 0) return null_argument("detsim_transport_deliver", "bytes");
+    if (transport->callbacks == nullptr)
+      return fail(DETSIM_INVALID_ARGUMENT,
+                  "detsim_transport_deliver: the transport was not made by "
+                  "detsim_transport_create (a UDP transport reads its own socket)");
+    if (size > detsim::net::max_datagram)
+      return fail(DETSIM_INVALID_ARGUMENT, "detsim_transport_deliver: " + std::to_string(size) +
+                                               " bytes is more than a datagram holds (" +
+                                               std::to_string(detsim::net::max_datagram) + ")");
+    transport->callbacks->deliver(from, std::span<const std::uint8_t>(bytes, size));
+    return ok();
+  });
+}
+
+void detsim_transport_destroy(detsim_transport* transport) {
+  delete transport;
 }
 
 void detsim_session_destroy(detsim_session* session) {

@@ -166,7 +166,8 @@ detsim_result detsim_world_shape_cast(const detsim_world* world, const detsim_sh
                                       detsim_vec3 position, detsim_quat orientation,
                                       detsim_vec3 translation, detsim_hit* hit, int* found);
 
-/* ---- Sessions: rollback and lockstep (docs/NET.md) over a seeded simulated network ---- */
+/* ---- Sessions: rollback and lockstep (docs/NET.md), over a seeded simulated network here and
+ * over UDP or the game's own transport below ---- */
 
 /* The game a session drives, GGPO's shape: the session decides when the game saves, loads and
  * advances. Every callback is called from inside detsim_session_poll or
@@ -256,6 +257,44 @@ uint64_t detsim_session_confirmed_frame(const detsim_session* session);
  * handed it on (the last 1024 such frames are kept). */
 detsim_result detsim_session_confirmed_hash(const detsim_session* session, uint64_t frame,
                                             uint64_t* hash);
+
+/* ---- Sessions over a real network: UDP, or the game's own transport ---- */
+
+/* Where a session's datagrams go. Player p's datagrams are sent to, and received from, peer p.
+ * Datagrams are at most DETSIM_MAX_DATAGRAM bytes; a transport is unreliable by contract (the
+ * session's protocol checks every byte and resends what matters). */
+#define DETSIM_MAX_DATAGRAM 1200
+typedef struct detsim_transport detsim_transport;
+
+/* A UDP socket bound to `bind` ("0.0.0.0:7000", "[::1]:0"; numeric addresses only, port 0: the
+ * system picks one, see detsim_udp_local_port), non-blocking. Errors name the address and the
+ * system's reason. In a build without sockets (DETSIM_WITH_UDP off, e.g. WebAssembly) this fails
+ * with DETSIM_INVALID_ARGUMENT and says so: bring the network with detsim_transport_create. */
+detsim_result detsim_udp_open(const char* bind, detsim_transport** out);
+/* Tells a UDP transport where player `player` is ("192.0.2.10:7000"): its datagrams go there, and
+ * only datagrams from exactly that address and port are taken as that player's. */
+detsim_result detsim_udp_add_peer(detsim_transport* transport, uint32_t player,
+                                  const char* address);
+/* The port a UDP transport is bound to (the system's choice when bound to port 0). */
+detsim_result detsim_udp_local_port(const detsim_transport* transport, uint16_t* port);
+
+/* The game's own network (Steam, WebRTC, WebSocket, a relay): detsim calls `send` with each
+ * datagram for player `player`, from inside detsim_session_poll or detsim_session_advance_frame;
+ * the game passes every datagram it receives to detsim_transport_deliver. */
+typedef void (*detsim_send_fn)(void* context, uint32_t player, const uint8_t* bytes, size_t size);
+detsim_result detsim_transport_create(detsim_send_fn send, void* context, detsim_transport** out);
+/* Queues a datagram received from player `from` for the session's next poll. More than
+ * DETSIM_MAX_DATAGRAM bytes is refused (DETSIM_INVALID_ARGUMENT); at most 4096 datagrams wait
+ * (more are dropped, as a network would). Only for transports made by detsim_transport_create. */
+detsim_result detsim_transport_deliver(detsim_transport* transport, uint32_t from,
+                                       const uint8_t* bytes, size_t size);
+/* Destroy a transport after the session that uses it. NULL is fine. */
+void detsim_transport_destroy(detsim_transport* transport);
+
+/* A session for config->local_player whose peers are reached through `transport` (player p is
+ * peer p). The game's state is saved as frame 0. The transport must outlive the session. */
+detsim_result detsim_session_create_on(const detsim_session_config* config, const detsim_game* game,
+                                       detsim_transport* transport, detsim_session** out);
 
 #ifdef __cplusplus
 }
