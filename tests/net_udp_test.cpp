@@ -7,11 +7,13 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -149,6 +151,31 @@ TEST(NetUdpEndpoint, AcceptsNumericAddressesAndPrintsThemCanonically) {
   EXPECT_EQ(parsed("127.0.0.1:7000"), Endpoint::ipv4(127, 0, 0, 1, 7000));
   EXPECT_EQ(parsed("[::1]:7000"), Endpoint::loopback(IpFamily::v6, 7000));
   EXPECT_EQ(parsed("[::1]:7000").family, IpFamily::v6);
+}
+
+// Endpoints order by family (IPv4 first), then address bytes, then port: the order of the tuple
+// (family, address, port), checked against std::tuple's on every pair of a small set.
+TEST(NetUdpEndpoint, OrdersByFamilyThenAddressThenPort) {
+  std::array<std::uint8_t, 16> low{};
+  std::array<std::uint8_t, 16> high{};
+  high[0] = 0x20;
+  const std::vector<Endpoint> all = {Endpoint::ipv4(10, 0, 0, 1, 7000),
+                                     Endpoint::ipv4(10, 0, 0, 1, 7001),
+                                     Endpoint::ipv4(10, 0, 0, 2, 1),
+                                     Endpoint::ipv4(9, 255, 255, 255, 65535),
+                                     Endpoint::ipv6(low, 7000),
+                                     Endpoint::ipv6(high, 1),
+                                     Endpoint::ipv6(high, 0)};
+  for (const Endpoint& a : all) {
+    for (const Endpoint& b : all) {
+      const auto tuple = [](const Endpoint& e) {
+        return std::make_tuple(static_cast<int>(e.family), e.address, e.port);
+      };
+      EXPECT_EQ(a < b, tuple(a) < tuple(b)) << a.to_string() << " vs " << b.to_string();
+      EXPECT_EQ(a == b, tuple(a) == tuple(b)) << a.to_string() << " vs " << b.to_string();
+      EXPECT_EQ((a <=> b) == 0, a == b);
+    }
+  }
 }
 
 TEST(NetUdpEndpoint, RejectsMalformedTextNamingTheProblem) {

@@ -84,7 +84,19 @@ struct Endpoint {
   /// parse_endpoint(e.to_string()) == e.
   [[nodiscard]] std::string to_string() const;
 
-  friend constexpr auto operator<=>(const Endpoint&, const Endpoint&) noexcept = default;
+  /// Written out rather than defaulted: a defaulted one needs std::array's operator<=>, which
+  /// some standard libraries lack (Emscripten 3.1.6's libc++ deletes it).
+  friend constexpr std::strong_ordering operator<=>(const Endpoint& a, const Endpoint& b) noexcept {
+    if (a.family != b.family)
+      return static_cast<int>(a.family) < static_cast<int>(b.family)
+                 ? std::strong_ordering::less
+                 : std::strong_ordering::greater;
+    for (std::size_t i = 0; i < a.address.size(); ++i)
+      if (a.address[i] != b.address[i])
+        return a.address[i] < b.address[i] ? std::strong_ordering::less
+                                           : std::strong_ordering::greater;
+    return a.port <=> b.port;
+  }
   friend constexpr bool operator==(const Endpoint&, const Endpoint&) noexcept = default;
 };
 
