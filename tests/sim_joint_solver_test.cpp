@@ -1,4 +1,4 @@
-// Joints, continued from sim_joint_test.cpp (docs/JOINTS-WIP.md): set_joint_motor, the joint
+// Joints, continued from sim_joint_test.cpp (docs/SIM.md, "Joints"): set_joint_motor, the joint
 // reaction, joint events, the slider's limit and motor, and the loads of issue 17's tests —
 // motors against loads, limits against torques, breaking, random torques on a shoulder, a hanging
 // chain and a wrecking ball a hundred times heavier than its links. Every expectation is derived
@@ -803,7 +803,8 @@ TEST(SimBallJoint, WreckingBallSwingsAsAPendulum) {
   // load, the ball's weight and centripetal force at the bottom, M g (3 - 2 cos 30), over the
   // light joints' effective mass (resting_gap scaled); the ball never rises above its start.
   // With the default single iteration of Gauss-Seidel the light links flailed (27 m/s, anchors
-  // 0.53 m apart, docs/JOINTS-WIP.md): the chain is a tree, its point blocks solved exactly.
+  // 0.53 m apart; docs/SIM.md, "Joints", "Trees"): the chain is a tree, its point blocks solved
+  // exactly.
   const WorldDef def;
   const Fixed angle = Fixed::pi() / 6_fx;
   Chain chain(def, 10, 0.5_fx, 100_fx, {0_fx, 20_fx, 0_fx}, {sin(angle), -cos(angle), 0_fx});

@@ -149,7 +149,7 @@ TEST(SimJointStructures, FortyPlankBridgeSettlesWithoutGainingEnergyAndRestsStil
               rise, to_string(fastest(w)).c_str(), to_string(gap).c_str());
   // At rest: no plank moving faster than the chain test's 0.05 m/s (asleep counts as still).
   EXPECT_LT(fastest(w), 0.05_fx);
-  // Held together: the hinges' give under the bridge's tension (docs/JOINTS-WIP.md, item 7: a
+  // Held together: the hinges' give under the bridge's tension (docs/SIM.md, "Joints": a
   // soft joint at rest stretches by F / (m_eff (2 pi 60 Hz)^2)). The end tension of a hanging
   // chain of weight W whose ends leave at angle theta is at most W / (2 sin theta): for 200 kg
   // and the planks' 0.2 rad, 4.93 kN, along the planks. Along a plank's axis its end's arm is

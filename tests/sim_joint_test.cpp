@@ -1,4 +1,4 @@
-// Joints (work in progress, docs/JOINTS-WIP.md): the API's promises (refusals name the field and
+// Joints (docs/SIM.md, "Joints"): the API's promises (refusals name the field and
 // change nothing, IDs ascend, a destroyed body takes its joints along) and the physics of the
 // solved joint types, with expectations derived from formulas (stated beside each), never from a
 // previous run's output.
@@ -168,8 +168,8 @@ TEST(SimJoint, DestroyingABodyRemovesItsJoints) {
 
 TEST(SimJoint, ACopiedWorldStepsLikeTheOriginal) {
   // A world copy carries its joints (definitions and warm-start impulses): the copy and the
-  // original give the same bytes and the same joint states step after step. (A save and restore
-  // does not yet: joints are not in the saved state, docs/JOINTS-WIP.md.)
+  // original give the same bytes and the same joint states step after step. (So does a save and
+  // restore: tests/sim_joint_state_test.cpp.)
   World w = make_world();
   BodyId previous = add(w, anchor_at({0_fx, 10_fx, 0_fx}));
   for (std::int32_t i = 0; i < 5; ++i) {

@@ -1,5 +1,5 @@
-// World: joints — creation, destruction and queries (work in progress, docs/JOINTS-WIP.md). The
-// solver's joint kind is solver/joint_solver.cpp.
+// World: joints — creation, destruction and queries (docs/SIM.md, "Joints"). The solver's joint
+// kind is solver/joint_solver.cpp.
 #include <algorithm>
 #include <cstdint>
 #include <span>

@@ -1,6 +1,6 @@
 // Joints, the second constraint kind (after contacts, solve.cpp): soft point constraints of the
-// sub-stepped solver, as Box2D v3 solves its joints, in 3D. Work in progress
-// (docs/JOINTS-WIP.md): every type is solved; joints are not yet in the saved state.
+// sub-stepped solver, as Box2D v3 solves its joints, in 3D (docs/SIM.md, "Joints": each type,
+// the choices made and what is not done yet).
 //
 // Unlike a contact, whose anchors stay fixed for the step, a joint's anchors turn with its bodies:
 // after every sub-step's position update (positions_moved) the anchors are rotated from each
@@ -745,8 +745,8 @@ void JointSolver::solve() {
   solve_joints(true);
 }
 
-// Not yet: the joint types solved so far have no hard limit to hold from the ground up (a
-// limit's end of range, later); their error stays within the spring's range.
+// Not yet: the limits (hinge, slider, swing-twist) are soft rows in solve and relax, not held here
+// from the ground up like the contact kind's end of range (docs/SIM.md, "Joints", "Not yet").
 void JointSolver::hold() {}
 
 // Not yet: position error beyond the spring's range (a chain stretched by a huge load) will be

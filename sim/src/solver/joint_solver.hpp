@@ -1,6 +1,6 @@
 // Joints as a constraint kind (joint_solver.cpp), run after contacts in every stage (solve.cpp).
-// Work in progress (docs/JOINTS-WIP.md): all six joint types are solved (swing-twist without a
-// motor). Internal to detsim::sim.
+// All six joint types (docs/SIM.md, "Joints": what each holds, and what is not done yet).
+// Internal to detsim::sim.
 #pragma once
 
 #include <array>

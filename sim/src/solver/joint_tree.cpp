@@ -4,7 +4,7 @@
 // Why: Gauss-Seidel passes a load along a chain one joint per pass. With the default single
 // iteration, a 100 kg ball on ten 1 kg links flailed (links at 27 m/s, anchors 0.53 m apart);
 // ragdolls landing on steps came apart by 0.35 m; a 20-plank bridge under a box stretched 8-10 mm
-// a joint (docs/JOINTS-WIP.md, Missing, item 7).
+// a joint (docs/SIM.md, "Joints", "Trees").
 //
 // The system. For the point rows of all the tree's joints together, A lambda = rhs with
 // A = J M^-1 J^T: A_jj is joint j's own 3x3 block K_j, A_jk = J_j,P M_P^-1 J_k,P^T for joints j

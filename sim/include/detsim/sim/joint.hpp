@@ -1,4 +1,5 @@
-// Joints: constraints between two bodies (docs/JOINTS-WIP.md: what is done, what is not yet).
+// Joints: constraints between two bodies (docs/SIM.md, "Joints": the types, how they behave, and
+// what is not done yet).
 //
 // A joint is created from a JointDef whose anchor and axis are in world space at creation; the
 // world keeps them in each body's frame from then on. Joints have IDs of their own, never reused,
@@ -24,7 +25,7 @@ struct JointId {
   friend constexpr auto operator<=>(JointId, JointId) noexcept = default;
 };
 
-/// The numeric values will be part of the canonical state encoding (append, never renumber).
+/// The numeric values are part of the canonical state encoding (append, never renumber).
 enum class JointType : std::uint8_t {
   ball = 0,         ///< the anchors coincide; free rotation
   hinge = 1,        ///< ball, plus rotation about `axis` only
@@ -41,7 +42,7 @@ struct JointDef {
   BodyId body_a{};
   BodyId body_b{};
   /// World-space point at creation, fixed in both bodies from then on. A distance joint attaches
-  /// here to body_a and to body_b's centre.
+  /// here to body_a and to body_b's position (its origin: the centre of a primitive).
   Vec3 anchor{};
   /// World-space unit vector at creation (|axis|^2 within 2^-20 of 1): the hinge's and slider's
   /// axis, the swing-twist's twist axis.
@@ -72,8 +73,8 @@ struct JointDef {
 struct JointState {
   JointId id{};
   JointDef def{};         ///< as created (anchor and axis in world space at creation)
-  Vec3 local_anchor_a{};  ///< the anchor in body_a's frame (relative to its centre)
-  Vec3 local_anchor_b{};  ///< in body_b's frame (a distance joint: body_b's centre, zero)
+  Vec3 local_anchor_a{};  ///< the anchor in body_a's frame (relative to its position)
+  Vec3 local_anchor_b{};  ///< in body_b's frame (a distance joint: body_b's position, zero)
   Vec3 local_axis_a{};    ///< the axis in body_a's frame
   Vec3 local_axis_b{};    ///< in body_b's frame
   /// Body b's orientation in body a's frame at creation, conj(q_a) q_b: what a fixed joint holds.
@@ -96,13 +97,13 @@ struct JointState {
 };
 
 /// The constraint force and torque a joint applied to body_b (body_a got the opposite): `force`
-/// (N, world frame) acts at the joint's anchor on body_b (a distance joint's: body_b's centre),
+/// (N, world frame) acts at the joint's anchor on body_b (a distance joint's: body_b's position),
 /// `torque` (N m, world frame) is the couple of its angular rows, limits and motors beside that
 /// force, so that the joint's moment about its anchor is `torque`. World::joint_reaction derives
 /// it from the accumulated impulses the joint keeps, those of the last sub-step of the last step
 /// it was solved (impulse * substeps / dt); zero for a broken joint. break_force and break_torque
-/// are compared with the mean over the step's sub-steps (docs/JOINTS-WIP.md: the last sub-step
-/// alone overshoots when a load comes on suddenly).
+/// are compared with the mean over the step's sub-steps (docs/SIM.md, "Joints", "Breaking": the
+/// last sub-step alone overshoots when a load comes on suddenly).
 struct JointReaction {
   Vec3 force{};
   Vec3 torque{};

@@ -304,7 +304,7 @@ class World {
   /// the body, so a game may keep an entity index or a team in it). Does not wake the body.
   Status set_user_data(BodyId id, std::uint64_t user_data);
 
-  // ---- Joints (docs/JOINTS-WIP.md: what is done, what is not yet) ----
+  // ---- Joints (<detsim/sim/joint.hpp>; docs/SIM.md, "Joints") ----
 
   /// Creates a joint; its ID is the next in joint sequence. An invalid definition (unknown or
   /// identical bodies, two static bodies, an axis that is not a unit vector, lower > upper,
