@@ -266,7 +266,7 @@ void prepare_body(WorldState& s, std::size_t i);
 void destroy_joints_of(WorldState& s, BodyId id);
 
 /// The force and torque joint `j` applied to its body b in the last step it was solved, from its
-/// accumulated impulses and its bodies' present poses (joint_solver.cpp; zero when broken).
+/// accumulated impulses and its bodies' present poses (joint_prepare.cpp; zero when broken).
 [[nodiscard]] JointReaction joint_reaction_of(const WorldState& s, const JointState& j);
 
 /// Detaches every particle attached to body `id` (the particle goes free; its group wakes)

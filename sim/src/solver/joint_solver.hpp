@@ -1,6 +1,6 @@
-// Joints as a constraint kind (joint_solver.cpp), run after contacts in every stage (solve.cpp).
-// All six joint types (docs/SIM.md, "Joints": what each holds, and what is not done yet).
-// Internal to detsim::sim.
+// Joints as a constraint kind (joint_prepare.cpp, joint_solver.cpp), run after contacts in every
+// stage (solve.cpp). All six joint types (docs/SIM.md, "Joints": what each holds, and what is not
+// done yet). Internal to detsim::sim.
 #pragma once
 
 #include <array>
