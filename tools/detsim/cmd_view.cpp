@@ -486,6 +486,8 @@ bool read_text(const std::string& path, std::string& out) {
 
 int view_command(const ViewArgs& args) {
   const auto start = std::chrono::steady_clock::now();
+  std::vector<std::string> files{args.record};
+  if (!args.other.empty()) files.push_back(args.other);
   // three.js and the two helpers the viewer uses, as Debian's libjs-three installs them.
   static constexpr const char* three_files[] = {"three.min.js", "examples/js/math/ConvexHull.js",
                                                 "examples/js/geometries/ConvexGeometry.js",
@@ -528,12 +530,12 @@ int view_command(const ViewArgs& args) {
   replay::ViewOptions options;
   options.first = args.from;
   options.last = args.to;
-  if (Status s = replay::view_records(args.files, options, sink); !s)
+  if (Status s = replay::view_records(files, options, sink); !s)
     return usage_error("view", s.message());
   if (Status s = data.finish(); !s) return usage_error("view", s.message());
 
-  std::string title = "detsim view: " + args.files.front();
-  if (args.files.size() == 2) title += " and " + args.files[1];
+  std::string title = "detsim view: " + files.front();
+  if (files.size() == 2) title += " and " + files[1];
   std::string page;
   page += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" +
           html_escape(title) + "</title>\n";
@@ -553,7 +555,7 @@ int view_command(const ViewArgs& args) {
 
   std::string out = args.out;
   if (out.empty()) {
-    out = args.files.front();
+    out = files.front();
     const auto dot = out.find_last_of('.');
     const auto slash = out.find_last_of('/');
     if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) out.resize(dot);

@@ -62,7 +62,8 @@ struct BisectArgs {
 int bisect_command(const BisectArgs& args);
 
 struct ViewArgs {
-  std::vector<std::string> files;   ///< one record, or two records of the same match
+  std::string record;               ///< a replay or a desync report
+  std::string other;                ///< optional: a second record of the same match, overlaid
   std::string out;                  ///< the page; empty: the first file with .html
   std::uint64_t from = 0;           ///< the first frame shown
   std::optional<std::uint64_t> to;  ///< the last (default: the records' end)

@@ -477,10 +477,9 @@ frame is printed. Exit 0 when the records agree.)") +
   c->callback([&exit_code] { exit_code = cli::bisect_command(bisect); });
 
   c = app.add_subcommand("view", "Write a 3D replay viewer: one HTML page that plays a match");
-  c->add_option("RECORD", view.files,
-                "A replay or desync report; a second record of the same match overlays both")
-      ->required()
-      ->expected(1, 2);
+  c->add_option("RECORD", view.record, "A replay or desync report")->required();
+  c->add_option("OTHER", view.other,
+                "Optional: a second record of the same match (another machine's), overlaid");
   c->add_option("-o,--out", view.out, "The page to write (default: RECORD with .html)")
       ->type_name("PAGE");
   c->add_option("--from", view.from, "The first frame shown (default 0)")->type_name("FRAME");
